@@ -1,0 +1,66 @@
+# Build helpers shared by every folder: warnings, sanitizers, libraries, tests, executables.
+
+if(OSCAR_SANITIZE STREQUAL "address")
+  add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  add_link_options(-fsanitize=address,undefined)
+elseif(OSCAR_SANITIZE STREQUAL "thread")
+  add_compile_options(-fsanitize=thread -fno-omit-frame-pointer)
+  add_link_options(-fsanitize=thread)
+elseif(NOT OSCAR_SANITIZE STREQUAL "")
+  message(FATAL_ERROR "OSCAR_SANITIZE='${OSCAR_SANITIZE}': use '', 'address' or 'thread'")
+endif()
+
+# Warnings for OSCAR's own code (generated and third-party code is compiled without them).
+function(oscar_warnings target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow)
+  if(OSCAR_WERROR)
+    target_compile_options(${target} PRIVATE -Werror)
+  endif()
+endfunction()
+
+# oscar_add_library(NAME <name> ALIAS <ns::name> SOURCES ... [PUBLIC ...] [PRIVATE ...] [EXPORT])
+# A library with include/ as its public include directory.
+function(oscar_add_library)
+  cmake_parse_arguments(A "SHARED;EXPORT" "NAME;ALIAS" "SOURCES;PUBLIC;PRIVATE" ${ARGN})
+  if(A_SHARED)
+    add_library(${A_NAME} SHARED ${A_SOURCES})
+  else()
+    add_library(${A_NAME} STATIC ${A_SOURCES})
+  endif()
+  if(A_ALIAS)
+    add_library(${A_ALIAS} ALIAS ${A_NAME})
+  endif()
+  target_include_directories(${A_NAME} PUBLIC
+    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
+    $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+  target_link_libraries(${A_NAME} PUBLIC ${A_PUBLIC} PRIVATE ${A_PRIVATE})
+  oscar_warnings(${A_NAME})
+endfunction()
+
+# oscar_add_executable(NAME <name> SOURCES ... [LIBS ...]): a program in build/bin.
+function(oscar_add_executable)
+  cmake_parse_arguments(A "" "NAME" "SOURCES;LIBS" ${ARGN})
+  add_executable(${A_NAME} ${A_SOURCES})
+  target_link_libraries(${A_NAME} PRIVATE ${A_LIBS})
+  oscar_warnings(${A_NAME})
+endfunction()
+
+# oscar_add_test(NAME <name> SOURCES ... [LIBS ...] [LABELS ...] [TIMEOUT s])
+# One GoogleTest executable per folder, each test registered with gtest_discover_tests.
+function(oscar_add_test)
+  cmake_parse_arguments(A "" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  if(NOT OSCAR_BUILD_TESTS)
+    return()
+  endif()
+  if(NOT A_TIMEOUT)
+    set(A_TIMEOUT 120)
+  endif()
+  add_executable(${A_NAME} ${A_SOURCES})
+  set_target_properties(${A_NAME} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
+  target_link_libraries(${A_NAME} PRIVATE ${A_LIBS} GTest::gtest GTest::gtest_main GTest::gmock)
+  oscar_warnings(${A_NAME})
+  gtest_discover_tests(${A_NAME}
+    DISCOVERY_TIMEOUT 60
+    PROPERTIES LABELS "${A_LABELS}" TIMEOUT ${A_TIMEOUT}
+    ENVIRONMENT "OSCAR_BUILD_DIR=${PROJECT_BINARY_DIR};OSCAR_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
+endfunction()
