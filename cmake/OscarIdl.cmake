@@ -1,0 +1,37 @@
+# oscar_generate_idl(<target> IDL <files...> [INCLUDE_DIRS <dirs...>] [SUBDIR <dir>])
+# Runs fastddsgen (with type objects) on the IDL files at build time and adds the generated
+# sources to <target>. Generated code lands in ${CMAKE_CURRENT_BINARY_DIR}/generated/<SUBDIR>
+# and is included as <SUBDIR/name.h>; it is never committed and compiled without our warnings.
+function(oscar_generate_idl target)
+  cmake_parse_arguments(A "" "SUBDIR" "IDL;INCLUDE_DIRS" ${ARGN})
+  if(NOT OSCAR_FASTDDSGEN)
+    find_program(OSCAR_FASTDDSGEN fastddsgen REQUIRED)
+  endif()
+  set(root ${CMAKE_CURRENT_BINARY_DIR}/generated)
+  set(out ${root}/${A_SUBDIR})
+  file(MAKE_DIRECTORY ${out})  # fastddsgen wants its -d folder to exist
+  set(include_flags "")
+  foreach(dir IN LISTS A_INCLUDE_DIRS)
+    list(APPEND include_flags -I ${dir})
+  endforeach()
+  set(all_sources "")
+  foreach(idl IN LISTS A_IDL)
+    get_filename_component(abs ${idl} ABSOLUTE)
+    get_filename_component(stem ${idl} NAME_WE)
+    get_filename_component(idl_dir ${abs} DIRECTORY)
+    set(generated
+      ${out}/${stem}.h ${out}/${stem}.cxx
+      ${out}/${stem}PubSubTypes.h ${out}/${stem}PubSubTypes.cxx
+      ${out}/${stem}TypeObject.h ${out}/${stem}TypeObject.cxx)
+    add_custom_command(
+      OUTPUT ${generated}
+      COMMAND ${OSCAR_FASTDDSGEN} -typeobject -replace -I ${idl_dir} ${include_flags} -d ${out} ${abs}
+      DEPENDS ${A_IDL}
+      COMMENT "fastddsgen ${stem}.idl"
+      VERBATIM)
+    list(APPEND all_sources ${generated})
+  endforeach()
+  target_sources(${target} PRIVATE ${all_sources})
+  target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${root}>)
+  set_source_files_properties(${all_sources} PROPERTIES GENERATED TRUE)
+endfunction()

@@ -1,0 +1,54 @@
+#pragma once
+/// @file One DDS participant per process, created with OSCAR's network profile, with cached
+/// topics and a map of the topic types discovery has seen (for clear type-mismatch errors).
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include "oscar/network.hpp"
+
+namespace oscar {
+
+class DdsParticipant {
+ public:
+  /// @throws std::runtime_error if no participant can be created (e.g. all ports taken).
+  DdsParticipant(int domain, const std::string& name, const NetworkConfig& network = {});
+  ~DdsParticipant();
+  DdsParticipant(const DdsParticipant&) = delete;
+  DdsParticipant& operator=(const DdsParticipant&) = delete;
+
+  eprosima::fastdds::dds::DomainParticipant& get() { return *participant_; }
+  eprosima::fastdds::dds::Publisher& publisher() { return *publisher_; }
+  eprosima::fastdds::dds::Subscriber& subscriber() { return *subscriber_; }
+  int domain() const { return domain_; }
+
+  /// The topic of that name, registering the type if needed.
+  /// @throws std::invalid_argument if the topic exists here with another type, or if discovery
+  ///         saw the topic with another type elsewhere (naming both types).
+  eprosima::fastdds::dds::Topic& topic(const std::string& name,
+                                       eprosima::fastdds::dds::TopicDataType* type);
+  /// The type discovery has seen for a topic (from remote writers and readers), if any.
+  std::optional<std::string> discovered_type(const std::string& topic) const;
+
+ private:
+  class Listener;
+  int domain_;
+  std::unique_ptr<Listener> listener_;
+  eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
+  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
+  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  std::mutex mutex_;
+  std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
+};
+
+}  // namespace oscar

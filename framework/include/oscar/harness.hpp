@@ -1,0 +1,73 @@
+#pragma once
+/// @file KernelHarness: drives one kernel without DDS and without other processes
+/// (DESIGN §5 "Stand-alone"): feed its inputs, step it, read its outputs.
+
+#include <chrono>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "oscar/kernel_instance.hpp"
+
+namespace oscar {
+
+class KernelHarness {
+ public:
+  /// Builds a kernel of a registered (or loadable) type.
+  /// @throws like KernelInstance, or std::runtime_error for an unknown type.
+  explicit KernelHarness(const std::string& type, YAML::Node params = {},
+                         std::string name = "kernel_under_test",
+                         std::map<std::string, InputOptions> input_options = {});
+  ~KernelHarness();
+
+  /// Gives a cue to an input, as a producer would (stamped with the harness time if unstamped).
+  /// Pull and prefetch inputs are answered from everything fed so far.
+  template <CueType T>
+  void feed(const std::string& input, T cue) {
+    auto& port = input_port(input);
+    if (port.type().name != cue_type_info<T>().name) {
+      throw std::invalid_argument("harness: input '" + input + "' takes " + port.type().name +
+                                  ", not " + cue_type_info<T>().name);
+    }
+    if (cue.header().stamps().empty()) append_stamp(cue.header(), now_);
+    feed_erased(port, std::make_shared<const T>(std::move(cue)));
+  }
+
+  /// Runs process() once at the harness time.
+  void step() { instance_->run(now_, Trigger::kHarness, false); }
+  /// Runs stub() once.
+  void step_stub() { instance_->run(now_, Trigger::kHarness, true); }
+
+  /// Every cue the output published since the last call, oldest first.
+  template <CueType T>
+  std::vector<std::shared_ptr<const T>> take(const std::string& output) {
+    std::vector<std::shared_ptr<const T>> out;
+    for (auto& cue : take_erased(output)) out.push_back(std::static_pointer_cast<const T>(cue));
+    return out;
+  }
+
+  /// How many cues the output published since the last take (and takes them).
+  std::size_t take_count(const std::string& output) { return take_erased(output).size(); }
+
+  Stamp now() const { return now_; }
+  void set_now(Stamp t) { now_ = t; }
+  void advance(std::chrono::nanoseconds d) { now_ += d.count(); }
+
+  KernelInstance& instance() { return *instance_; }
+  Kernel& kernel() { return instance_->kernel(); }
+
+ private:
+  struct Captured;
+  InputPort& input_port(const std::string& name);
+  void feed_erased(InputPort& port, std::shared_ptr<const void> cue);
+  std::vector<std::shared_ptr<const void>> take_erased(const std::string& output);
+
+  Stamp now_ = 1'000'000'000;  // 1 s after the epoch: stamps are never 0 ("none")
+  std::unique_ptr<KernelInstance> instance_;
+  std::map<std::string, std::unique_ptr<Captured>> captured_;    // per output
+  std::map<std::string, std::unique_ptr<RingBuffer>> produced_;  // per input: what was fed
+};
+
+}  // namespace oscar

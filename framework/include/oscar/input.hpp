@@ -1,0 +1,165 @@
+#pragma once
+/// @file Inputs: the consumer end of a channel, with its ring buffer and transfer (DESIGN §5).
+
+#include <chrono>
+#include <functional>
+#include <future>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "oscar/cue.hpp"
+#include "oscar/ring_buffer.hpp"
+
+namespace oscar {
+
+/// How an input gets its cues (DESIGN §5).
+enum class Transfer {
+  kPush,     ///< the producer publishes; cues arrive in the ring buffer (default)
+  kPull,     ///< the consumer asks the producer's output ring buffer on demand
+  kPrefetch  ///< a non-blocking pull that returns a future
+};
+/// "push", "pull" or "prefetch".
+const char* to_string(Transfer t);
+/// @throws std::invalid_argument for any other text.
+Transfer parse_transfer(std::string_view text);
+
+/// Which cue of the producer's ring a pull asks for.
+enum class PullQuery { kLatest, kAtOrBefore, kNearest };
+
+struct InputOptions {
+  std::size_t depth = 16;
+  Transfer transfer = Transfer::kPush;
+};
+
+/// Answers pulls for one input: the producer's ring in this process, or a request over DDS.
+class PullSource {
+ public:
+  virtual ~PullSource() = default;
+  /// Resolves to the cue, or to nullptr if the producer holds none that matches.
+  virtual std::shared_future<std::shared_ptr<const void>> request(PullQuery query, Stamp t) = 0;
+};
+
+/// The type-independent part of an input; the framework works with this.
+class InputPort {
+ public:
+  InputPort(std::string kernel, std::string name, const CueTypeInfo& type, InputOptions options);
+  virtual ~InputPort() = default;
+  InputPort(const InputPort&) = delete;
+  InputPort& operator=(const InputPort&) = delete;
+
+  const std::string& kernel() const { return kernel_; }
+  const std::string& name() const { return name_; }
+  const CueTypeInfo& type() const { return type_; }
+  Transfer transfer() const { return transfer_; }
+  void set_transfer(Transfer t) { transfer_ = t; }
+  RingBuffer& buffer() { return buffer_; }
+  const RingBuffer& buffer() const { return buffer_; }
+
+  /// Stores an arriving cue (stamping its receive time) and runs the arrival hook.
+  void deliver(std::shared_ptr<const void> cue);
+  /// Called after every delivery, on the delivering thread (the frame triggers kernels with it).
+  void set_arrival_hook(std::function<void()> hook);
+  void set_pull_source(std::shared_ptr<PullSource> source);
+  /// Asks the producer; the answer is also stored in the ring buffer.
+  /// @throws std::logic_error if the input is not connected to a producer.
+  std::shared_future<std::shared_ptr<const void>> request(PullQuery query, Stamp t);
+
+ protected:
+  std::uint64_t seen_index_ = 0;  // newest entry handed out by wait_next
+
+ private:
+  std::string kernel_, name_;
+  const CueTypeInfo& type_;
+  Transfer transfer_;
+  RingBuffer buffer_;
+  std::mutex hooks_mutex_;
+  std::function<void()> arrival_hook_;
+  std::shared_ptr<PullSource> pull_source_;
+};
+
+/// A cue that a prefetch will deliver.
+template <CueType T>
+class CueFuture {
+ public:
+  explicit CueFuture(std::shared_future<std::shared_ptr<const void>> f) : f_(std::move(f)) {}
+  /// True once the answer is there (then get() does not block).
+  bool ready() const { return f_.wait_for(std::chrono::seconds(0)) == std::future_status::ready; }
+  /// Waits up to `timeout`; nullptr if the producer had nothing or did not answer in time.
+  std::shared_ptr<const T> get(std::chrono::nanoseconds timeout = std::chrono::seconds(1)) const {
+    if (f_.wait_for(timeout) != std::future_status::ready) return nullptr;
+    return std::static_pointer_cast<const T>(f_.get());
+  }
+
+ private:
+  std::shared_future<std::shared_ptr<const void>> f_;
+};
+
+/// A typed input handle, as KernelSetup::input<T>() returns it.
+template <CueType T>
+class Input final : public InputPort {
+ public:
+  using Ptr = std::shared_ptr<const T>;
+  using InputPort::InputPort;
+
+  /// The newest cue, or nullptr.
+  Ptr latest() const { return cast(buffer().latest()); }
+  /// The n newest cues, oldest first.
+  std::vector<Ptr> latest(std::size_t n) const { return cast(buffer().latest(n)); }
+  /// The newest cue generated at or before t, or nullptr.
+  Ptr at_or_before(Stamp t) const { return cast(buffer().at_or_before(t)); }
+  /// The cue generated nearest to t, or nullptr.
+  Ptr nearest(Stamp t) const { return cast(buffer().nearest(t)); }
+  /// The cues generated in [t0, t1], oldest first. @throws std::invalid_argument if t0 > t1.
+  std::vector<Ptr> range(Stamp t0, Stamp t1) const { return cast(buffer().range(t0, t1)); }
+  /// The next cue after the last one this call returned, waiting up to `timeout`.
+  Ptr wait_next(std::chrono::nanoseconds timeout) {
+    auto e = buffer().wait_next(seen_index_, timeout);
+    if (!e) return nullptr;
+    seen_index_ = e->index;
+    return std::static_pointer_cast<const T>(e->cue);
+  }
+  /// A cue with the time it reached this input.
+  struct Received {
+    Ptr cue;
+    Stamp received;
+  };
+  /// Every cue that arrived since the last take_new() or wait_next(), oldest first (cues the
+  /// ring buffer already evicted are lost: size the depth for the rate).
+  std::vector<Received> take_new() {
+    std::vector<Received> out;
+    for (const auto& e : buffer().latest(buffer().depth())) {
+      if (e.index <= seen_index_) continue;
+      out.push_back({std::static_pointer_cast<const T>(e.cue), e.received});
+      seen_index_ = e.index;
+    }
+    return out;
+  }
+  /// Pulls the producer's newest cue (pull transfer); nullptr if none or no answer in time.
+  Ptr pull(std::chrono::nanoseconds timeout = std::chrono::seconds(1)) {
+    return CueFuture<T>(request(PullQuery::kLatest, 0)).get(timeout);
+  }
+  /// Pulls the producer's cue at or before (or nearest to) t.
+  Ptr pull_at(Stamp t, PullQuery query = PullQuery::kAtOrBefore,
+              std::chrono::nanoseconds timeout = std::chrono::seconds(1)) {
+    return CueFuture<T>(request(query, t)).get(timeout);
+  }
+  /// Starts a pull and returns at once (prefetch transfer).
+  CueFuture<T> prefetch(PullQuery query = PullQuery::kLatest, Stamp t = 0) {
+    return CueFuture<T>(request(query, t));
+  }
+
+ private:
+  static Ptr cast(const std::optional<RingEntry>& e) {
+    return e ? std::static_pointer_cast<const T>(e->cue) : nullptr;
+  }
+  static std::vector<Ptr> cast(const std::vector<RingEntry>& entries) {
+    std::vector<Ptr> out;
+    out.reserve(entries.size());
+    for (const auto& e : entries) out.push_back(std::static_pointer_cast<const T>(e.cue));
+    return out;
+  }
+};
+
+}  // namespace oscar

@@ -1,0 +1,82 @@
+#pragma once
+/// @file Module: the frame of one module process (seed 004 §2.2, "Rahmen"). It hosts one or more
+/// kernels, does all communication (DDS and in-process handoff), runs the kernels in one
+/// processing thread according to their modes, and obeys configuration commands.
+
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <oscar/config.h>
+
+#include "oscar/kernel_instance.hpp"
+#include "oscar/module_spec.hpp"
+
+namespace oscar {
+
+class DdsParticipant;
+
+class Module {
+ public:
+  /// Loads the kernel types, constructs the kernels, checks the multi-core rules and wires the
+  /// kernels of this module to each other. Acquires no DDS or threads.
+  /// @throws std::invalid_argument / std::runtime_error naming the module, kernel and rule.
+  explicit Module(ModuleSpec spec, const std::vector<std::string>& plugin_path);
+  ~Module();
+  Module(const Module&) = delete;
+  Module& operator=(const Module&) = delete;
+
+  /// Joins the DDS domain (or stays in-process if domain < 0), wires remote inputs, starts the
+  /// processing thread and applies the initial modes.
+  void start(int domain);
+  /// Blocks until a shutdown command or request_stop().
+  void wait();
+  void request_stop();
+  /// Stops threads and leaves the domain (also done by the destructor).
+  void stop();
+
+  /// Applies a configuration command (as one arriving on oscar/config/<module> would be).
+  ConfigReply apply(const ConfigCommand& command);
+  ModuleState state() const;
+
+  const ModuleSpec& spec() const { return spec_; }
+  KernelInstance& kernel(const std::string& name);
+
+ private:
+  struct Slot;
+  class Dds;
+
+  void check_multicore_rules() const;
+  void wire_in_process();
+  void processing_loop();
+  void run_slot(Slot& slot, Trigger trigger);
+  void mark_pending(Slot& slot);
+  void post_and_wait(const std::function<void()>& task);
+  void report(const std::string& transition);
+  Slot& slot_for(const std::string& kernel, const std::string& command);
+  std::vector<Slot*> slots_for(const std::string& kernel_or_all, const std::string& command);
+  void rewire(Slot& slot, const std::string& input, const std::string& source);
+  ModuleState state_locked() const;
+
+  ModuleSpec spec_;
+  std::vector<std::unique_ptr<Slot>> slots_;
+  std::shared_ptr<spdlog::logger> log_;
+
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<std::function<void()>> tasks_;
+  bool suspended_ = false;
+  bool stopping_ = false;
+  bool stop_requested_ = false;
+  std::condition_variable stopped_;
+  std::string last_transition_;
+  std::thread processing_;
+  std::unique_ptr<Dds> dds_;
+};
+
+}  // namespace oscar

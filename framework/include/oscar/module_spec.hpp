@@ -1,0 +1,79 @@
+#pragma once
+/// @file What one module process hosts: parsed from YAML (a `modules:` entry of a system file or
+/// an oscar-run fragment) and checked against the seed's multi-core rules (seed 004 §2.2).
+
+#include <chrono>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "oscar/input.hpp"
+#include "oscar/network.hpp"
+
+namespace oscar {
+
+/// A kernel's mode (DESIGN §5): continuous with a cycle, single step with a trigger, or off.
+struct ModeSpec {
+  enum class Kind { kContinuous, kSingleStep, kDeactivated };
+  Kind kind = Kind::kSingleStep;
+  std::chrono::nanoseconds cycle{0};  ///< continuous only
+  std::string trigger;  ///< single step: "" (default), "command", "module" or "input:<name>"
+
+  /// "continuous(33ms)", "single_step(input:image)", "deactivated".
+  std::string describe() const;
+  /// Parses `single_step`, `deactivated`, `continuous:33ms`, `{continuous: 33ms}`,
+  /// `{single_step: {trigger: image}}`. @throws std::invalid_argument naming the rule.
+  static ModeSpec parse(const YAML::Node& node);
+  static ModeSpec parse_text(const std::string& text);
+};
+const char* to_string(ModeSpec::Kind kind);
+
+struct InputWiring {
+  std::string source;  ///< "<kernel>/<channel>"; empty = not wired
+  std::optional<Transfer> transfer;
+  std::optional<std::size_t> depth;
+};
+
+struct KernelSpec {
+  std::string type;
+  std::string name;
+  YAML::Node params;
+  std::map<std::string, InputWiring> inputs;
+  std::optional<ModeSpec> mode;
+  std::string where;  ///< "file:line" of its YAML entry, for messages
+};
+
+struct ModuleSpec {
+  std::string name;
+  std::string host;
+  std::optional<int> domain;
+  std::vector<KernelSpec> kernels;
+  ModeSpec mode;
+  bool stub = false;
+  NetworkConfig network;
+  std::string where;
+
+  /// Parses one module map. `file` names the source in messages ("file:line: ...").
+  /// @throws std::invalid_argument for unknown keys, missing names, duplicate kernel names,
+  ///         bad modes or wiring.
+  static ModuleSpec from_yaml(const YAML::Node& node, const std::string& file);
+  /// Loads a file holding either one module map or a system file with `modules:`; `module`
+  /// picks one of a system file's modules. YAML syntax errors are reported as file:line:col.
+  static ModuleSpec load(const std::string& path, const std::string& module = "");
+
+  const KernelSpec* find_kernel(const std::string& kernel_name) const;
+  /// The mode a kernel starts in: its own, or derived from the module's mode (a continuous
+  /// module runs its first kernel continuously and triggers the others).
+  ModeSpec effective_mode(const KernelSpec& kernel) const;
+};
+
+/// Loads a YAML file; syntax errors become std::invalid_argument "file:line:col: message".
+YAML::Node load_yaml_file(const std::string& path);
+
+/// "file:line" of a node (1-based line), for error messages.
+std::string yaml_where(const std::string& file, const YAML::Node& node);
+
+}  // namespace oscar

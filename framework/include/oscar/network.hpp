@@ -1,0 +1,32 @@
+#pragma once
+/// @file Where a participant may send and listen (DESIGN §4, the network rule).
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace YAML {
+class Node;
+}
+
+namespace oscar {
+
+/// The transport profile of a DDS participant. The default confines it to the loopback
+/// interface: UDP on 127.0.0.1 with unicast discovery to localhost, plus shared memory; no
+/// multicast, no other interface. A system file may name other interfaces and peers.
+struct NetworkConfig {
+  std::vector<std::string> interfaces{"127.0.0.1"};  ///< IPv4 addresses UDP may use
+  std::vector<std::string> peers{"127.0.0.1"};       ///< hosts discovery announces itself to
+  bool shared_memory = true;
+  std::uint32_t shm_segment_bytes = 8u << 20;  ///< must hold the largest cues in flight
+  int max_participants_per_host = 32;          ///< participant ids probed per peer
+
+  /// Reads a `network:` map (interfaces, peers, shared_memory, shm_segment_bytes).
+  /// @throws std::invalid_argument on unknown keys or non-IPv4 addresses.
+  static NetworkConfig from_yaml(const YAML::Node& node);
+};
+
+/// The domain id from $OSCAR_DOMAIN, else `fallback`.
+int domain_from_env(int fallback);
+
+}  // namespace oscar

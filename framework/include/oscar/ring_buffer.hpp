@@ -1,0 +1,68 @@
+#pragma once
+/// @file The ring buffer behind every channel end (DESIGN §5, seed 004 §2.2).
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <vector>
+
+#include "oscar/time.hpp"
+
+namespace oscar {
+
+/// One cue as a ring buffer holds it: the shared immutable payload and its stamps.
+struct RingEntry {
+  std::shared_ptr<const void> cue;  ///< the payload; never copied by the buffer
+  Stamp t = 0;                      ///< the cue's generation stamp (its header's first stamp)
+  Stamp received = 0;               ///< when this buffer got it
+  std::uint64_t index = 0;          ///< 1, 2, 3, ... in arrival order at this buffer
+};
+
+/// A fixed-depth buffer of the newest cues of one channel end, with access by time.
+/// Thread-safe: one or more producers, any number of readers. Queries by time assume nothing
+/// about order (a rewired input may receive older stamps), so they scan at most `depth` entries.
+class RingBuffer {
+ public:
+  /// @throws std::invalid_argument if depth is 0.
+  explicit RingBuffer(std::size_t depth);
+
+  /// Stores a cue, evicting the oldest when full; wakes waiters. Returns the entry's index.
+  std::uint64_t push(std::shared_ptr<const void> cue, Stamp t, Stamp received);
+
+  std::size_t depth() const { return slots_.size(); }
+  std::size_t size() const;
+  /// Cues pushed since construction (including evicted ones).
+  std::uint64_t pushed() const;
+
+  std::optional<RingEntry> latest() const;
+  /// The n newest entries, oldest first (fewer if fewer are held).
+  std::vector<RingEntry> latest(std::size_t n) const;
+  /// The newest entry with t <= `t`.
+  std::optional<RingEntry> at_or_before(Stamp t) const;
+  /// The entry whose t is closest to `t` (the older one on a tie).
+  std::optional<RingEntry> nearest(Stamp t) const;
+  /// Entries with t0 <= t <= t1, in ascending t.
+  /// @throws std::invalid_argument if t0 > t1 (an inverted time range).
+  std::vector<RingEntry> range(Stamp t0, Stamp t1) const;
+  /// The first entry with an index greater than `after_index`, waiting up to `timeout` for it.
+  /// If it was already evicted, the oldest held entry newer than `after_index` is returned.
+  std::optional<RingEntry> wait_next(std::uint64_t after_index,
+                                     std::chrono::nanoseconds timeout) const;
+  /// Drops every entry (indices keep counting).
+  void clear();
+
+ private:
+  std::vector<RingEntry> held_locked() const;  // oldest first
+
+  mutable std::mutex mutex_;
+  mutable std::condition_variable arrived_;
+  std::vector<RingEntry> slots_;
+  std::size_t next_ = 0;   // slot the next push writes
+  std::size_t count_ = 0;  // entries held
+  std::uint64_t pushed_ = 0;
+};
+
+}  // namespace oscar

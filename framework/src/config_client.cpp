@@ -1,0 +1,98 @@
+#include "oscar/config_client.hpp"
+
+#include <thread>
+
+#include <fmt/format.h>
+#include <oscar/configPubSubTypes.h>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+
+namespace oscar {
+namespace dds = eprosima::fastdds::dds;
+
+struct ConfigClient::Channel {
+  dds::DataWriter* writer = nullptr;
+  dds::DataReader* reader = nullptr;
+};
+
+ConfigClient::ConfigClient(DdsParticipant& participant, std::string sender)
+    : participant_(participant), sender_(std::move(sender)) {}
+
+ConfigClient::~ConfigClient() {
+  for (auto& [module, c] : channels_) {
+    participant_.publisher().delete_datawriter(c->writer);
+    participant_.subscriber().delete_datareader(c->reader);
+  }
+}
+
+ConfigClient::Channel& ConfigClient::channel(const std::string& module) {
+  auto& c = channels_[module];
+  if (c) return *c;
+  c = std::make_unique<Channel>();
+  dds::DataWriterQos wq = dds::DATAWRITER_QOS_DEFAULT;
+  wq.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  wq.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+  c->writer = participant_.publisher().create_datawriter(
+      &participant_.topic("oscar/config/" + module, new ConfigCommandPubSubType()), wq);
+  dds::DataReaderQos rq = dds::DATAREADER_QOS_DEFAULT;
+  rq.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  rq.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+  c->reader = participant_.subscriber().create_datareader(
+      &participant_.topic("oscar/config_reply/" + module, new ConfigReplyPubSubType()), rq);
+  return *c;
+}
+
+ConfigReply ConfigClient::send(const std::string& module, CommandKind kind,
+                               std::vector<std::string> args, std::chrono::milliseconds timeout) {
+  std::lock_guard lock(mutex_);
+  auto& c = channel(module);
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  // Wait until the module reads our commands and we read its replies.
+  for (;;) {
+    dds::PublicationMatchedStatus pub;
+    dds::SubscriptionMatchedStatus sub;
+    c.writer->get_publication_matched_status(pub);
+    c.reader->get_subscription_matched_status(sub);
+    if (pub.current_count > 0 && sub.current_count > 0) break;
+    if (std::chrono::steady_clock::now() > until) {
+      throw std::runtime_error(
+          fmt::format("no module named '{}' is running (nobody reads oscar/config/{} after {} ms)",
+                      module, module, timeout.count()));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ConfigCommand cmd;
+  cmd.id(next_id_++);
+  cmd.sender(sender_);
+  cmd.target(module);
+  cmd.kind(kind);
+  cmd.args(std::move(args));
+  c.writer->write(&cmd);
+  while (std::chrono::steady_clock::now() < until) {
+    ConfigReply reply;
+    dds::SampleInfo info;
+    while (c.reader->take_next_sample(&reply, &info) == ReturnCode_t::RETCODE_OK) {
+      if (info.valid_data && reply.id() == cmd.id()) return reply;
+    }
+    c.reader->wait_for_unread_message(eprosima::fastrtps::Duration_t(0, 20'000'000));
+  }
+  throw std::runtime_error(fmt::format("module '{}' did not answer command {} within {} ms", module,
+                                       cmd.id(), timeout.count()));
+}
+
+CommandKind parse_command_kind(const std::string& text) {
+  static const std::pair<const char*, CommandKind> kinds[] = {
+      {"activate", CMD_ACTIVATE},   {"deactivate", CMD_DEACTIVATE}, {"trigger", CMD_TRIGGER},
+      {"set_cycle", CMD_SET_CYCLE}, {"set_param", CMD_SET_PARAM},   {"rewire", CMD_REWIRE},
+      {"suspend", CMD_SUSPEND},     {"resume", CMD_RESUME},         {"stub", CMD_STUB},
+      {"shutdown", CMD_SHUTDOWN}};
+  std::string known;
+  for (const auto& [name, kind] : kinds) {
+    if (text == name) return kind;
+    known += (known.empty() ? "" : ", ") + std::string(name);
+  }
+  throw std::invalid_argument(fmt::format("unknown command '{}' (commands: {})", text, known));
+}
+
+}  // namespace oscar

@@ -1,0 +1,49 @@
+#include <algorithm>
+#include <map>
+#include <mutex>
+
+#include "oscar/cue_type_info.hpp"
+#include "oscar/cue_types.hpp"
+
+namespace oscar {
+namespace {
+struct Registry {
+  std::mutex mutex;
+  std::map<std::string, std::unique_ptr<CueTypeInfo>> types;
+};
+Registry& registry() {
+  static Registry r;
+  return r;
+}
+}  // namespace
+
+const CueTypeInfo& register_cue_type(CueTypeInfo info) {
+  auto& r = registry();
+  std::lock_guard lock(r.mutex);
+  auto& slot = r.types[info.name];
+  if (!slot) slot = std::make_unique<CueTypeInfo>(std::move(info));
+  return *slot;
+}
+
+const CueTypeInfo* find_cue_type(const std::string& name) {
+  auto& r = registry();
+  std::lock_guard lock(r.mutex);
+  const auto it = r.types.find(name);
+  return it == r.types.end() ? nullptr : it->second.get();
+}
+
+std::vector<std::string> cue_type_names() {
+  auto& r = registry();
+  std::lock_guard lock(r.mutex);
+  std::vector<std::string> names;
+  for (const auto& [name, info] : r.types) names.push_back(name);
+  return names;
+}
+
+void register_standard_cue_types() {
+  cue_type_info<Bool>();
+  cue_type_info<LineSeg3DSeq>();
+  cue_type_info<GvImage>();
+}
+
+}  // namespace oscar

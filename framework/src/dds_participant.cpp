@@ -1,0 +1,219 @@
+#include "oscar/dds_participant.hpp"
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <stdexcept>
+
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
+#include <fastrtps/utils/IPLocator.h>
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+
+namespace oscar {
+namespace dds = eprosima::fastdds::dds;
+using eprosima::fastrtps::rtps::IPLocator;
+using eprosima::fastrtps::rtps::Locator_t;
+
+namespace {
+
+bool is_ipv4(const std::string& s) {
+  in_addr a{};
+  return inet_pton(AF_INET, s.c_str(), &a) == 1;
+}
+
+// RTPS well-known ports (spec 9.6.1.1): PB + DG * domain + d1 + PG * participant.
+std::uint32_t metatraffic_unicast_port(int domain, int participant) {
+  return static_cast<std::uint32_t>(7400 + 250 * domain + 10 + 2 * participant);
+}
+
+// True if nobody on this host has bound the UDP port on that address.
+bool udp_port_free(const std::string& address, std::uint32_t port) {
+  const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+  if (fd < 0) return false;
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<std::uint16_t>(port));
+  inet_pton(AF_INET, address.c_str(), &a.sin_addr);
+  const bool ok = bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+  close(fd);
+  return ok;
+}
+
+dds::DomainParticipantQos participant_qos(const std::string& name, const NetworkConfig& net,
+                                          int domain, int participant_id) {
+  dds::DomainParticipantQos qos;
+  qos.name(name);
+  auto& transport = qos.transport();
+  transport.use_builtin_transports = false;
+  auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+  udp->interfaceWhiteList = net.interfaces;
+  transport.user_transports.push_back(udp);
+  if (net.shared_memory) {
+    auto shm = std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>();
+    shm->segment_size(net.shm_segment_bytes);
+    transport.user_transports.push_back(shm);
+  }
+  auto& builtin = qos.wire_protocol().builtin;
+  qos.wire_protocol().participant_id = participant_id;
+  // An explicit metatraffic unicast locator and no multicast locator: discovery is unicast only.
+  builtin.metatrafficMulticastLocatorList.clear();
+  builtin.metatrafficUnicastLocatorList.clear();
+  builtin.avoid_builtin_multicast = true;
+  Locator_t own;
+  IPLocator::setIPv4(own, net.interfaces.front());
+  own.port = metatraffic_unicast_port(domain, participant_id);
+  builtin.metatrafficUnicastLocatorList.push_back(own);
+  builtin.initialPeersList.clear();
+  for (const auto& peer : net.peers) {
+    for (int id = 0; id < net.max_participants_per_host; ++id) {
+      Locator_t l;
+      IPLocator::setIPv4(l, peer);
+      l.port = metatraffic_unicast_port(domain, id);
+      builtin.initialPeersList.push_back(l);
+    }
+  }
+  // Leave quickly and announce often: a vanished participant must not linger for 20 s.
+  builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(3, 0);
+  builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(1, 0);
+  return qos;
+}
+
+}  // namespace
+
+NetworkConfig NetworkConfig::from_yaml(const YAML::Node& node) {
+  NetworkConfig net;
+  if (!node || node.IsNull()) return net;
+  if (!node.IsMap()) throw std::invalid_argument("network: expected a map");
+  const auto addresses = [](const YAML::Node& list, const char* key) {
+    std::vector<std::string> out;
+    if (!list.IsSequence() || list.size() == 0) {
+      throw std::invalid_argument(fmt::format("network.{}: expected a non-empty list", key));
+    }
+    for (const auto& a : list) {
+      const auto s = a.as<std::string>();
+      if (!is_ipv4(s)) {
+        throw std::invalid_argument(fmt::format("network.{}: '{}' is not an IPv4 address", key, s));
+      }
+      out.push_back(s);
+    }
+    return out;
+  };
+  for (const auto& kv : node) {
+    const auto key = kv.first.as<std::string>();
+    if (key == "interfaces")
+      net.interfaces = addresses(kv.second, "interfaces");
+    else if (key == "peers")
+      net.peers = addresses(kv.second, "peers");
+    else if (key == "shared_memory")
+      net.shared_memory = kv.second.as<bool>();
+    else if (key == "shm_segment_bytes")
+      net.shm_segment_bytes = kv.second.as<std::uint32_t>();
+    else if (key == "max_participants_per_host")
+      net.max_participants_per_host = kv.second.as<int>();
+    else {
+      throw std::invalid_argument(
+          fmt::format("network: unknown key '{}' (allowed: interfaces, peers, shared_memory, "
+                      "shm_segment_bytes, max_participants_per_host)",
+                      key));
+    }
+  }
+  return net;
+}
+
+int domain_from_env(int fallback) {
+  const char* env = std::getenv("OSCAR_DOMAIN");
+  if (!env || !*env) return fallback;
+  char* end = nullptr;
+  const long d = std::strtol(env, &end, 10);
+  if (*end != '\0' || d < 0 || d > 232) {
+    throw std::invalid_argument(fmt::format("OSCAR_DOMAIN='{}': expected 0..232", env));
+  }
+  return static_cast<int>(d);
+}
+
+class DdsParticipant::Listener final : public dds::DomainParticipantListener {
+ public:
+  void on_publisher_discovery(dds::DomainParticipant*,
+                              eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
+    note(info.info.topicName().to_string(), info.info.typeName().to_string());
+  }
+  void on_subscriber_discovery(dds::DomainParticipant*,
+                               eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
+    note(info.info.topicName().to_string(), info.info.typeName().to_string());
+  }
+  std::optional<std::string> type_of(const std::string& topic) const {
+    std::lock_guard lock(mutex_);
+    const auto it = types_.find(topic);
+    if (it == types_.end()) return std::nullopt;
+    return it->second;
+  }
+
+ private:
+  void note(std::string topic, std::string type) {
+    std::lock_guard lock(mutex_);
+    types_[std::move(topic)] = std::move(type);
+  }
+  mutable std::mutex mutex_;
+  std::map<std::string, std::string> types_;
+};
+
+DdsParticipant::DdsParticipant(int domain, const std::string& name, const NetworkConfig& network)
+    : domain_(domain), listener_(std::make_unique<Listener>()) {
+  if (network.interfaces.empty()) throw std::invalid_argument("network: no interface given");
+  auto* factory = dds::DomainParticipantFactory::get_instance();
+  dds::StatusMask mask = dds::StatusMask::none();
+  for (int id = 0; id < network.max_participants_per_host && !participant_; ++id) {
+    if (!udp_port_free(network.interfaces.front(), metatraffic_unicast_port(domain, id))) continue;
+    participant_ = factory->create_participant(domain, participant_qos(name, network, domain, id),
+                                               listener_.get(), mask);
+  }
+  if (!participant_) {
+    throw std::runtime_error(fmt::format(
+        "cannot create a DDS participant '{}' on domain {}: no free participant id among {} "
+        "on {}",
+        name, domain, network.max_participants_per_host, network.interfaces.front()));
+  }
+  publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+  subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+}
+
+DdsParticipant::~DdsParticipant() {
+  if (participant_) {
+    participant_->delete_contained_entities();
+    dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  }
+}
+
+dds::Topic& DdsParticipant::topic(const std::string& name, dds::TopicDataType* type) {
+  dds::TypeSupport support(type);  // owns `type` from here on
+  std::lock_guard lock(mutex_);
+  if (auto it = topics_.find(name); it != topics_.end()) {
+    if (it->second->get_type_name() != support.get_type_name()) {
+      throw std::invalid_argument(fmt::format("topic '{}' carries {}, not {}", name,
+                                              it->second->get_type_name(),
+                                              support.get_type_name()));
+    }
+    return *it->second;
+  }
+  if (auto seen = listener_->type_of(name); seen && *seen != support.get_type_name()) {
+    throw std::invalid_argument(fmt::format("topic '{}' carries {} in the running system, not {}",
+                                            name, *seen, support.get_type_name()));
+  }
+  if (!participant_->find_type(support.get_type_name())) support.register_type(participant_);
+  auto* topic = participant_->create_topic(name, support.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+  if (!topic) throw std::runtime_error(fmt::format("cannot create topic '{}'", name));
+  topics_[name] = topic;
+  return *topic;
+}
+
+std::optional<std::string> DdsParticipant::discovered_type(const std::string& topic) const {
+  return listener_->type_of(topic);
+}
+
+}  // namespace oscar

@@ -1,0 +1,157 @@
+#include <dlfcn.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "oscar/kernel_registry.hpp"
+
+namespace oscar {
+namespace {
+struct TypeRegistry {
+  std::mutex mutex;
+  std::map<std::string, KernelTypeInfo, std::less<>> types;
+};
+TypeRegistry& type_registry() {
+  static TypeRegistry r;
+  return r;
+}
+
+bool is_identifier(std::string_view s) {
+  if (s.empty() || std::isdigit(static_cast<unsigned char>(s[0]))) return false;
+  return std::all_of(s.begin(), s.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+  });
+}
+}  // namespace
+
+InputPort* KernelPorts::find_input(std::string_view name) const {
+  for (const auto& p : inputs) {
+    if (p->name() == name) return p.get();
+  }
+  return nullptr;
+}
+
+OutputPort* KernelPorts::find_output(std::string_view name) const {
+  for (const auto& p : outputs) {
+    if (p->name() == name) return p.get();
+  }
+  return nullptr;
+}
+
+KernelSetup::KernelSetup(std::string kernel_name, std::string kernel_type, KernelPorts& ports,
+                         YAML::Node params, std::map<std::string, InputOptions> input_options)
+    : name_(std::move(kernel_name)),
+      type_(std::move(kernel_type)),
+      ports_(ports),
+      params_(std::move(params)),
+      input_options_(std::move(input_options)) {}
+
+void KernelSetup::check_port_name(const std::string& name) const {
+  if (!is_identifier(name)) {
+    throw std::invalid_argument(
+        fmt::format("kernel '{}' ({}): port name '{}' must be an identifier (letters, digits, _)",
+                    name_, type_, name));
+  }
+  if (ports_.find_input(name) || ports_.find_output(name)) {
+    throw std::invalid_argument(fmt::format(
+        "kernel '{}' ({}): port '{}' is declared twice; port names are unique per kernel", name_,
+        type_, name));
+  }
+}
+
+bool KernelSetup::unbound_params() const {
+  return !params_bound_ && params_ && params_.IsMap() && params_.size() > 0;
+}
+
+namespace internal {
+bool register_kernel_type(const char* type, KernelFactory factory, const char* source_file) {
+  auto& r = type_registry();
+  std::lock_guard lock(r.mutex);
+  r.types.try_emplace(type, KernelTypeInfo{type, factory, source_file});
+  return true;
+}
+}  // namespace internal
+
+const KernelTypeInfo* find_kernel_type(std::string_view type) {
+  auto& r = type_registry();
+  std::lock_guard lock(r.mutex);
+  const auto it = r.types.find(type);
+  return it == r.types.end() ? nullptr : &it->second;
+}
+
+std::vector<std::string> kernel_type_names() {
+  auto& r = type_registry();
+  std::lock_guard lock(r.mutex);
+  std::vector<std::string> names;
+  for (const auto& [name, info] : r.types) names.push_back(name);
+  return names;
+}
+
+std::vector<std::string> plugin_search_path() {
+  std::vector<std::string> path;
+  if (const char* env = std::getenv("OSCAR_PLUGIN_PATH")) {
+    std::string_view rest(env);
+    while (!rest.empty()) {
+      const auto colon = rest.find(':');
+      if (auto part = rest.substr(0, colon); !part.empty()) path.emplace_back(part);
+      if (colon == std::string_view::npos) break;
+      rest.remove_prefix(colon + 1);
+    }
+  }
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const auto dir = exe.parent_path();
+    path.push_back((dir / ".." / "lib" / "oscar" / "plugins").lexically_normal().string());
+    path.push_back((dir / ".." / "lib").lexically_normal().string());
+  }
+  return path;
+}
+
+std::vector<std::string> load_plugin(const std::string& path) {
+  const auto before = kernel_type_names();
+  // RTLD_GLOBAL: kernels of one module may share cue types defined in another plugin.
+  void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_GLOBAL);
+  if (!handle) {
+    throw std::runtime_error(fmt::format("plugin '{}' failed to load: {}", path, dlerror()));
+  }
+  std::vector<std::string> added;
+  for (const auto& name : kernel_type_names()) {
+    if (std::find(before.begin(), before.end(), name) == before.end()) added.push_back(name);
+  }
+  return added;
+}
+
+const KernelTypeInfo& load_kernel_type(const std::string& type,
+                                       const std::vector<std::string>& search_path) {
+  if (const auto* info = find_kernel_type(type)) return *info;
+  if (!is_identifier(type)) {
+    throw std::runtime_error(fmt::format(
+        "unknown kernel type '{}': type names are identifiers (letters, digits, _)", type));
+  }
+  const std::string file = "liboscar_kernel_" + type + ".so";
+  for (const auto& dir : search_path) {
+    const auto candidate = std::filesystem::path(dir) / file;
+    if (!std::filesystem::exists(candidate)) continue;
+    const auto added = load_plugin(candidate.string());
+    if (const auto* info = find_kernel_type(type)) return *info;
+    throw std::runtime_error(
+        fmt::format("plugin '{}' loaded but registers no kernel type '{}' (it registers: {})",
+                    candidate.string(), type,
+                    added.empty() ? "nothing" : fmt::format("{}", fmt::join(added, ", "))));
+  }
+  throw std::runtime_error(fmt::format(
+      "unknown kernel type '{}': no plugin {} in [{}] (set OSCAR_PLUGIN_PATH); known types: {}",
+      type, file, fmt::join(search_path, ", "), fmt::join(kernel_type_names(), ", ")));
+}
+
+}  // namespace oscar

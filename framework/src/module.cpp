@@ -1,0 +1,357 @@
+#include "oscar/module.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <future>
+#include <map>
+#include <set>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include "module_dds.hpp"
+#include "module_slot.hpp"
+#include "ring_pull_source.hpp"
+
+namespace oscar {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+
+std::string source_kernel(const std::string& source) { return source.substr(0, source.find('/')); }
+std::string source_channel(const std::string& source) {
+  return source.substr(source.find('/') + 1);
+}
+}  // namespace
+
+Module::Module(ModuleSpec spec, const std::vector<std::string>& plugin_path)
+    : spec_(std::move(spec)) {
+  log_ = spdlog::get(spec_.name);
+  if (!log_) {
+    log_ = std::make_shared<spdlog::logger>(
+        spec_.name, std::make_shared<spdlog::sinks::stdout_color_sink_mt>());
+    log_->set_pattern("%H:%M:%S.%e %^%-5l%$ [%n] %v");
+  }
+  for (const auto& k : spec_.kernels) {
+    const auto& type = [&]() -> const KernelTypeInfo& {
+      try {
+        return load_kernel_type(k.type, plugin_path);
+      } catch (const std::exception& e) {
+        throw std::runtime_error(fmt::format("{}: kernel '{}': {}", k.where, k.name, e.what()));
+      }
+    }();
+    std::map<std::string, InputOptions> options;
+    for (const auto& [input, wiring] : k.inputs) {
+      InputOptions o;
+      if (wiring.depth) o.depth = *wiring.depth;
+      if (wiring.transfer) o.transfer = *wiring.transfer;
+      options[input] = o;
+    }
+    auto slot = std::make_unique<Slot>();
+    slot->spec = &k;
+    try {
+      slot->instance = std::make_unique<KernelInstance>(type, k.name, k.params, options, log_);
+      // Declared defaults stand unless the YAML set depth/transfer explicitly.
+      for (const auto& [input, wiring] : k.inputs) {
+        auto* port = slot->instance->ports().find_input(input);
+        if (wiring.transfer) port->set_transfer(*wiring.transfer);
+      }
+    } catch (const std::exception& e) {
+      throw std::invalid_argument(
+          fmt::format("{}: kernel '{}' ({}): {}", k.where, k.name, k.type, e.what()));
+    }
+    slot->mode = spec_.effective_mode(k);
+    slot->stub = spec_.stub;
+    slots_.push_back(std::move(slot));
+  }
+  check_multicore_rules();
+  wire_in_process();
+}
+
+Module::~Module() { stop(); }
+
+KernelInstance& Module::kernel(const std::string& name) {
+  for (auto& s : slots_) {
+    if (s->instance->name() == name) return *s->instance;
+  }
+  throw std::invalid_argument(fmt::format("module '{}' has no kernel '{}'", spec_.name, name));
+}
+
+// Seed 004 §2.2: the conditions under which several kernels may share one frame and thread.
+void Module::check_multicore_rules() const {
+  const auto rule = [&](const std::string& name, const std::string& detail) {
+    return std::invalid_argument(fmt::format("{}: module '{}' breaks the multi-core rule '{}': {}",
+                                             spec_.where, spec_.name, name, detail));
+  };
+  std::vector<std::string> continuous;
+  for (const auto& s : slots_) {
+    if (s->continuous()) continuous.push_back(s->instance->name());
+  }
+  if (continuous.size() > 1) {
+    throw rule("at most one kernel in continuous mode (it triggers the others)",
+               fmt::format("kernels {} are all continuous", fmt::join(continuous, ", ")));
+  }
+  // The internal cue flow: wires whose source is a kernel of this module.
+  std::map<std::string, int> fan_out;  // source address -> internal consumers
+  std::map<std::string, int> fan_in;   // kernel -> internal inputs
+  std::set<std::string> kinds;
+  for (const auto& s : slots_) {
+    for (const auto& [input, wiring] : s->spec->inputs) {
+      if (wiring.source.empty() || !spec_.find_kernel(source_kernel(wiring.source))) continue;
+      ++fan_out[wiring.source];
+      ++fan_in[s->instance->name()];
+      const auto transfer = s->instance->ports().find_input(input)->transfer();
+      kinds.insert(transfer == Transfer::kPush ? "push" : "pull");
+    }
+  }
+  if (kinds.size() > 1) {
+    throw rule("inside a multi-core module only pull or only push",
+               "its internal inputs mix push with pull/prefetch");
+  }
+  const auto branch =
+      std::find_if(fan_out.begin(), fan_out.end(), [](const auto& kv) { return kv.second > 1; });
+  const auto merge =
+      std::find_if(fan_in.begin(), fan_in.end(), [](const auto& kv) { return kv.second > 1; });
+  if (branch != fan_out.end() && merge != fan_in.end()) {
+    throw rule("no branching together with merging of cue flow",
+               fmt::format("{} branches to {} kernels and {} merges {} inputs", branch->first,
+                           branch->second, merge->first, merge->second));
+  }
+}
+
+void Module::wire_in_process() {
+  for (auto& s : slots_) {
+    for (const auto& [input_name, wiring] : s->spec->inputs) {
+      if (wiring.source.empty()) continue;
+      const auto producer_name = source_kernel(wiring.source);
+      if (!spec_.find_kernel(producer_name)) continue;  // remote: wired when DDS starts
+      auto* input = s->instance->ports().find_input(input_name);
+      auto& producer = kernel(producer_name);
+      auto* output = producer.ports().find_output(source_channel(wiring.source));
+      if (!output) {
+        throw std::invalid_argument(fmt::format(
+            "{}: kernel '{}' input '{}': kernel '{}' has no output '{}'", s->spec->where,
+            s->instance->name(), input_name, producer_name, source_channel(wiring.source)));
+      }
+      if (input->transfer() == Transfer::kPush) {
+        output->connect(input);  // throws naming both types if they differ
+      } else if (output->type().name != input->type().name) {
+        throw std::invalid_argument(fmt::format(
+            "cannot wire {} ({}) to input {}/{} ({}): the types differ", output->address(),
+            output->type().name, input->kernel(), input->name(), input->type().name));
+      }
+      input->set_pull_source(std::make_shared<internal::RingPullSource>(output->buffer(), *input));
+    }
+  }
+  // Triggers: a single-step kernel triggered by data runs when its trigger input gets a cue.
+  for (auto& s : slots_) {
+    Slot* slot = s.get();
+    for (auto& input : slot->instance->ports().inputs) {
+      InputPort* port = input.get();
+      port->set_arrival_hook([this, slot, port] {
+        std::lock_guard lock(mutex_);
+        if (!slot->single_step()) return;
+        const auto& t = slot->mode.trigger;
+        const bool first_input = slot->instance->ports().inputs.front().get() == port;
+        if (t == "input:" + port->name() || (t.empty() && first_input)) mark_pending(*slot);
+      });
+    }
+  }
+}
+
+void Module::mark_pending(Slot& slot) {
+  slot.pending = true;
+  wake_.notify_all();
+}
+
+void Module::start(int domain) {
+  if (domain >= 0) {
+    dds_ = std::make_unique<Dds>(*this, domain);
+    dds_->wire_outputs(slots_);
+    for (auto& s : slots_) {
+      for (const auto& [input, wiring] : s->spec->inputs) {
+        if (wiring.source.empty() || spec_.find_kernel(source_kernel(wiring.source))) continue;
+        dds_->connect_input(*s->instance->ports().find_input(input), wiring.source);
+      }
+    }
+  }
+  {
+    std::lock_guard lock(mutex_);
+    const auto now = Clock::now();
+    for (auto& s : slots_) s->next_due = now;
+  }
+  processing_ = std::thread([this] { processing_loop(); });
+  if (dds_) dds_->start_config();
+  std::vector<std::string> modes;
+  for (auto& s : slots_) modes.push_back(s->instance->name() + ": " + s->mode.describe());
+  report(fmt::format("started ({})", fmt::join(modes, ", ")));
+}
+
+void Module::wait() {
+  std::unique_lock lock(mutex_);
+  stopped_.wait(lock, [&] { return stop_requested_; });
+}
+
+void Module::request_stop() {
+  std::lock_guard lock(mutex_);
+  stop_requested_ = true;
+  stopped_.notify_all();
+}
+
+void Module::stop() {
+  if (dds_) dds_->stop_config();
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+    stop_requested_ = true;
+    stopped_.notify_all();
+    wake_.notify_all();
+  }
+  if (processing_.joinable()) processing_.join();
+  dds_.reset();
+}
+
+void Module::run_slot(Slot& slot, Trigger trigger) {
+  try {
+    if (!slot.active) {
+      slot.instance->kernel().on_activate();
+      slot.active = true;
+    }
+    slot.instance->run(wall_now(), trigger, slot.stub);
+  } catch (const std::exception& e) {
+    slot.failure = e.what();
+    log_->error("kernel '{}' failed in {}: {}", slot.instance->name(),
+                slot.stub ? "stub()" : "process()", e.what());
+  }
+}
+
+// One thread runs every kernel of the module (seed 004 §2.2): the continuous kernel on its
+// cycle, followed by the kernels it triggers; single-step kernels when their trigger holds.
+void Module::processing_loop() {
+  std::unique_lock lock(mutex_);
+  while (!stopping_) {
+    while (!tasks_.empty()) {
+      auto task = std::move(tasks_.front());
+      tasks_.pop_front();
+      lock.unlock();
+      task();
+      lock.lock();
+    }
+    if (stopping_) break;
+    Slot* due = nullptr;
+    for (auto& s : slots_) {
+      if (s->continuous()) due = s.get();
+    }
+    const bool pending = std::any_of(slots_.begin(), slots_.end(),
+                                     [](const auto& s) { return s->pending && s->single_step(); });
+    const auto now = Clock::now();
+    if (suspended_ || (!pending && (!due || due->next_due > now))) {
+      if (!suspended_ && due) {
+        wake_.wait_until(lock, due->next_due);
+      } else {
+        wake_.wait(lock);
+      }
+      continue;
+    }
+    std::vector<std::pair<Slot*, Trigger>> run;
+    if (due && due->next_due <= now) {
+      run.emplace_back(due, Trigger::kCycle);
+      for (auto& s : slots_) {
+        if (s.get() != due && s->single_step() && s->mode.trigger == "module") {
+          run.emplace_back(s.get(), Trigger::kModule);
+        }
+      }
+      due->next_due += due->mode.cycle;
+    }
+    lock.unlock();
+    for (auto [slot, trigger] : run) run_slot(*slot, trigger);
+    lock.lock();
+    if (due && !run.empty()) {
+      const auto after = Clock::now();
+      if (after > due->next_due) {  // the cycle took longer than the cycle time
+        ++due->overruns;
+        if (due->overruns == 1 || due->overruns % 100 == 0) {
+          log_->warn("kernel '{}' overran its {} cycle ({} overruns so far)", due->instance->name(),
+                     format_duration(due->mode.cycle), due->overruns);
+        }
+        due->next_due = after;
+      }
+    }
+    // Kernels whose trigger fired, in declaration order (upstream first in a chain).
+    for (bool again = true; again && !stopping_ && !suspended_;) {
+      again = false;
+      for (auto& s : slots_) {
+        if (!s->pending || !s->single_step()) continue;
+        s->pending = false;
+        again = true;
+        const auto trigger = s->mode.trigger == "command" ? Trigger::kCommand : Trigger::kInput;
+        lock.unlock();
+        run_slot(*s, trigger);
+        lock.lock();
+      }
+    }
+  }
+  lock.unlock();
+  for (auto& s : slots_) {
+    if (s->active) {
+      s->instance->kernel().on_deactivate();
+      s->active = false;
+    }
+  }
+}
+
+void Module::post_and_wait(const std::function<void()>& task) {
+  if (std::this_thread::get_id() == processing_.get_id() || !processing_.joinable()) {
+    task();
+    return;
+  }
+  std::packaged_task<void()> packaged(task);
+  auto done = packaged.get_future();
+  {
+    std::lock_guard lock(mutex_);
+    tasks_.emplace_back([&packaged] { packaged(); });
+    wake_.notify_all();
+  }
+  done.get();  // rethrows what the task threw
+}
+
+void Module::report(const std::string& transition) {
+  {
+    std::lock_guard lock(mutex_);
+    last_transition_ = transition;
+  }
+  log_->info("{}", transition);
+  if (dds_) dds_->publish_state(state());
+}
+
+ModuleState Module::state() const {
+  std::lock_guard lock(mutex_);
+  return state_locked();
+}
+
+ModuleState Module::state_locked() const {
+  ModuleState st;
+  st.module_name(spec_.name);
+  st.host(spec_.host);
+  st.pid(static_cast<std::int32_t>(getpid()));
+  st.suspended(suspended_);
+  st.last_transition(last_transition_);
+  for (const auto& s : slots_) {
+    KernelState k;
+    k.name(s->instance->name());
+    k.type(s->instance->type());
+    k.mode(to_string(s->mode.kind));
+    k.cycle_ns(s->continuous() ? s->mode.cycle.count() : 0);
+    k.trigger(s->single_step() ? (s->mode.trigger.empty() ? "default" : s->mode.trigger) : "");
+    k.stub(s->stub);
+    k.cycles(s->instance->cycles());
+    k.overruns(s->overruns);
+    st.kernels().push_back(std::move(k));
+  }
+  return st;
+}
+
+}  // namespace oscar

@@ -1,0 +1,266 @@
+// Configuration flow (DESIGN §6): commands, the authority rule, and replies.
+#include <algorithm>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "module_dds.hpp"
+#include "module_slot.hpp"
+
+namespace oscar {
+namespace {
+
+const char* kind_name(CommandKind k) {
+  switch (k) {
+    case CMD_ACTIVATE:
+      return "activate";
+    case CMD_DEACTIVATE:
+      return "deactivate";
+    case CMD_TRIGGER:
+      return "trigger";
+    case CMD_SET_CYCLE:
+      return "set_cycle";
+    case CMD_SET_PARAM:
+      return "set_param";
+    case CMD_REWIRE:
+      return "rewire";
+    case CMD_SUSPEND:
+      return "suspend";
+    case CMD_RESUME:
+      return "resume";
+    case CMD_STUB:
+      return "stub";
+    case CMD_SHUTDOWN:
+      return "shutdown";
+  }
+  return "?";
+}
+
+// Seed 004 §2.4: only the coordinator configures modules; the registry suspends, resumes and
+// re-applies a restarted module's configuration; boot applies the initial configuration.
+bool authorised(const std::string& sender, CommandKind kind) {
+  if (sender == "coordinator" || sender == "boot") return true;
+  if (sender == "registry") return kind != CMD_TRIGGER;
+  return false;
+}
+
+void need_args(const ConfigCommand& c, std::size_t n, const char* form) {
+  if (c.args().size() != n) {
+    throw std::invalid_argument(fmt::format("{} takes {} argument(s) ({}), got {}",
+                                            kind_name(c.kind()), n, form, c.args().size()));
+  }
+}
+
+}  // namespace
+
+Module::Slot& Module::slot_for(const std::string& kernel, const std::string& command) {
+  for (auto& s : slots_) {
+    if (s->instance->name() == kernel) return *s;
+  }
+  std::vector<std::string> names;
+  for (auto& s : slots_) names.push_back(s->instance->name());
+  throw std::invalid_argument(fmt::format("{}: module '{}' has no kernel '{}' (kernels: {})",
+                                          command, spec_.name, kernel, fmt::join(names, ", ")));
+}
+
+std::vector<Module::Slot*> Module::slots_for(const std::string& kernel_or_all,
+                                             const std::string& command) {
+  std::vector<Slot*> out;
+  if (kernel_or_all == "*") {
+    for (auto& s : slots_) out.push_back(s.get());
+  } else {
+    out.push_back(&slot_for(kernel_or_all, command));
+  }
+  return out;
+}
+
+ConfigReply Module::apply(const ConfigCommand& c) {
+  ConfigReply reply;
+  reply.id(c.id());
+  reply.module_name(spec_.name);
+  const std::string kind = kind_name(c.kind());
+  if (!authorised(c.sender(), c.kind())) {
+    reply.ok(false);
+    reply.error(fmt::format(
+        "refused: '{}' may not {} module '{}': only the coordinator configures modules (the "
+        "registry may suspend, resume and re-apply; boot applies the initial configuration)",
+        c.sender(), kind, spec_.name));
+    log_->warn("{}", reply.error());
+    reply.state(state());
+    return reply;
+  }
+  try {
+    std::string transition;
+    switch (c.kind()) {
+      case CMD_ACTIVATE: {
+        if (c.args().empty() || c.args().size() > 2) {
+          throw std::invalid_argument(
+              "activate takes [kernel|*] or [kernel|*, mode], e.g. ['cam', 'continuous:33ms']");
+        }
+        const auto targets = slots_for(c.args()[0], kind);
+        post_and_wait([&] {
+          for (auto* s : targets) {
+            auto mode = c.args().size() == 2 ? ModeSpec::parse_text(c.args()[1])
+                                             : spec_.effective_mode(*s->spec);
+            if (mode.kind == ModeSpec::Kind::kDeactivated) mode = ModeSpec{};
+            std::lock_guard lock(mutex_);
+            if (mode.kind == ModeSpec::Kind::kContinuous) {
+              for (auto& other : slots_) {
+                if (other.get() != s && other->continuous()) {
+                  throw std::invalid_argument(fmt::format(
+                      "cannot make '{}' continuous: '{}' already is (multi-core rule: at most "
+                      "one kernel in continuous mode)",
+                      s->instance->name(), other->instance->name()));
+                }
+              }
+            }
+            transition += fmt::format("{}{}: {} -> {}", transition.empty() ? "" : "; ",
+                                      s->instance->name(), s->mode.describe(), mode.describe());
+            s->mode = mode;
+            s->next_due = std::chrono::steady_clock::now();
+          }
+          wake_.notify_all();
+        });
+        break;
+      }
+      case CMD_DEACTIVATE: {
+        need_args(c, 1, "kernel|*");
+        const auto targets = slots_for(c.args()[0], kind);
+        post_and_wait([&] {
+          for (auto* s : targets) {
+            {
+              std::lock_guard lock(mutex_);
+              transition += fmt::format("{}{}: {} -> deactivated", transition.empty() ? "" : "; ",
+                                        s->instance->name(), s->mode.describe());
+              s->mode.kind = ModeSpec::Kind::kDeactivated;
+              s->pending = false;
+            }
+            if (s->active) {
+              s->instance->kernel().on_deactivate();
+              s->active = false;
+            }
+          }
+        });
+        break;
+      }
+      case CMD_TRIGGER: {
+        need_args(c, 1, "kernel|*");
+        std::lock_guard lock(mutex_);
+        for (auto* s : slots_for(c.args()[0], kind)) {
+          if (!s->single_step()) {
+            throw std::invalid_argument(
+                fmt::format("cannot trigger '{}': it is {}, not single_step", s->instance->name(),
+                            s->mode.describe()));
+          }
+          mark_pending(*s);
+        }
+        break;  // not a transition: no report
+      }
+      case CMD_SET_CYCLE: {
+        need_args(c, 2, "kernel, cycle");
+        auto& s = slot_for(c.args()[0], kind);
+        const auto cycle = parse_duration(c.args()[1]);
+        std::lock_guard lock(mutex_);
+        if (!s.continuous() || cycle.count() <= 0) {
+          throw std::invalid_argument(
+              fmt::format("set_cycle: '{}' is {}; only a continuous kernel has a (positive) cycle",
+                          s.instance->name(), s.mode.describe()));
+        }
+        transition = fmt::format("{}: cycle {} -> {}", s.instance->name(),
+                                 format_duration(s.mode.cycle), format_duration(cycle));
+        s.mode.cycle = cycle;
+        break;
+      }
+      case CMD_SET_PARAM: {
+        need_args(c, 3, "kernel, name, value");
+        auto& s = slot_for(c.args()[0], kind);
+        const auto* field = s.instance->ports().params.find(c.args()[1]);
+        if (field && !field->runtime && s.active) {
+          throw std::invalid_argument(
+              fmt::format("parameter '{}' of '{}' cannot change while it runs; deactivate it first",
+                          c.args()[1], s.instance->name()));
+        }
+        post_and_wait([&] {
+          s.instance->ports().params.set_text(c.args()[1], c.args()[2]);
+          s.instance->kernel().on_params_changed();
+        });
+        transition = fmt::format("{}: {} = {}", s.instance->name(), c.args()[1], c.args()[2]);
+        break;
+      }
+      case CMD_REWIRE: {
+        need_args(c, 3, "kernel, input, source");
+        rewire(slot_for(c.args()[0], kind), c.args()[1], c.args()[2]);
+        transition = fmt::format("{}.{} <- {}", c.args()[0], c.args()[1], c.args()[2]);
+        break;
+      }
+      case CMD_SUSPEND:
+      case CMD_RESUME: {
+        need_args(c, 0, "none");
+        std::lock_guard lock(mutex_);
+        suspended_ = c.kind() == CMD_SUSPEND;
+        wake_.notify_all();
+        transition = suspended_ ? "suspended (buffers kept)" : "resumed";
+        break;
+      }
+      case CMD_STUB: {
+        need_args(c, 2, "kernel|*, on|off");
+        if (c.args()[1] != "on" && c.args()[1] != "off") {
+          throw std::invalid_argument("stub: the second argument is 'on' or 'off'");
+        }
+        std::lock_guard lock(mutex_);
+        for (auto* s : slots_for(c.args()[0], kind)) {
+          s->stub = c.args()[1] == "on";
+          transition += fmt::format("{}{}: stub {}", transition.empty() ? "" : "; ",
+                                    s->instance->name(), c.args()[1]);
+        }
+        break;
+      }
+      case CMD_SHUTDOWN:
+        transition = "shutdown requested";
+        request_stop();
+        break;
+    }
+    if (!transition.empty()) report(transition);
+    reply.ok(true);
+  } catch (const std::exception& e) {
+    reply.ok(false);
+    reply.error(fmt::format("{} failed: {}", kind, e.what()));
+    log_->warn("{}", reply.error());
+  }
+  reply.state(state());
+  return reply;
+}
+
+void Module::rewire(Slot& slot, const std::string& input_name, const std::string& source) {
+  auto* input = slot.instance->ports().find_input(input_name);
+  if (!input) {
+    throw std::invalid_argument(
+        fmt::format("kernel '{}' has no input '{}'", slot.instance->name(), input_name));
+  }
+  const auto slash = source.find('/');
+  if (slash == std::string::npos || slash == 0 || slash + 1 == source.size()) {
+    throw std::invalid_argument(fmt::format("source '{}' must be '<kernel>/<channel>'", source));
+  }
+  const auto producer = source.substr(0, slash);
+  // Disconnect from every in-process producer first, then connect the new source.
+  for (auto& s : slots_) {
+    for (auto& out : s->instance->ports().outputs) out->disconnect(input);
+  }
+  if (spec_.find_kernel(producer)) {
+    auto* output = kernel(producer).ports().find_output(source.substr(slash + 1));
+    if (!output) {
+      throw std::invalid_argument(
+          fmt::format("kernel '{}' has no output '{}'", producer, source.substr(slash + 1)));
+    }
+    if (dds_) dds_->disconnect_input(*input);
+    output->connect(input);
+  } else if (dds_) {
+    dds_->connect_input(*input, source);  // waits until the new source is matched
+  } else {
+    throw std::invalid_argument(fmt::format(
+        "source '{}' is not in module '{}' and the module runs without DDS", source, spec_.name));
+  }
+}
+
+}  // namespace oscar

@@ -1,0 +1,235 @@
+#include "module_dds.hpp"
+
+#include <chrono>
+#include <stdexcept>
+#include <thread>
+
+#include <fmt/format.h>
+#include <oscar/configPubSubTypes.h>
+
+namespace oscar {
+namespace dds = eprosima::fastdds::dds;
+
+namespace {
+dds::DataWriterQos cue_writer_qos(const OutputOptions& o) {
+  dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
+  q.reliability().kind =
+      o.reliable ? dds::RELIABLE_RELIABILITY_QOS : dds::BEST_EFFORT_RELIABILITY_QOS;
+  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = static_cast<std::int32_t>(o.depth);
+  q.durability().kind =
+      o.transient_local ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
+  q.publish_mode().kind = dds::SYNCHRONOUS_PUBLISH_MODE;
+  return q;
+}
+
+dds::DataReaderQos cue_reader_qos(std::size_t depth) {
+  dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
+  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = static_cast<std::int32_t>(std::max<std::size_t>(depth, 1));
+  q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
+  return q;
+}
+}  // namespace
+
+// Writes an output's cues to DDS, skipping the serialisation while nobody listens (volatile).
+class Module::Dds::OutputWriter final : public dds::DataWriterListener {
+ public:
+  OutputWriter(DdsParticipant& p, OutputPort& out) : out_(out) {
+    auto& topic = p.topic(cue_topic(out.address()), out.type().new_topic_type());
+    writer_ = p.publisher().create_datawriter(&topic, cue_writer_qos(out.options()), this,
+                                              dds::StatusMask::publication_matched());
+    if (!writer_) throw std::runtime_error("cannot create a writer for " + out.address());
+    const bool keep_history = out.options().transient_local;
+    out.set_remote([this, keep_history](const void* cue) {
+      if (keep_history || matched_.load(std::memory_order_relaxed) > 0) {
+        writer_->write(const_cast<void*>(cue));
+      }
+    });
+  }
+  ~OutputWriter() override { out_.set_remote(nullptr); }
+  void on_publication_matched(dds::DataWriter*,
+                              const dds::PublicationMatchedStatus& status) override {
+    matched_ = status.current_count;
+  }
+  dds::DataWriter* writer_ = nullptr;
+
+ private:
+  OutputPort& out_;
+  std::atomic<int> matched_{0};
+};
+
+class Module::Dds::CueReader final : public dds::DataReaderListener {
+ public:
+  CueReader(DdsParticipant& p, InputPort& input, const std::string& source) : input_(input) {
+    auto& topic = p.topic(cue_topic(source), input.type().new_topic_type());
+    reader_ = p.subscriber().create_datareader(&topic, cue_reader_qos(input.buffer().depth()), this,
+                                               dds::StatusMask::data_available()
+                                                   << dds::StatusMask::subscription_matched());
+    if (!reader_) throw std::runtime_error("cannot create a reader for " + source);
+  }
+  void on_data_available(dds::DataReader* reader) override {
+    dds::SampleInfo info;
+    for (;;) {
+      auto cue = input_.type().make();
+      if (reader->take_next_sample(cue.get(), &info) != ReturnCode_t::RETCODE_OK) break;
+      if (info.valid_data) input_.deliver(std::move(cue));
+    }
+  }
+  void on_subscription_matched(dds::DataReader*,
+                               const dds::SubscriptionMatchedStatus& status) override {
+    matched_ = status.current_count;
+  }
+  bool wait_matched(std::chrono::milliseconds timeout) const {
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    while (matched_.load() == 0 && std::chrono::steady_clock::now() < until) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    return matched_.load() > 0;
+  }
+  dds::DataReader* reader_ = nullptr;
+
+ private:
+  InputPort& input_;
+  std::atomic<int> matched_{0};
+};
+
+class Module::Dds::ConfigListener final : public dds::DataReaderListener {
+ public:
+  explicit ConfigListener(Dds& owner) : owner_(owner) {}
+  void on_data_available(dds::DataReader* reader) override {
+    ConfigCommand c;
+    dds::SampleInfo info;
+    while (reader->take_next_sample(&c, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      std::lock_guard lock(owner_.queue_mutex_);
+      owner_.queue_.push_back(c);
+      owner_.queue_cv_.notify_all();
+    }
+  }
+
+ private:
+  Dds& owner_;
+};
+
+Module::Dds::Dds(Module& module, int domain)
+    : module_(module), participant_(domain, "oscar:" + module.spec_.name, module.spec_.network) {}
+
+Module::Dds::~Dds() {
+  stop_config();
+  {
+    std::lock_guard lock(readers_mutex_);
+    for (auto& [input, reader] : readers_)
+      participant_.subscriber().delete_datareader(reader->reader_);
+    readers_.clear();
+  }
+  for (auto& w : writers_) participant_.publisher().delete_datawriter(w->writer_);
+  writers_.clear();
+}
+
+void Module::Dds::wire_outputs(std::vector<std::unique_ptr<Slot>>& slots) {
+  for (auto& s : slots) {
+    for (auto& out : s->instance->ports().outputs) {
+      writers_.push_back(std::make_unique<OutputWriter>(participant_, *out));
+    }
+  }
+}
+
+void Module::Dds::connect_input(InputPort& input, const std::string& source) {
+  auto reader = std::make_unique<CueReader>(participant_, input, source);
+  if (!reader->wait_matched(std::chrono::milliseconds(2000))) {
+    module_.log_->warn("input {}/{}: no publisher of {} matched yet; cues arrive once it appears",
+                       input.kernel(), input.name(), cue_topic(source));
+  }
+  std::unique_ptr<CueReader> old;
+  {
+    std::lock_guard lock(readers_mutex_);
+    auto& slot = readers_[&input];
+    old = std::move(slot);
+    slot = std::move(reader);
+  }
+  if (old) participant_.subscriber().delete_datareader(old->reader_);
+}
+
+void Module::Dds::disconnect_input(InputPort& input) {
+  std::unique_ptr<CueReader> old;
+  {
+    std::lock_guard lock(readers_mutex_);
+    auto it = readers_.find(&input);
+    if (it == readers_.end()) return;
+    old = std::move(it->second);
+    readers_.erase(it);
+  }
+  participant_.subscriber().delete_datareader(old->reader_);
+}
+
+void Module::Dds::start_config() {
+  const auto& name = module_.spec_.name;
+  dds::DataWriterQos state_qos = dds::DATAWRITER_QOS_DEFAULT;
+  state_qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  state_qos.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
+  state_qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  state_qos.history().depth = 1;
+  state_writer_ = participant_.publisher().create_datawriter(
+      &participant_.topic("oscar/registry/module_state", new ModuleStatePubSubType()), state_qos);
+
+  dds::DataWriterQos reply_qos = dds::DATAWRITER_QOS_DEFAULT;
+  reply_qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  reply_qos.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+  reply_writer_ = participant_.publisher().create_datawriter(
+      &participant_.topic("oscar/config_reply/" + name, new ConfigReplyPubSubType()), reply_qos);
+
+  dds::DataReaderQos config_qos = dds::DATAREADER_QOS_DEFAULT;
+  config_qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  config_qos.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+  config_listener_ = std::make_unique<ConfigListener>(*this);
+  config_reader_ = participant_.subscriber().create_datareader(
+      &participant_.topic("oscar/config/" + name, new ConfigCommandPubSubType()), config_qos,
+      config_listener_.get(), dds::StatusMask::data_available());
+  if (!state_writer_ || !reply_writer_ || !config_reader_) {
+    throw std::runtime_error("cannot create the configuration endpoints of module " + name);
+  }
+  {
+    std::lock_guard lock(queue_mutex_);
+    serving_ = true;
+  }
+  config_thread_ = std::thread([this] { serve_config(); });
+}
+
+// Commands are applied on their own thread, never inside a DDS callback: a rewire creates and
+// deletes readers, and activate waits for the processing thread.
+void Module::Dds::serve_config() {
+  std::unique_lock lock(queue_mutex_);
+  while (true) {
+    queue_cv_.wait(lock, [&] { return !serving_ || !queue_.empty(); });
+    if (!serving_) return;
+    auto command = std::move(queue_.front());
+    queue_.pop_front();
+    lock.unlock();
+    auto reply = module_.apply(command);
+    reply_writer_->write(&reply);
+    lock.lock();
+  }
+}
+
+void Module::Dds::stop_config() {
+  {
+    std::lock_guard lock(queue_mutex_);
+    if (!serving_) return;
+    serving_ = false;
+    queue_cv_.notify_all();
+  }
+  if (config_thread_.joinable()) config_thread_.join();
+  if (config_reader_) participant_.subscriber().delete_datareader(config_reader_);
+  config_reader_ = nullptr;
+}
+
+void Module::Dds::publish_state(const ModuleState& state) {
+  if (state_writer_) {
+    auto copy = state;
+    state_writer_->write(&copy);
+  }
+}
+
+}  // namespace oscar

@@ -1,0 +1,64 @@
+#pragma once
+// The DDS side of a module frame: cue writers and readers, the configuration topic and its
+// replies, module state and log records (DESIGN §4 topics and QoS classes).
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+
+#include "module_slot.hpp"
+#include "oscar/dds_participant.hpp"
+#include "oscar/module.hpp"
+
+namespace oscar {
+
+/// Topic of a kernel's output channel.
+inline std::string cue_topic(const std::string& address) { return "oscar/cue/" + address; }
+
+class Module::Dds {
+ public:
+  Dds(Module& module, int domain);
+  ~Dds();
+
+  void wire_outputs(std::vector<std::unique_ptr<Slot>>& slots);
+  /// Subscribes the input to a remote source, replacing any earlier subscription once the new
+  /// one is matched (so nothing the new source publishes after the switch is lost).
+  void connect_input(InputPort& input, const std::string& source);
+  void disconnect_input(InputPort& input);
+  void start_config();
+  void stop_config();
+  void publish_state(const ModuleState& state);
+
+ private:
+  class CueReader;
+  class OutputWriter;
+  class ConfigListener;
+  void serve_config();
+
+  Module& module_;
+  DdsParticipant participant_;
+  std::vector<std::unique_ptr<OutputWriter>> writers_;
+  std::mutex readers_mutex_;
+  std::map<InputPort*, std::unique_ptr<CueReader>> readers_;
+
+  eprosima::fastdds::dds::DataWriter* state_writer_ = nullptr;
+  eprosima::fastdds::dds::DataWriter* reply_writer_ = nullptr;
+  eprosima::fastdds::dds::DataReader* config_reader_ = nullptr;
+  std::unique_ptr<ConfigListener> config_listener_;
+  std::mutex queue_mutex_;
+  std::condition_variable queue_cv_;
+  std::deque<ConfigCommand> queue_;
+  bool serving_ = false;
+  std::thread config_thread_;
+};
+
+}  // namespace oscar

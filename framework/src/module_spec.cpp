@@ -1,0 +1,289 @@
+#include "oscar/module_spec.hpp"
+
+#include <algorithm>
+#include <set>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "oscar/time.hpp"
+
+namespace oscar {
+namespace {
+
+[[noreturn]] void fail(const std::string& at, const std::string& message) {
+  throw std::invalid_argument(at + ": " + message);
+}
+
+void check_keys(const YAML::Node& map, const std::string& file, const std::string& what,
+                std::initializer_list<const char*> allowed) {
+  for (const auto& kv : map) {
+    const auto key = kv.first.as<std::string>();
+    if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
+      fail(yaml_where(file, kv.first),
+           fmt::format("{}: unknown key '{}' (allowed: {})", what, key, fmt::join(allowed, ", ")));
+    }
+  }
+}
+
+std::string scalar(const YAML::Node& node, const std::string& file, const std::string& what) {
+  if (!node || !node.IsScalar() || node.Scalar().empty()) {
+    fail(node ? yaml_where(file, node) : file, what + " must be a non-empty string");
+  }
+  return node.Scalar();
+}
+
+bool is_identifier(const std::string& s) {
+  return !s.empty() && !std::isdigit(static_cast<unsigned char>(s[0])) &&
+         std::all_of(s.begin(), s.end(), [](char c) {
+           return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+         });
+}
+
+InputWiring parse_wiring(const YAML::Node& node, const std::string& file, const std::string& what) {
+  InputWiring w;
+  if (node.IsScalar()) {
+    w.source = node.Scalar();
+  } else if (node.IsMap()) {
+    check_keys(node, file, what, {"source", "transfer", "depth"});
+    if (node["source"]) w.source = scalar(node["source"], file, what + ".source");
+    try {
+      if (node["transfer"]) w.transfer = parse_transfer(node["transfer"].as<std::string>());
+      if (node["depth"]) w.depth = node["depth"].as<std::size_t>();
+    } catch (const std::exception& e) {
+      fail(yaml_where(file, node), what + ": " + e.what());
+    }
+  } else {
+    fail(yaml_where(file, node), what + ": expected 'kernel/channel' or {source, transfer, depth}");
+  }
+  const auto slash = w.source.find('/');
+  if (!w.source.empty() &&
+      (slash == std::string::npos || slash == 0 || slash + 1 == w.source.size() ||
+       w.source.find('/', slash + 1) != std::string::npos)) {
+    fail(yaml_where(file, node),
+         fmt::format("{}: source '{}' must be '<kernel>/<channel>'", what, w.source));
+  }
+  if (w.depth && *w.depth == 0) fail(yaml_where(file, node), what + ": depth must be at least 1");
+  return w;
+}
+
+KernelSpec parse_kernel(const YAML::Node& node, const std::string& file, std::size_t index) {
+  const auto what = fmt::format("kernels[{}]", index);
+  if (!node.IsMap()) fail(yaml_where(file, node), what + ": expected a map with type and name");
+  check_keys(node, file, what, {"type", "name", "params", "inputs", "mode"});
+  KernelSpec k;
+  k.where = yaml_where(file, node);
+  k.type = scalar(node["type"], file.empty() ? k.where : file, what + ".type");
+  k.name = node["name"] ? scalar(node["name"], file, what + ".name") : k.type;
+  if (!is_identifier(k.name)) {
+    fail(k.where, fmt::format("{}: kernel name '{}' must be an identifier", what, k.name));
+  }
+  k.params = node["params"] ? YAML::Clone(node["params"]) : YAML::Node();
+  if (k.params && !k.params.IsNull() && !k.params.IsMap()) {
+    fail(yaml_where(file, node["params"]), what + ".params: expected a map of name: value");
+  }
+  if (const auto inputs = node["inputs"]) {
+    if (!inputs.IsMap()) fail(yaml_where(file, inputs), what + ".inputs: expected a map");
+    // DESIGN §7's short form puts `transfer:`/`depth:` beside the inputs: it applies to all.
+    std::optional<Transfer> all_transfer;
+    std::optional<std::size_t> all_depth;
+    for (const auto& kv : inputs) {
+      const auto key = kv.first.as<std::string>();
+      try {
+        if (key == "transfer") all_transfer = parse_transfer(kv.second.as<std::string>());
+        if (key == "depth") all_depth = kv.second.as<std::size_t>();
+      } catch (const std::exception& e) {
+        fail(yaml_where(file, kv.second), fmt::format("{}.inputs.{}: {}", what, key, e.what()));
+      }
+    }
+    for (const auto& kv : inputs) {
+      const auto key = kv.first.as<std::string>();
+      if (key == "transfer" || key == "depth") continue;
+      auto w = parse_wiring(kv.second, file, fmt::format("{}.inputs.{}", what, key));
+      if (!w.transfer) w.transfer = all_transfer;
+      if (!w.depth) w.depth = all_depth;
+      k.inputs[key] = std::move(w);
+    }
+  }
+  if (node["mode"]) {
+    try {
+      k.mode = ModeSpec::parse(node["mode"]);
+    } catch (const std::invalid_argument& e) {
+      fail(yaml_where(file, node["mode"]), what + ".mode: " + e.what());
+    }
+  }
+  return k;
+}
+
+}  // namespace
+
+std::string yaml_where(const std::string& file, const YAML::Node& node) {
+  const auto mark = node.Mark();
+  if (mark.line < 0) return file;
+  return fmt::format("{}:{}", file, mark.line + 1);
+}
+
+YAML::Node load_yaml_file(const std::string& path) {
+  try {
+    return YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw std::invalid_argument(fmt::format("{}: cannot read the file", path));
+  } catch (const YAML::ParserException& e) {
+    throw std::invalid_argument(fmt::format("{}:{}:{}: malformed YAML: {}", path, e.mark.line + 1,
+                                            e.mark.column + 1, e.msg));
+  }
+}
+
+const char* to_string(ModeSpec::Kind kind) {
+  switch (kind) {
+    case ModeSpec::Kind::kContinuous:
+      return "continuous";
+    case ModeSpec::Kind::kSingleStep:
+      return "single_step";
+    case ModeSpec::Kind::kDeactivated:
+      return "deactivated";
+  }
+  return "?";
+}
+
+std::string ModeSpec::describe() const {
+  switch (kind) {
+    case Kind::kContinuous:
+      return fmt::format("continuous({})", format_duration(cycle));
+    case Kind::kSingleStep:
+      return fmt::format("single_step({})", trigger.empty() ? "default" : trigger);
+    case Kind::kDeactivated:
+      return "deactivated";
+  }
+  return "?";
+}
+
+ModeSpec ModeSpec::parse_text(const std::string& text) {
+  const auto colon = text.find(':');
+  const auto head = text.substr(0, colon);
+  const auto tail = colon == std::string::npos ? std::string() : text.substr(colon + 1);
+  ModeSpec m;
+  if (head == "continuous") {
+    if (tail.empty()) {
+      throw std::invalid_argument("mode 'continuous' needs a cycle, e.g. 'continuous:33ms'");
+    }
+    m.kind = Kind::kContinuous;
+    m.cycle = parse_duration(tail);
+    if (m.cycle.count() <= 0) throw std::invalid_argument("a continuous cycle must be positive");
+  } else if (head == "single_step") {
+    m.kind = Kind::kSingleStep;
+    if (!tail.empty()) {
+      m.trigger = (tail == "command" || tail == "module" || tail.starts_with("input:"))
+                      ? tail
+                      : "input:" + tail;
+    }
+  } else if (head == "deactivated" && tail.empty()) {
+    m.kind = Kind::kDeactivated;
+  } else {
+    throw std::invalid_argument(fmt::format(
+        "mode '{}': expected continuous:<cycle>, single_step[:<trigger>] or deactivated", text));
+  }
+  return m;
+}
+
+ModeSpec ModeSpec::parse(const YAML::Node& node) {
+  if (node.IsScalar()) return parse_text(node.Scalar());
+  if (node.IsMap() && node.size() == 1) {
+    const auto key = node.begin()->first.as<std::string>();
+    const auto value = node.begin()->second;
+    if (key == "continuous" && value.IsScalar()) return parse_text("continuous:" + value.Scalar());
+    if (key == "single_step") {
+      if (value.IsNull()) return parse_text("single_step");
+      if (value.IsMap() && value["trigger"] && value.size() == 1) {
+        return parse_text("single_step:" + value["trigger"].as<std::string>());
+      }
+    }
+  }
+  throw std::invalid_argument(
+      "expected single_step, deactivated, {continuous: <cycle>} or {single_step: {trigger: X}}");
+}
+
+ModuleSpec ModuleSpec::from_yaml(const YAML::Node& node, const std::string& file) {
+  if (!node || !node.IsMap()) fail(file, "a module must be a map with name and kernels");
+  check_keys(node, file, "module",
+             {"name", "host", "domain", "kernels", "mode", "stub", "network", "restart", "debug"});
+  ModuleSpec m;
+  m.where = yaml_where(file, node);
+  m.name = scalar(node["name"], m.where, "module name");
+  if (!is_identifier(m.name)) {
+    fail(m.where, fmt::format("module name '{}' must be an identifier", m.name));
+  }
+  if (node["host"]) m.host = scalar(node["host"], file, "host");
+  if (node["domain"]) m.domain = node["domain"].as<int>();
+  const auto kernels = node["kernels"];
+  if (!kernels || !kernels.IsSequence() || kernels.size() == 0) {
+    fail(m.where, fmt::format("module '{}': kernels must be a non-empty list", m.name));
+  }
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < kernels.size(); ++i) {
+    auto k = parse_kernel(kernels[i], file, i);
+    if (!names.insert(k.name).second) {
+      fail(k.where, fmt::format("module '{}': duplicate kernel name '{}'; kernel names are unique "
+                                "within a system",
+                                m.name, k.name));
+    }
+    m.kernels.push_back(std::move(k));
+  }
+  if (node["mode"]) {
+    try {
+      m.mode = ModeSpec::parse(node["mode"]);
+    } catch (const std::invalid_argument& e) {
+      fail(yaml_where(file, node["mode"]), std::string("mode: ") + e.what());
+    }
+  }
+  if (node["stub"]) m.stub = node["stub"].as<bool>();
+  try {
+    m.network = NetworkConfig::from_yaml(node["network"]);
+  } catch (const std::invalid_argument& e) {
+    fail(yaml_where(file, node["network"]), e.what());
+  }
+  return m;
+}
+
+ModuleSpec ModuleSpec::load(const std::string& path, const std::string& module) {
+  const auto root = load_yaml_file(path);
+  if (root.IsMap() && root["modules"]) {
+    const auto modules = root["modules"];
+    std::vector<std::string> names;
+    for (const auto& m : modules) {
+      if (m["name"] && m["name"].IsScalar()) names.push_back(m["name"].Scalar());
+      if (m["name"] && m["name"].IsScalar() && (module.empty() || m["name"].Scalar() == module)) {
+        if (module.empty() && modules.size() > 1) break;
+        auto spec = from_yaml(m, path);
+        if (!spec.domain && root["domain"]) spec.domain = root["domain"].as<int>();
+        if (!m["network"] && root["network"])
+          spec.network = NetworkConfig::from_yaml(root["network"]);
+        return spec;
+      }
+    }
+    throw std::invalid_argument(fmt::format("{}: {} (modules: {})", path,
+                                            module.empty()
+                                                ? "the system has several modules; name one"
+                                                : "no module named '" + module + "'",
+                                            fmt::join(names, ", ")));
+  }
+  return from_yaml(root, path);
+}
+
+const KernelSpec* ModuleSpec::find_kernel(const std::string& kernel_name) const {
+  for (const auto& k : kernels) {
+    if (k.name == kernel_name) return &k;
+  }
+  return nullptr;
+}
+
+ModeSpec ModuleSpec::effective_mode(const KernelSpec& kernel) const {
+  if (kernel.mode) return *kernel.mode;
+  if (mode.kind == ModeSpec::Kind::kContinuous && &kernel != &kernels.front()) {
+    return ModeSpec{ModeSpec::Kind::kSingleStep, {}, "module"};
+  }
+  return mode;
+}
+
+}  // namespace oscar

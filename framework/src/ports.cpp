@@ -1,0 +1,128 @@
+#include <algorithm>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "oscar/input.hpp"
+#include "oscar/output.hpp"
+
+namespace oscar {
+
+const char* to_string(Transfer t) {
+  switch (t) {
+    case Transfer::kPush:
+      return "push";
+    case Transfer::kPull:
+      return "pull";
+    case Transfer::kPrefetch:
+      return "prefetch";
+  }
+  return "?";
+}
+
+Transfer parse_transfer(std::string_view text) {
+  if (text == "push") return Transfer::kPush;
+  if (text == "pull") return Transfer::kPull;
+  if (text == "prefetch") return Transfer::kPrefetch;
+  throw std::invalid_argument(fmt::format("transfer '{}': expected push, pull or prefetch", text));
+}
+
+InputPort::InputPort(std::string kernel, std::string name, const CueTypeInfo& type,
+                     InputOptions options)
+    : kernel_(std::move(kernel)),
+      name_(std::move(name)),
+      type_(type),
+      transfer_(options.transfer),
+      buffer_(options.depth) {}
+
+void InputPort::deliver(std::shared_ptr<const void> cue) {
+  const Stamp t = generation_stamp(type_.header(cue.get()));
+  buffer_.push(std::move(cue), t, wall_now());
+  std::function<void()> hook;
+  {
+    std::lock_guard lock(hooks_mutex_);
+    hook = arrival_hook_;
+  }
+  if (hook) hook();
+}
+
+void InputPort::set_arrival_hook(std::function<void()> hook) {
+  std::lock_guard lock(hooks_mutex_);
+  arrival_hook_ = std::move(hook);
+}
+
+void InputPort::set_pull_source(std::shared_ptr<PullSource> source) {
+  std::lock_guard lock(hooks_mutex_);
+  pull_source_ = std::move(source);
+}
+
+std::shared_future<std::shared_ptr<const void>> InputPort::request(PullQuery query, Stamp t) {
+  std::shared_ptr<PullSource> source;
+  {
+    std::lock_guard lock(hooks_mutex_);
+    source = pull_source_;
+  }
+  if (!source) {
+    throw std::logic_error(fmt::format(
+        "input '{}/{}' cannot pull: it is not connected to a producer", kernel_, name_));
+  }
+  return source->request(query, t);
+}
+
+OutputPort::OutputPort(std::string kernel, std::string name, const CueTypeInfo& type,
+                       OutputOptions options)
+    : kernel_(std::move(kernel)),
+      name_(std::move(name)),
+      type_(type),
+      options_(options),
+      buffer_(options.depth),
+      clock_(&wall_now) {}
+
+void OutputPort::publish_erased(std::shared_ptr<void> cue) {
+  // The header is a const view in CueTypeInfo; the cue is still ours to complete here.
+  auto& header = const_cast<CueHeader&>(type_.header(cue.get()));
+  std::lock_guard lock(mutex_);
+  header.seq(++seq_);
+  header.source(address());
+  if (header.stamps().empty()) header.stamps().push_back(static_cast<unsigned long long>(clock_()));
+  std::shared_ptr<const void> frozen = std::move(cue);
+  buffer_.push(frozen, generation_stamp(header), wall_now());
+  for (auto* input : consumers_) input->deliver(frozen);
+  if (remote_) remote_(frozen.get());
+}
+
+void OutputPort::forward_erased(std::shared_ptr<const void> cue) {
+  std::lock_guard lock(mutex_);
+  buffer_.push(cue, generation_stamp(type_.header(cue.get())), wall_now());
+  for (auto* input : consumers_) input->deliver(cue);
+  if (remote_) remote_(cue.get());
+}
+
+void OutputPort::connect(InputPort* input) {
+  if (input->type().name != type_.name) {
+    throw std::invalid_argument(
+        fmt::format("cannot wire {} ({}) to input {}/{} ({}): the types differ", address(),
+                    type_.name, input->kernel(), input->name(), input->type().name));
+  }
+  std::lock_guard lock(mutex_);
+  if (std::find(consumers_.begin(), consumers_.end(), input) == consumers_.end()) {
+    consumers_.push_back(input);
+  }
+}
+
+void OutputPort::disconnect(InputPort* input) {
+  std::lock_guard lock(mutex_);
+  std::erase(consumers_, input);
+}
+
+void OutputPort::set_remote(std::function<void(const void*)> remote) {
+  std::lock_guard lock(mutex_);
+  remote_ = std::move(remote);
+}
+
+void OutputPort::set_clock(std::function<Stamp()> clock) {
+  std::lock_guard lock(mutex_);
+  clock_ = std::move(clock);
+}
+
+}  // namespace oscar

@@ -1,0 +1,122 @@
+// oscar-run: hosts one or more kernels from plugins in one process (DESIGN §5).
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+#include <thread>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include "oscar/cue_types.hpp"
+#include "oscar/module.hpp"
+#include "oscar/time.hpp"
+
+namespace {
+
+oscar::ModuleSpec spec_from_flags(const std::string& name, const std::vector<std::string>& kernels,
+                                  const std::vector<std::string>& params,
+                                  const std::vector<std::string>& inputs) {
+  YAML::Node root;
+  root["name"] = name;
+  for (const auto& k : kernels) {
+    const auto colon = k.find(':');
+    YAML::Node kernel;
+    kernel["type"] = k.substr(0, colon);
+    kernel["name"] = colon == std::string::npos ? k : k.substr(colon + 1);
+    root["kernels"].push_back(kernel);
+  }
+  const auto kernel_node = [&](const std::string& flag, const std::string& text) {
+    const auto dot = text.find('.');
+    const auto eq = text.find('=');
+    if (dot == std::string::npos || eq == std::string::npos || eq < dot) {
+      throw std::invalid_argument(fmt::format("{} '{}': expected KERNEL.KEY=VALUE", flag, text));
+    }
+    const auto kernel = text.substr(0, dot);
+    for (auto k : root["kernels"]) {
+      if (k["name"].as<std::string>() == kernel) {
+        return std::make_tuple(k, text.substr(dot + 1, eq - dot - 1), text.substr(eq + 1));
+      }
+    }
+    throw std::invalid_argument(fmt::format("{} '{}': no kernel named '{}'", flag, text, kernel));
+  };
+  for (const auto& p : params) {
+    auto [k, key, value] = kernel_node("--param", p);
+    k["params"][key] = YAML::Load(value);
+  }
+  for (const auto& i : inputs) {
+    auto [k, key, value] = kernel_node("--input", i);
+    k["inputs"][key] = value;
+  }
+  return oscar::ModuleSpec::from_yaml(root, "<command line>");
+}
+
+}  // namespace
+
+namespace oscar {
+int run_main(int argc, char** argv) {
+  CLI::App app{"oscar-run: hosts OSCAR kernels in one module process"};
+  std::string file, module_name, mode, name = "module";
+  std::vector<std::string> kernels, params, inputs, plugins;
+  int domain = -1;
+  bool stub = false, check = false, list = false;
+  app.add_option("file", file, "module YAML (one module map, or a system file with --module)");
+  app.add_option("--module", module_name, "the module of a system file to run");
+  app.add_option("--name", name, "module name when kernels are given on the command line");
+  app.add_option("-k,--kernel", kernels, "TYPE[:NAME] of a kernel to host (repeatable)");
+  app.add_option("-p,--param", params, "KERNEL.KEY=VALUE (repeatable)");
+  app.add_option("-i,--input", inputs, "KERNEL.INPUT=SOURCE_KERNEL/CHANNEL (repeatable)");
+  app.add_option("-m,--mode", mode,
+                 "module mode: continuous:33ms | single_step[:trigger] | deactivated");
+  app.add_option("-d,--domain", domain, "DDS domain (default: the file's, $OSCAR_DOMAIN, or 0)");
+  app.add_option("--plugin", plugins, "plugin file to load first (repeatable)");
+  app.add_flag("--stub", stub, "start every kernel in stub mode");
+  app.add_flag("--check", check, "load and check the module, print it, and exit");
+  app.add_flag("--list-types", list, "list the kernel types that can be loaded and exit");
+  CLI11_PARSE(app, argc, argv);
+
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);  // every thread started from here inherits it
+
+  try {
+    register_standard_cue_types();
+    for (const auto& p : plugins) load_plugin(p);
+    if (list) {
+      for (const auto& t : kernel_type_names()) std::cout << t << "\n";
+      return 0;
+    }
+    if (file.empty() == kernels.empty()) {
+      throw std::invalid_argument("give either a module YAML file or --kernel TYPE[:NAME]");
+    }
+    auto spec = file.empty() ? spec_from_flags(name, kernels, params, inputs)
+                             : ModuleSpec::load(file, module_name);
+    if (!mode.empty()) spec.mode = ModeSpec::parse_text(mode);
+    if (stub) spec.stub = true;
+    Module module(std::move(spec), plugin_search_path());
+    if (check) {
+      for (const auto& k : module.state().kernels()) {
+        std::cout << k.name() << " (" << k.type() << "): " << k.mode() << "\n";
+      }
+      return 0;
+    }
+    const int d = domain >= 0 ? domain : module.spec().domain.value_or(domain_from_env(0));
+    module.start(d);
+    std::thread signal_waiter([&] {
+      int sig = 0;
+      sigwait(&signals, &sig);
+      module.request_stop();
+    });
+    module.wait();
+    module.stop();
+    // Wake the signal waiter if the module stopped on a shutdown command.
+    pthread_kill(signal_waiter.native_handle(), SIGTERM);
+    signal_waiter.join();
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "oscar-run: %s\n", e.what());
+    return 2;
+  }
+}
+}  // namespace oscar

@@ -1,0 +1,112 @@
+#include "bench_sink_kernel.hpp"
+
+#include <algorithm>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <oscar/kernel_registry.hpp>
+
+namespace oscar::modules {
+
+void BenchSink::Params::describe(ParamSpec& spec) {
+  spec.field("type", type, "cue type").one_of({"Bool", "LineSeg3DSeq", "GvImage"}).fixed();
+  spec.field("report", report, "JSON report file (empty: log only)");
+  spec.field("expect", expect, "write the report after this many cues; 0 = at the end").at_least(0);
+  spec.field("warmup", warmup, "cues left out of the latency figures").at_least(0);
+}
+
+struct BenchSink::Ports {
+  virtual ~Ports() = default;
+  virtual void consume(Cycle& cycle, Stats& stats, std::int64_t warmup) = 0;
+};
+
+namespace {
+template <class T>
+struct TypedPorts final : BenchSink::Ports {
+  explicit TypedPorts(KernelSetup& setup) : in(setup.input<T>("in", {.depth = 256})) {}
+  void consume(Cycle& cycle, BenchSink::Stats& s, std::int64_t warmup) override {
+    for (const auto& r : in.take_new()) {
+      const auto& h = r.cue->header();
+      if (s.received > 0 && h.seq() <= s.last_seq) {
+        ++s.duplicates;
+        continue;
+      }
+      if (s.received > 0 && h.seq() > s.last_seq + 1) s.gaps += h.seq() - s.last_seq - 1;
+      s.last_seq = h.seq();
+      ++s.received;
+      const auto n = h.stamps().size();
+      s.stamps_min = s.received == 1 ? n : std::min<std::uint64_t>(s.stamps_min, n);
+      s.stamps_max = std::max<std::uint64_t>(s.stamps_max, n);
+      if (static_cast<std::int64_t>(s.received) <= warmup || n == 0) continue;
+      const auto generated = static_cast<std::int64_t>(h.stamps().front());
+      s.delivery_ns.push_back(r.received - generated);
+      s.process_ns.push_back(cycle.now() - generated);
+    }
+  }
+  Input<T>& in;
+};
+
+struct Percentiles {
+  double p50 = 0, p90 = 0, max = 0;
+};
+Percentiles percentiles_us(std::vector<std::int64_t> v) {
+  if (v.empty()) return {};
+  std::sort(v.begin(), v.end());
+  const auto at = [&](double q) {
+    return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))] /
+           1e3;
+  };
+  return {at(0.5), at(0.9), v.back() / 1e3};
+}
+}  // namespace
+
+BenchSink::BenchSink(KernelSetup& setup) {
+  setup.params(params_);
+  ports_ = visit_standard_type(params_.type, [&]<class T>() -> std::unique_ptr<Ports> {
+    return std::make_unique<TypedPorts<T>>(setup);
+  });
+}
+
+BenchSink::~BenchSink() = default;
+
+void BenchSink::process(Cycle& cycle) {
+  ports_->consume(cycle, stats_, params_.warmup);
+  if (params_.expect > 0 && !reported_ &&
+      static_cast<std::int64_t>(stats_.received) >= params_.expect) {
+    write_report();
+    reported_ = true;
+  }
+}
+
+// A sink has no outputs; in stub mode it still counts, so a source can be tested against it.
+void BenchSink::stub(Cycle& cycle) { process(cycle); }
+
+void BenchSink::on_deactivate() {
+  if (!reported_) write_report();
+}
+
+std::string BenchSink::report() const {
+  const auto d = percentiles_us(stats_.delivery_ns);
+  const auto p = percentiles_us(stats_.process_ns);
+  return fmt::format(
+      R"({{"type":"{}","received":{},"gaps":{},"duplicates":{},"last_seq":{},"stamps_min":{},)"
+      R"("stamps_max":{},"samples":{},"delivery_us":{{"p50":{:.2f},"p90":{:.2f},"max":{:.2f}}},)"
+      R"("process_us":{{"p50":{:.2f},"p90":{:.2f},"max":{:.2f}}}}})",
+      params_.type, stats_.received, stats_.gaps, stats_.duplicates, stats_.last_seq,
+      stats_.stamps_min, stats_.stamps_max, stats_.delivery_ns.size(), d.p50, d.p90, d.max, p.p50,
+      p.p90, p.max);
+}
+
+void BenchSink::write_report() const {
+  if (params_.report.empty()) return;
+  const auto tmp = params_.report + ".tmp";
+  {
+    std::ofstream out(tmp);
+    out << report() << "\n";
+  }
+  std::rename(tmp.c_str(), params_.report.c_str());  // readers never see half a report
+}
+
+}  // namespace oscar::modules
+
+OSCAR_REGISTER_KERNEL(oscar::modules::BenchSink, "bench_sink")

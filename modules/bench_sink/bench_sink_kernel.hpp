@@ -1,0 +1,49 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <oscar/cue_types.hpp>
+#include <oscar/kernel.hpp>
+
+namespace oscar::modules {
+
+/// Consumes benchmark cues: counts them, counts sequence gaps and duplicates, and measures the
+/// one-way latency from the header's first stamp to the cue's arrival at the input (delivery)
+/// and to the start of the cycle that processes it. Writes a JSON report when `expect` cues
+/// have arrived and when deactivated.
+class BenchSink final : public Kernel {
+ public:
+  struct Params {
+    std::string type = "Bool";
+    std::string report;       ///< JSON report file; empty = only log
+    std::int64_t expect = 0;  ///< write the report once this many cues arrived; 0 = at the end
+    std::int64_t warmup = 0;  ///< cues to leave out of the latency figures
+    void describe(ParamSpec& spec);
+  };
+  struct Stats {
+    std::uint64_t received = 0, gaps = 0, duplicates = 0, last_seq = 0;
+    std::vector<std::int64_t> delivery_ns, process_ns;
+    std::uint64_t stamps_min = 0, stamps_max = 0;  ///< header stamp count (fusion depth)
+  };
+  explicit BenchSink(KernelSetup& setup);
+  ~BenchSink() override;
+  void process(Cycle& cycle) override;
+  void stub(Cycle& cycle) override;
+  void on_deactivate() override;
+  const Stats& stats() const { return stats_; }
+  /// The report as JSON text.
+  std::string report() const;
+  struct Ports;
+
+ private:
+  void write_report() const;
+  Params params_;
+  std::unique_ptr<Ports> ports_;
+  Stats stats_;
+  bool reported_ = false;
+};
+
+}  // namespace oscar::modules
