@@ -1,12 +1,16 @@
 #include "oscar/config_client.hpp"
 
+#include <unistd.h>
+
 #include <thread>
 
 #include <fmt/format.h>
 #include <oscar/configPubSubTypes.h>
+
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include "oscar/time.hpp"
 
 namespace oscar {
 namespace dds = eprosima::fastdds::dds;
@@ -17,7 +21,11 @@ struct ConfigClient::Channel {
 };
 
 ConfigClient::ConfigClient(DdsParticipant& participant, std::string sender)
-    : participant_(participant), sender_(std::move(sender)) {}
+    : participant_(participant),
+      sender_(std::move(sender)),
+      // Ids unique across clients: replies of other clients' commands are read and skipped.
+      next_id_((static_cast<unsigned long long>(getpid()) << 32) |
+               (static_cast<unsigned long long>(wall_now()) & 0xffff0000ull)) {}
 
 ConfigClient::~ConfigClient() {
   for (auto& [module, c] : channels_) {
@@ -37,7 +45,9 @@ ConfigClient::Channel& ConfigClient::channel(const std::string& module) {
       &participant_.topic("oscar/config/" + module, new ConfigCommandPubSubType()), wq);
   dds::DataReaderQos rq = dds::DATAREADER_QOS_DEFAULT;
   rq.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  rq.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+  rq.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
+  rq.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  rq.history().depth = 64;
   c->reader = participant_.subscriber().create_datareader(
       &participant_.topic("oscar/config_reply/" + module, new ConfigReplyPubSubType()), rq);
   return *c;

@@ -1,5 +1,7 @@
 #include "module_dds.hpp"
 
+#include <unistd.h>
+
 #include <chrono>
 #include <stdexcept>
 #include <thread>
@@ -124,6 +126,9 @@ Module::Dds::~Dds() {
       participant_.subscriber().delete_datareader(reader->reader_);
     readers_.clear();
   }
+  for (auto& [input, source] : pull_sources_) input->set_pull_source(nullptr);
+  pull_sources_.clear();
+  pull_servers_.clear();
   for (auto& w : writers_) participant_.publisher().delete_datawriter(w->writer_);
   writers_.clear();
 }
@@ -132,11 +137,25 @@ void Module::Dds::wire_outputs(std::vector<std::unique_ptr<Slot>>& slots) {
   for (auto& s : slots) {
     for (auto& out : s->instance->ports().outputs) {
       writers_.push_back(std::make_unique<OutputWriter>(participant_, *out));
+      pull_servers_.push_back(std::make_unique<internal::DdsPullServer>(participant_, *out));
     }
   }
 }
 
 void Module::Dds::connect_input(InputPort& input, const std::string& source) {
+  if (input.transfer() != Transfer::kPush) {
+    auto puller = std::make_shared<internal::DdsPullSource>(
+        participant_, input, source,
+        fmt::format("{}/{}/{}@{}", module_.spec_.name, input.kernel(), input.name(), getpid()));
+    if (!puller->wait_matched(std::chrono::milliseconds(2000))) {
+      module_.log_->warn("input {}/{}: the producer {} does not answer pulls yet", input.kernel(),
+                         input.name(), source);
+    }
+    input.set_pull_source(puller);
+    std::lock_guard lock(readers_mutex_);
+    pull_sources_[&input] = std::move(puller);
+    return;
+  }
   auto reader = std::make_unique<CueReader>(participant_, input, source);
   if (!reader->wait_matched(std::chrono::milliseconds(2000))) {
     module_.log_->warn("input {}/{}: no publisher of {} matched yet; cues arrive once it appears",
@@ -174,9 +193,13 @@ void Module::Dds::start_config() {
   state_writer_ = participant_.publisher().create_datawriter(
       &participant_.topic("oscar/registry/module_state", new ModuleStatePubSubType()), state_qos);
 
+  // Transient-local: a client whose reader this writer has not matched yet still gets the
+  // reply once it does (discovery is not symmetric in time).
   dds::DataWriterQos reply_qos = dds::DATAWRITER_QOS_DEFAULT;
   reply_qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  reply_qos.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+  reply_qos.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
+  reply_qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  reply_qos.history().depth = 64;
   reply_writer_ = participant_.publisher().create_datawriter(
       &participant_.topic("oscar/config_reply/" + name, new ConfigReplyPubSubType()), reply_qos);
 

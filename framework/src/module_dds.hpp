@@ -15,6 +15,7 @@
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 
+#include "dds_pull.hpp"
 #include "module_slot.hpp"
 #include "oscar/dds_participant.hpp"
 #include "oscar/module.hpp"
@@ -47,6 +48,8 @@ class Module::Dds {
   Module& module_;
   DdsParticipant participant_;
   std::vector<std::unique_ptr<OutputWriter>> writers_;
+  std::vector<std::unique_ptr<internal::DdsPullServer>> pull_servers_;
+  std::map<InputPort*, std::shared_ptr<internal::DdsPullSource>> pull_sources_;
   std::mutex readers_mutex_;
   std::map<InputPort*, std::unique_ptr<CueReader>> readers_;
 

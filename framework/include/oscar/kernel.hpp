@@ -139,13 +139,17 @@ std::unique_ptr<Kernel> make_kernel(KernelSetup& setup) {
 
 }  // namespace oscar
 
+#define OSCAR_INTERNAL_CONCAT2(a, b) a##b
+#define OSCAR_INTERNAL_CONCAT(a, b) OSCAR_INTERNAL_CONCAT2(a, b)
+
 /// Makes CLASS loadable as kernel type TYPE (one line, in the kernel's .cpp).
-#define OSCAR_REGISTER_KERNEL(CLASS, TYPE)                                                        \
-  static_assert(std::is_base_of_v<::oscar::Kernel, CLASS>,                                        \
-                #CLASS " must derive from oscar::Kernel to be registered");                       \
-  static_assert(std::is_constructible_v<CLASS, ::oscar::KernelSetup&>,                            \
-                #CLASS " needs a constructor " #CLASS "(oscar::KernelSetup& setup)");             \
-  namespace {                                                                                     \
-  [[maybe_unused]] const bool oscar_kernel_registered_ = ::oscar::internal::register_kernel_type( \
-      TYPE, &::oscar::internal::make_kernel<CLASS>, __FILE__);                                    \
+#define OSCAR_REGISTER_KERNEL(CLASS, TYPE)                                                  \
+  static_assert(std::is_base_of_v<::oscar::Kernel, CLASS>,                                  \
+                #CLASS " must derive from oscar::Kernel to be registered");                 \
+  static_assert(std::is_constructible_v<CLASS, ::oscar::KernelSetup&>,                      \
+                #CLASS " needs a constructor " #CLASS "(oscar::KernelSetup& setup)");       \
+  namespace {                                                                               \
+  [[maybe_unused]] const bool OSCAR_INTERNAL_CONCAT(oscar_kernel_registered_, __LINE__) =   \
+      ::oscar::internal::register_kernel_type(TYPE, &::oscar::internal::make_kernel<CLASS>, \
+                                              __FILE__);                                    \
   }

@@ -1,0 +1,358 @@
+// The module frame without DDS: in-process handoff, modes, configuration and the rules.
+#include "oscar/module.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "test_kernels.hpp"
+
+namespace oscar {
+namespace {
+using namespace std::chrono_literals;
+using testing::HasSubstr;
+using testing::ThrowsMessage;
+
+ModuleSpec spec(const std::string& yaml) {
+  return ModuleSpec::from_yaml(YAML::Load(yaml), "test.yaml");
+}
+
+template <class K>
+K& kernel_of(Module& m, const std::string& name) {
+  return dynamic_cast<K&>(m.kernel(name).kernel());
+}
+
+bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds limit = 5s) {
+  const auto until = std::chrono::steady_clock::now() + limit;
+  while (!condition()) {
+    if (std::chrono::steady_clock::now() > until) return false;
+    std::this_thread::sleep_for(1ms);
+  }
+  return true;
+}
+
+ConfigCommand command(CommandKind kind, std::vector<std::string> args,
+                      std::string sender = "coordinator") {
+  ConfigCommand c;
+  c.id(1);
+  c.sender(std::move(sender));
+  c.kind(kind);
+  c.args(std::move(args));
+  return c;
+}
+
+const char* const kChain = R"(
+name: chain
+mode: { continuous: 2ms }
+kernels:
+  - { type: test_counter, name: src }
+  - { type: test_collect, name: sink, inputs: { in: src/out } }
+)";
+
+TEST(Module, HandsCuesBetweenItsKernelsWithoutCopies) {
+  Module m(spec(kChain), {});
+  m.start(-1);
+  auto& sink = kernel_of<test::Collect>(m, "sink");
+  ASSERT_TRUE(eventually([&] { return sink.seen().size() >= 20; }));
+  m.stop();
+  // The very object the producer published is what the consumer holds: no copy.
+  auto& out_ring = m.kernel("src").ports().find_output("out")->buffer();
+  const auto published = out_ring.latest();
+  const auto delivered = m.kernel("sink").ports().find_input("in")->buffer().latest();
+  ASSERT_TRUE(published && delivered);
+  EXPECT_EQ(published->cue.get(), delivered->cue.get());
+  EXPECT_EQ(sink.seen().back().get(), published->cue.get());
+}
+
+TEST(Module, TheContinuousKernelTriggersTheOthersOfAContinuousModule) {
+  Module m(spec(kChain), {});
+  EXPECT_EQ(m.state().kernels()[1].trigger(), "module");
+  m.start(-1);
+  auto& src = kernel_of<test::Counter>(m, "src");
+  auto& sink = kernel_of<test::Collect>(m, "sink");
+  ASSERT_TRUE(eventually([&] { return src.count_ >= 10; }));
+  m.stop();
+  EXPECT_GE(sink.runs(), src.count_ - 1);
+  EXPECT_LE(sink.runs(), src.count_ + 1);
+}
+
+TEST(Module, SingleStepKernelsRunOnDataOrOnCommand) {
+  Module m(spec(R"(
+name: steps
+mode: single_step
+kernels:
+  - { type: test_counter, name: src, mode: { single_step: { trigger: command } } }
+  - { type: test_collect, name: sink, inputs: { in: src/out } }
+)"),
+           {});
+  m.start(-1);
+  auto& src = kernel_of<test::Counter>(m, "src");
+  auto& sink = kernel_of<test::Collect>(m, "sink");
+  std::this_thread::sleep_for(20ms);
+  EXPECT_EQ(src.count_, 0) << "a command-triggered kernel waits for its trigger";
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_TRUE(m.apply(command(CMD_TRIGGER, {"src"})).ok());
+    ASSERT_TRUE(eventually([&] { return sink.seen().size() == static_cast<std::size_t>(i + 1); }));
+  }
+  EXPECT_EQ(src.count_, 3);
+  EXPECT_EQ(sink.runs(), 3) << "the sink runs once per cue on its trigger input";
+}
+
+TEST(Module, DeactivateAndActivateCallTheKernelHooks) {
+  Module m(spec(kChain), {});
+  m.start(-1);
+  auto& src = kernel_of<test::Counter>(m, "src");
+  ASSERT_TRUE(eventually([&] { return src.count_ > 0; }));
+  const auto reply = m.apply(command(CMD_DEACTIVATE, {"src"}));
+  ASSERT_TRUE(reply.ok()) << reply.error();
+  EXPECT_EQ(reply.state().kernels()[0].mode(), "deactivated");
+  EXPECT_EQ(src.deactivations_, 1);
+  const int frozen = src.count_;
+  std::this_thread::sleep_for(20ms);
+  EXPECT_EQ(src.count_, frozen);
+  ASSERT_TRUE(m.apply(command(CMD_ACTIVATE, {"src", "continuous:1ms"})).ok());
+  ASSERT_TRUE(eventually([&] { return src.count_ > frozen; }));
+  EXPECT_EQ(src.activations_, 2);
+  EXPECT_THAT(m.state().last_transition(), HasSubstr("src: deactivated -> continuous(1ms)"));
+}
+
+TEST(Module, SuspendKeepsBuffersAndResumeContinues) {
+  Module m(spec(kChain), {});
+  m.start(-1);
+  auto& src = kernel_of<test::Counter>(m, "src");
+  ASSERT_TRUE(eventually([&] { return src.count_ >= 5; }));
+  ASSERT_TRUE(m.apply(command(CMD_SUSPEND, {}, "registry")).ok());
+  EXPECT_TRUE(m.state().suspended());
+  const int frozen = src.count_;
+  const auto held = m.kernel("sink").ports().find_input("in")->buffer().size();
+  std::this_thread::sleep_for(20ms);
+  EXPECT_EQ(src.count_, frozen);
+  EXPECT_EQ(m.kernel("sink").ports().find_input("in")->buffer().size(), held) << "buffers kept";
+  EXPECT_GT(held, 0u);
+  ASSERT_TRUE(m.apply(command(CMD_RESUME, {}, "registry")).ok());
+  ASSERT_TRUE(eventually([&] { return src.count_ > frozen; }));
+}
+
+TEST(Module, StubModeRunsStubInsteadOfProcess) {
+  Module m(spec(kChain), {});
+  m.start(-1);
+  auto& src = kernel_of<test::Counter>(m, "src");
+  ASSERT_TRUE(m.apply(command(CMD_STUB, {"src", "on"})).ok());
+  ASSERT_TRUE(eventually([&] { return src.stubs_ >= 3; }));
+  EXPECT_TRUE(m.state().kernels()[0].stub());
+  ASSERT_TRUE(m.apply(command(CMD_STUB, {"*", "off"})).ok());
+  const int stubs = src.stubs_;
+  const int count = src.count_;
+  ASSERT_TRUE(eventually([&] { return src.count_ > count + 2; }));
+  EXPECT_LE(src.stubs_, stubs + 1);
+}
+
+TEST(Module, SetParamAndSetCycleChangeTheRunningKernel) {
+  Module m(spec(kChain), {});
+  m.start(-1);
+  auto reply = m.apply(command(CMD_SET_PARAM, {"sink", "factor", "7"}));
+  ASSERT_TRUE(reply.ok()) << reply.error();
+  EXPECT_EQ(kernel_of<test::Collect>(m, "sink").params_.factor, 7);
+  reply = m.apply(command(CMD_SET_PARAM, {"sink", "factor", "seven"}));
+  EXPECT_FALSE(reply.ok());
+  EXPECT_THAT(reply.error(), HasSubstr("parameter 'factor' expects a int, got 'seven'"));
+  reply = m.apply(command(CMD_SET_CYCLE, {"src", "5ms"}));
+  ASSERT_TRUE(reply.ok()) << reply.error();
+  EXPECT_EQ(reply.state().kernels()[0].cycle_ns(), 5'000'000);
+  reply = m.apply(command(CMD_SET_CYCLE, {"sink", "5ms"}));
+  EXPECT_THAT(reply.error(), HasSubstr("only a continuous kernel has a (positive) cycle"));
+}
+
+TEST(Module, OnlyTheCoordinatorRegistryAndBootMayConfigure) {
+  Module m(spec(kChain), {});
+  m.start(-1);
+  auto reply = m.apply(command(CMD_DEACTIVATE, {"src"}, "some_module"));
+  EXPECT_FALSE(reply.ok());
+  EXPECT_THAT(reply.error(), HasSubstr("refused: 'some_module' may not deactivate module 'chain': "
+                                       "only the coordinator configures modules"));
+  EXPECT_EQ(reply.state().kernels()[0].mode(), "continuous");
+  EXPECT_FALSE(m.apply(command(CMD_TRIGGER, {"sink"}, "registry")).ok())
+      << "the registry suspends, resumes and re-applies; it does not trigger";
+  EXPECT_TRUE(m.apply(command(CMD_SUSPEND, {}, "registry")).ok());
+  EXPECT_TRUE(m.apply(command(CMD_RESUME, {}, "boot")).ok());
+  EXPECT_TRUE(m.apply(command(CMD_SET_CYCLE, {"src", "3ms"}, "coordinator")).ok());
+}
+
+TEST(Module, CommandsNameUnknownKernels) {
+  Module m(spec(kChain), {});
+  const auto reply = m.apply(command(CMD_TRIGGER, {"cam"}));
+  EXPECT_THAT(reply.error(), HasSubstr("module 'chain' has no kernel 'cam' (kernels: src, sink)"));
+}
+
+TEST(Module, RewireMovesAnInputToAnotherProducer) {
+  Module m(spec(R"(
+name: two
+mode: single_step
+kernels:
+  - { type: test_counter, name: a, mode: { single_step: { trigger: command } } }
+  - { type: test_counter, name: b, mode: { single_step: { trigger: command } } }
+  - { type: test_collect, name: sink, inputs: { in: a/out } }
+)"),
+           {});
+  m.start(-1);
+  auto& sink = kernel_of<test::Collect>(m, "sink");
+  m.apply(command(CMD_TRIGGER, {"a"}));
+  ASSERT_TRUE(eventually([&] { return sink.seen().size() == 1; }));
+  ASSERT_TRUE(m.apply(command(CMD_REWIRE, {"sink", "in", "b/out"})).ok());
+  m.apply(command(CMD_TRIGGER, {"a"}));
+  m.apply(command(CMD_TRIGGER, {"b"}));
+  ASSERT_TRUE(eventually([&] { return sink.seen().size() == 2; }));
+  std::this_thread::sleep_for(10ms);
+  ASSERT_EQ(sink.seen().size(), 2u) << "nothing from the old producer after the switch";
+  EXPECT_EQ(sink.seen()[1]->header().source(), "b/out");
+}
+
+TEST(Module, PullAsksTheProducersRingForAGivenTime) {
+  Module m(spec(R"(
+name: pulling
+mode: single_step
+kernels:
+  - { type: test_counter, name: src, mode: { single_step: { trigger: command } } }
+  - { type: test_collect, name: sink, inputs: { in: { source: src/out, transfer: pull } }, mode: deactivated }
+)"),
+           {});
+  m.start(-1);
+  auto& src_ring = m.kernel("src").ports().find_output("out")->buffer();
+  for (int i = 0; i < 3; ++i) {
+    m.apply(command(CMD_TRIGGER, {"src"}));
+    ASSERT_TRUE(eventually([&] { return src_ring.pushed() == static_cast<std::uint64_t>(i + 1); }));
+  }
+  auto& in = kernel_of<test::Collect>(m, "sink").in_;
+  EXPECT_EQ(in.buffer().size(), 0u) << "a pull input receives nothing unasked";
+  const auto all = src_ring.latest(3);
+  const auto second = in.pull_at(all[1].t);
+  ASSERT_TRUE(second);
+  EXPECT_EQ(second->header().seq(), 2u);
+  EXPECT_EQ(in.pull()->header().seq(), 3u);
+  const auto future = in.prefetch(PullQuery::kNearest, all[0].t + 1);
+  EXPECT_EQ(future.get()->header().seq(), 1u);
+  EXPECT_FALSE(in.pull_at(all[0].t - 1)) << "nothing at or before a time older than the ring";
+}
+
+// --- the seed's multi-core rules (seed 004 §2.2) and bad input ---
+
+TEST(ModuleRules, AtMostOneContinuousKernel) {
+  EXPECT_THAT(
+      [] {
+        Module m(spec(R"(
+name: two_clocks
+kernels:
+  - { type: test_counter, name: a, mode: continuous:10ms }
+  - { type: test_counter, name: b, mode: continuous:10ms }
+)"),
+                 {});
+      },
+      ThrowsMessage<std::invalid_argument>(HasSubstr(
+          "breaks the multi-core rule 'at most one kernel in continuous mode (it triggers the "
+          "others)': kernels a, b are all continuous")));
+}
+
+TEST(ModuleRules, OnlyPullOrOnlyPushInside) {
+  EXPECT_THAT(
+      [] {
+        Module m(spec(R"(
+name: mixed
+mode: single_step
+kernels:
+  - { type: test_counter, name: a }
+  - { type: test_collect, name: x, inputs: { in: a/out } }
+  - { type: test_collect, name: y, inputs: { in: { source: a/out, transfer: pull } } }
+)"),
+                 {});
+      },
+      ThrowsMessage<std::invalid_argument>(
+          HasSubstr("'inside a multi-core module only pull or only push'")));
+}
+
+TEST(ModuleRules, NoBranchingTogetherWithMerging) {
+  EXPECT_THAT(
+      [] {
+        Module m(spec(R"(
+name: diamond
+mode: single_step
+kernels:
+  - { type: test_counter, name: a }
+  - { type: test_merge, name: m, inputs: { a: a/out, b: a/out } }
+)"),
+                 {});
+      },
+      ThrowsMessage<std::invalid_argument>(
+          HasSubstr("'no branching together with merging of cue flow'")));
+}
+
+TEST(ModuleBadInput, WiringBetweenDifferentTypesNamesBoth) {
+  EXPECT_THAT(
+      [] {
+        Module m(spec(R"(
+name: wrong
+mode: single_step
+kernels:
+  - { type: test_lines, name: lines }
+  - { type: test_collect, name: sink, inputs: { in: lines/out } }
+)"),
+                 {});
+      },
+      ThrowsMessage<std::invalid_argument>(
+          HasSubstr("cannot wire lines/out (oscar::LineSeg3DSeq) to input sink/in (oscar::Bool)")));
+}
+
+TEST(ModuleBadInput, DuplicateKernelNames) {
+  EXPECT_THAT(
+      [] {
+        spec("{name: d, kernels: [{type: test_counter, name: a}, {type: test_counter, name: a}]}");
+      },
+      ThrowsMessage<std::invalid_argument>(HasSubstr("duplicate kernel name 'a'")));
+}
+
+TEST(ModuleBadInput, UnknownKernelTypeNamesTheSearchPath) {
+  EXPECT_THAT([] { Module m(spec("{name: u, kernels: [{type: no_such_type}]}"), {"/nowhere"}); },
+              ThrowsMessage<std::runtime_error>(
+                  HasSubstr("unknown kernel type 'no_such_type': no plugin "
+                            "liboscar_kernel_no_such_type.so in [/nowhere]")));
+}
+
+TEST(ModuleBadInput, APluginThatFailsToLoadShowsTheLoaderMessage) {
+  const auto dir = std::filesystem::temp_directory_path() / "oscar_bad_plugin";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "liboscar_kernel_broken.so") << "this is not an ELF file";
+  EXPECT_THAT(
+      [&] { Module m(spec("{name: b, kernels: [{type: broken}]}"), {dir.string()}); },
+      ThrowsMessage<std::runtime_error>(HasSubstr("liboscar_kernel_broken.so' failed to load")));
+}
+
+TEST(ModuleBadInput, UnknownKeysAndParamsAreErrorsWithTheLine) {
+  EXPECT_THAT([] { spec("name: k\nkernels:\n  - {type: test_counter, prams: {x: 1}}\n"); },
+              ThrowsMessage<std::invalid_argument>(
+                  HasSubstr("test.yaml:3: kernels[0]: unknown key 'prams'")));
+  EXPECT_THAT(
+      [] { Module m(spec("{name: k, kernels: [{type: test_collect, params: {factr: 2}}]}"), {}); },
+      ThrowsMessage<std::invalid_argument>(
+          HasSubstr("has no parameter 'factr'; its parameters: factor")));
+  EXPECT_THAT(
+      [] { Module m(spec("{name: k, kernels: [{type: test_counter, params: {x: 2}}]}"), {}); },
+      ThrowsMessage<std::invalid_argument>(
+          HasSubstr("has no parameters, but the configuration gives some")));
+  EXPECT_THAT([] { spec("{name: k, kernels: [{type: test_collect, inputs: {in: nowhere}}]}"); },
+              ThrowsMessage<std::invalid_argument>(
+                  HasSubstr("source 'nowhere' must be '<kernel>/<channel>'")));
+  EXPECT_THAT([] { spec("{name: k, mode: continuous, kernels: [{type: test_counter}]}"); },
+              ThrowsMessage<std::invalid_argument>(HasSubstr("mode 'continuous' needs a cycle")));
+}
+
+TEST(ModuleBadInput, MalformedYamlNamesFileLineAndColumn) {
+  const auto file = std::filesystem::temp_directory_path() / "oscar_malformed.yaml";
+  std::ofstream(file) << "name: m\nkernels:\n  - { type: test_counter\n  - oops: [\n";
+  EXPECT_THAT([&] { ModuleSpec::load(file.string()); },
+              ThrowsMessage<std::invalid_argument>(HasSubstr(file.string() + ":4:")));
+}
+
+}  // namespace
+}  // namespace oscar

@@ -1,0 +1,8 @@
+#include "test_kernels.hpp"
+
+#include "oscar/kernel_registry.hpp"
+
+OSCAR_REGISTER_KERNEL(oscar::test::Counter, "test_counter")
+OSCAR_REGISTER_KERNEL(oscar::test::Collect, "test_collect")
+OSCAR_REGISTER_KERNEL(oscar::test::Lines, "test_lines")
+OSCAR_REGISTER_KERNEL(oscar::test::Merge, "test_merge")

@@ -1,0 +1,92 @@
+#pragma once
+// Small kernels for the framework's own tests (registered in test_kernels.cpp).
+
+#include <atomic>
+#include <mutex>
+#include <vector>
+
+#include "oscar/cue_types.hpp"
+#include "oscar/kernel.hpp"
+
+namespace oscar::test {
+
+/// Publishes Bool cues (value alternates) on every cycle; stub publishes `false` only.
+class Counter final : public Kernel {
+ public:
+  explicit Counter(KernelSetup& setup) : out_(setup.output<Bool>("out")) {}
+  void process(Cycle&) override {
+    Bool b;
+    b.value(++count_ % 2 == 1);
+    out_.publish(b);
+  }
+  void stub(Cycle&) override {
+    ++stubs_;
+    out_.publish(Bool{});
+  }
+  void on_activate() override { ++activations_; }
+  void on_deactivate() override { ++deactivations_; }
+  std::atomic<int> count_{0}, stubs_{0}, activations_{0}, deactivations_{0};
+
+ private:
+  Output<Bool>& out_;
+};
+
+/// Keeps every Bool cue it receives (as the shared pointers it was handed).
+class Collect final : public Kernel {
+ public:
+  struct Params {
+    int factor = 1;
+    void describe(ParamSpec& spec) { spec.field("factor", factor, "a number").at_least(1); }
+  };
+  explicit Collect(KernelSetup& setup) : in_(setup.input<Bool>("in")) { setup.params(params_); }
+  void process(Cycle&) override {
+    std::lock_guard lock(mutex_);
+    ++runs_;
+    for (auto& r : in_.take_new()) seen_.push_back(r.cue);
+  }
+  void stub(Cycle& c) override { process(c); }
+  std::vector<std::shared_ptr<const Bool>> seen() {
+    std::lock_guard lock(mutex_);
+    return seen_;
+  }
+  int runs() {
+    std::lock_guard lock(mutex_);
+    return runs_;
+  }
+  Input<Bool>& in_;
+  Params params_;
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::shared_ptr<const Bool>> seen_;
+  int runs_ = 0;
+};
+
+/// Publishes LineSeg3DSeq cues: for type-mismatch tests.
+class Lines final : public Kernel {
+ public:
+  explicit Lines(KernelSetup& setup) : out_(setup.output<LineSeg3DSeq>("out")) {}
+  void process(Cycle&) override { out_.publish(LineSeg3DSeq{}); }
+  void stub(Cycle& c) override { process(c); }
+
+ private:
+  Output<LineSeg3DSeq>& out_;
+};
+
+/// Merges two Bool inputs: for the multi-core branching/merging rule.
+class Merge final : public Kernel {
+ public:
+  explicit Merge(KernelSetup& setup)
+      : a_(setup.input<Bool>("a")), b_(setup.input<Bool>("b")), out_(setup.output<Bool>("out")) {}
+  void process(Cycle&) override {
+    if (a_.latest() && b_.latest()) out_.publish(Bool{});
+  }
+  void stub(Cycle&) override { out_.publish(Bool{}); }
+
+ private:
+  Input<Bool>& a_;
+  Input<Bool>& b_;
+  Output<Bool>& out_;
+};
+
+}  // namespace oscar::test
