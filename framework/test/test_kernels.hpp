@@ -90,3 +90,14 @@ class Merge final : public Kernel {
 };
 
 }  // namespace oscar::test
+
+namespace oscar::test {
+/// Holds a GvImage input (for prefetch tests); does nothing by itself.
+class CollectImage final : public Kernel {
+ public:
+  explicit CollectImage(KernelSetup& setup) : in_(setup.input<GvImage>("in")) {}
+  void process(Cycle&) override {}
+  void stub(Cycle&) override {}
+  Input<GvImage>& in_;
+};
+}  // namespace oscar::test

@@ -1,0 +1,241 @@
+// Cue flow and configuration across real processes on loopback (issue: foundation tests).
+#include <filesystem>
+#include <fstream>
+#include <functional>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "oscar/config_client.hpp"
+#include "oscar/module.hpp"
+#include "process.hpp"
+#include "test_kernels.hpp"
+
+namespace oscar {
+namespace {
+using namespace std::chrono_literals;
+using test::Process;
+using testing::HasSubstr;
+
+bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds limit = 10s) {
+  const auto until = std::chrono::steady_clock::now() + limit;
+  while (!condition()) {
+    if (std::chrono::steady_clock::now() > until) return false;
+    std::this_thread::sleep_for(2ms);
+  }
+  return true;
+}
+
+std::string temp(const std::string& name) {
+  return (std::filesystem::temp_directory_path() /
+          (name + "_" + std::to_string(getpid())))
+      .string();
+}
+
+// An oscar-run process hosting one kernel of a standard module type.
+std::unique_ptr<Process> run(const std::string& module, std::vector<std::string> args) {
+  std::vector<std::string> argv{test::bin("oscar-run"), "--name", module, "--domain",
+                                std::to_string(test::test_domain())};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return std::make_unique<Process>(argv, temp(module + ".log"));
+}
+
+// A module in this test process, joined to the same domain.
+std::unique_ptr<Module> local_module(const std::string& yaml) {
+  auto m = std::make_unique<Module>(ModuleSpec::from_yaml(YAML::Load(yaml), "test"),
+                                    plugin_search_path());
+  m->start(test::test_domain());
+  return m;
+}
+
+test::Collect& collect(Module& m, const std::string& name) {
+  return dynamic_cast<test::Collect&>(m.kernel(name).kernel());
+}
+
+TEST(CueFlow, PushAcrossProcessesDeliversEveryCueInOrder) {
+  const auto report = temp("push_report.json");
+  std::filesystem::remove(report);
+  auto sink = run("sink", {"-k", "bench_sink:sink", "-p", "sink.type=LineSeg3DSeq", "-p",
+                           "sink.report=" + report, "-p", "sink.expect=200", "-i",
+                           "sink.in=src/out", "-m", "single_step"});
+  std::this_thread::sleep_for(300ms);
+  auto src = run("src", {"-k", "bench_source:src", "-p", "src.type=LineSeg3DSeq", "-m",
+                         "continuous:2ms"});
+  ASSERT_TRUE(eventually([&] { return std::filesystem::exists(report); }))
+      << sink->output() << src->output();
+  const auto r = nlohmann::json::parse(std::ifstream(report));
+  EXPECT_GE(r["received"].get<int>(), 200);
+  EXPECT_EQ(r["gaps"], 0) << "reliable push loses nothing once matched";
+  EXPECT_EQ(r["duplicates"], 0);
+  EXPECT_EQ(r["stamps_min"], 1);
+}
+
+const char* const kPullConsumer = R"(
+name: consumer
+mode: deactivated
+kernels:
+  - { type: test_collect, name: sink, inputs: { in: { source: src/out, transfer: pull } } }
+)";
+
+TEST(CueFlow, PullAcrossProcessesForAGivenTime) {
+  auto src = run("src", {"-k", "bench_source:src", "-p", "src.type=Bool", "-m", "continuous:5ms"});
+  auto consumer = local_module(kPullConsumer);
+  auto& in = collect(*consumer, "sink").in_;
+  std::this_thread::sleep_for(100ms);
+  EXPECT_EQ(in.buffer().pushed(), 0u) << "a pull input receives nothing unasked";
+  Input<Bool>::Ptr now;
+  ASSERT_TRUE(eventually([&] { return (now = in.pull()) && now->header().seq() > 20; }));
+  const auto t = static_cast<Stamp>(now->header().stamps()[0]);
+  const auto earlier = in.pull_at(t - 12'000'000);  // ~2-3 cycles before
+  ASSERT_TRUE(earlier);
+  EXPECT_LT(earlier->header().seq(), now->header().seq());
+  EXPECT_LE(static_cast<Stamp>(earlier->header().stamps()[0]), t - 12'000'000);
+  const auto exact = in.pull_at(t);
+  ASSERT_TRUE(exact);
+  EXPECT_EQ(exact->header().seq(), now->header().seq()) << "at-or-before t finds the cue at t";
+}
+
+TEST(CueFlow, PrefetchReturnsAtOnceAndDeliversLater) {
+  auto src = run("src", {"-k", "bench_source:src", "-p", "src.type=GvImage", "-m",
+                         "continuous:20ms"});
+  auto consumer = local_module(R"(
+name: consumer
+mode: deactivated
+kernels:
+  - { type: test_gv, name: sink, inputs: { in: { source: src/out, transfer: prefetch } } }
+)");
+  auto& in = dynamic_cast<test::CollectImage&>(consumer->kernel("sink").kernel()).in_;
+  std::shared_ptr<const GvImage> image;
+  ASSERT_TRUE(eventually([&] {
+    const auto started = std::chrono::steady_clock::now();
+    auto future = in.prefetch();
+    EXPECT_LT(std::chrono::steady_clock::now() - started, 5ms) << "prefetch does not block";
+    image = future.get(1s);
+    return image != nullptr;
+  }));
+  EXPECT_EQ(image->image().size(), 768u * 576u);
+  EXPECT_EQ(image->dx(), 768);
+}
+
+TEST(CueFlow, RewireMidStreamLosesNothingAfterTheSwitch) {
+  auto a = run("a", {"-k", "bench_source:a", "-m", "continuous:3ms"});
+  auto b = run("b", {"-k", "bench_source:b", "-m", "continuous:3ms"});
+  auto consumer = local_module(R"(
+name: consumer
+kernels: [ { type: test_collect, name: sink, inputs: { in: a/out } } ]
+)");
+  auto& sink = collect(*consumer, "sink");
+  ASSERT_TRUE(eventually([&] { return sink.seen().size() > 10; }));
+  DdsParticipant participant(test::test_domain(), "test:coordinator");
+  ConfigClient coordinator(participant, "coordinator");
+  const auto reply = coordinator.send("consumer", CMD_REWIRE, {"sink", "in", "b/out"});
+  ASSERT_TRUE(reply.ok()) << reply.error();
+  const Stamp switched = wall_now();
+  ASSERT_TRUE(eventually([&] {
+    const auto seen = sink.seen();
+    return seen.back()->header().source() == "b/out" && seen.back()->header().seq() > 100;
+  }));
+  consumer->stop();
+  std::vector<std::shared_ptr<const Bool>> from_b;
+  for (const auto& c : sink.seen()) {
+    if (c->header().source() == "b/out") from_b.push_back(c);
+  }
+  ASSERT_FALSE(from_b.empty());
+  // The reply comes only once b is matched, so b's first delivered cue is at most one cycle
+  // (3 ms, plus scheduling slack) younger than the reply: nothing b published later is lost.
+  EXPECT_LT(static_cast<Stamp>(from_b.front()->header().stamps()[0]), switched + 15'000'000)
+      << "b was matched only well after the rewire was acknowledged";
+  for (std::size_t i = 1; i < from_b.size(); ++i) {
+    ASSERT_EQ(from_b[i]->header().seq(), from_b[i - 1]->header().seq() + 1) << "lost after switch";
+  }
+}
+
+TEST(CueFlow, CommandsConfigureAModuleInAnotherProcess) {
+  auto src = run("src", {"-k", "bench_source:src", "-m", "single_step:command"});
+  auto consumer = local_module(R"(
+name: consumer
+kernels: [ { type: test_collect, name: sink, inputs: { in: src/out } } ]
+)");
+  auto& sink = collect(*consumer, "sink");
+  DdsParticipant participant(test::test_domain(), "test:coordinator");
+  ConfigClient coordinator(participant, "coordinator");
+
+  // single-step triggering: exactly one cue per trigger (once the two have matched: a cue
+  // published before that is not delivered, as with any volatile DDS topic)
+  ASSERT_TRUE(eventually([&] {
+    EXPECT_TRUE(coordinator.send("src", CMD_TRIGGER, {"src"}).ok());
+    return eventually([&] { return !sink.seen().empty(); }, 200ms);
+  }));
+  const auto first = sink.seen().size();
+  for (std::size_t i = 1; i <= 3; ++i) {
+    ASSERT_TRUE(coordinator.send("src", CMD_TRIGGER, {"src"}).ok());
+    ASSERT_TRUE(eventually([&] { return sink.seen().size() == first + i; }));
+  }
+  std::this_thread::sleep_for(20ms);
+  EXPECT_EQ(sink.seen().size(), first + 3) << "no cue without a trigger";
+  // continuous, then deactivated: the flow stops
+  auto reply = coordinator.send("src", CMD_ACTIVATE, {"src", "continuous:2ms"});
+  ASSERT_TRUE(reply.ok()) << reply.error();
+  ASSERT_TRUE(eventually([&] { return sink.seen().size() > 20; }));
+  reply = coordinator.send("src", CMD_DEACTIVATE, {"src"});
+  ASSERT_TRUE(reply.ok());
+  EXPECT_EQ(reply.state().kernels()[0].mode(), "deactivated");
+  std::this_thread::sleep_for(50ms);
+  const auto stopped = sink.seen().size();
+  std::this_thread::sleep_for(50ms);
+  EXPECT_EQ(sink.seen().size(), stopped);
+
+  // suspend keeps buffers; resume continues
+  ASSERT_TRUE(coordinator.send("src", CMD_ACTIVATE, {"src", "continuous:2ms"}).ok());
+  reply = coordinator.send("consumer", CMD_SUSPEND, {});
+  ASSERT_TRUE(reply.ok());
+  EXPECT_TRUE(reply.state().suspended());
+  const auto runs = sink.runs();
+  std::this_thread::sleep_for(50ms);
+  EXPECT_EQ(sink.runs(), runs) << "a suspended module runs no kernel";
+  EXPECT_GT(consumer->kernel("sink").ports().find_input("in")->buffer().size(), 0u);
+  ASSERT_TRUE(coordinator.send("consumer", CMD_RESUME, {}).ok());
+  ASSERT_TRUE(eventually([&] { return sink.runs() > runs; }));
+
+  // stub mode: the source publishes its stub cues
+  reply = coordinator.send("src", CMD_STUB, {"src", "on"});
+  ASSERT_TRUE(reply.ok());
+  EXPECT_TRUE(reply.state().kernels()[0].stub());
+
+  // anyone but the coordinator, the registry and boot is refused, with a reply saying so
+  ConfigClient stranger(participant, "rogue_module");
+  reply = stranger.send("src", CMD_DEACTIVATE, {"src"});
+  EXPECT_FALSE(reply.ok());
+  EXPECT_THAT(reply.error(), HasSubstr("refused: 'rogue_module' may not deactivate module 'src'"));
+}
+
+TEST(CueFlow, ACommandToAnUnknownModuleIsAClearError) {
+  DdsParticipant participant(test::test_domain(), "test:coordinator");
+  ConfigClient coordinator(participant, "coordinator");
+  EXPECT_THAT([&] { coordinator.send("nobody", CMD_SUSPEND, {}, 500ms); },
+              testing::ThrowsMessage<std::runtime_error>(
+                  HasSubstr("no module named 'nobody' is running")));
+}
+
+TEST(OscarRun, BadInputExitsWithAClearMessage) {
+  const auto yaml = temp("bad.yaml");
+  std::ofstream(yaml) << "name: m\nkernels:\n  - { type: relay\n";
+  Process malformed({test::bin("oscar-run"), yaml}, temp("bad1.log"));
+  EXPECT_EQ(malformed.wait(10s), 2);
+  EXPECT_THAT(malformed.output(), HasSubstr(yaml + ":4:"));
+
+  Process unknown({test::bin("oscar-run"), "-k", "no_such_kernel"}, temp("bad2.log"));
+  EXPECT_EQ(unknown.wait(10s), 2);
+  EXPECT_THAT(unknown.output(), HasSubstr("unknown kernel type 'no_such_kernel'"));
+
+  Process mismatch({test::bin("oscar-run"), "-k", "bench_source:src", "-p", "src.type=GvImage",
+                    "-k", "bench_sink:sink", "-i", "sink.in=src/out", "--check"},
+                   temp("bad3.log"));
+  EXPECT_EQ(mismatch.wait(10s), 2);
+  EXPECT_THAT(mismatch.output(),
+              HasSubstr("cannot wire src/out (oscar::GvImage) to input sink/in (oscar::Bool)"));
+}
+
+}  // namespace
+}  // namespace oscar

@@ -1,0 +1,89 @@
+#pragma once
+// A child process for integration tests: started with fork/exec, output to a log file, stopped
+// (SIGTERM, then SIGKILL) when the object goes away, so a failed test leaves nothing behind.
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace oscar::test {
+
+inline std::string build_dir() {
+  const char* dir = std::getenv("OSCAR_BUILD_DIR");
+  return dir ? dir : ".";
+}
+
+inline std::string bin(const std::string& program) { return build_dir() + "/bin/" + program; }
+
+class Process {
+ public:
+  Process(std::vector<std::string> argv, std::string log) : log_(std::move(log)) {
+    pid_ = fork();
+    if (pid_ == 0) {
+      const int fd = ::open(log_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      dup2(fd, 1);
+      dup2(fd, 2);
+      std::vector<char*> args;
+      for (auto& a : argv) args.push_back(a.data());
+      args.push_back(nullptr);
+      execv(args[0], args.data());
+      _exit(127);
+    }
+  }
+  ~Process() { stop(); }
+  Process(const Process&) = delete;
+  Process& operator=(const Process&) = delete;
+
+  pid_t pid() const { return pid_; }
+
+  /// The exit code, once the process ended within `timeout`.
+  std::optional<int> wait(std::chrono::milliseconds timeout) {
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    while (!status_) {
+      int status = 0;
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        break;
+      }
+      if (std::chrono::steady_clock::now() > until) return std::nullopt;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return status_;
+  }
+
+  void stop() {
+    if (pid_ <= 0 || status_) return;
+    kill(pid_, SIGTERM);
+    if (!wait(std::chrono::seconds(5))) {
+      kill(pid_, SIGKILL);
+      wait(std::chrono::seconds(5));
+    }
+  }
+
+  std::string output() const {
+    std::ifstream in(log_);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+
+ private:
+  std::string log_;
+  pid_t pid_ = -1;
+  std::optional<int> status_;
+};
+
+/// A DDS domain of this test process's own (tests on one machine do not hear each other).
+inline int test_domain() { return 1 + static_cast<int>(getpid() % 200); }
+
+}  // namespace oscar::test
