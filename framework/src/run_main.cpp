@@ -58,7 +58,7 @@ int run_main(int argc, char** argv) {
   std::string file, module_name, mode, name = "module";
   std::vector<std::string> kernels, params, inputs, plugins;
   int domain = -1;
-  bool stub = false, check = false, list = false;
+  bool stub = false, check = false, list = false, modules = false;
   app.add_option("file", file, "module YAML (one module map, or a system file with --module)");
   app.add_option("--module", module_name, "the module of a system file to run");
   app.add_option("--name", name, "module name when kernels are given on the command line");
@@ -72,6 +72,7 @@ int run_main(int argc, char** argv) {
   app.add_flag("--stub", stub, "start every kernel in stub mode");
   app.add_flag("--check", check, "load and check the module, print it, and exit");
   app.add_flag("--list-types", list, "list the kernel types that can be loaded and exit");
+  app.add_flag("--list-modules", modules, "list the modules of the system file and exit");
   CLI11_PARSE(app, argc, argv);
 
   sigset_t signals;
@@ -85,6 +86,11 @@ int run_main(int argc, char** argv) {
     for (const auto& p : plugins) load_plugin(p);
     if (list) {
       for (const auto& t : kernel_type_names()) std::cout << t << "\n";
+      return 0;
+    }
+    if (modules) {
+      const auto root = load_yaml_file(file);
+      for (const auto& m : root["modules"]) std::cout << m["name"].as<std::string>() << "\n";
       return 0;
     }
     if (file.empty() == kernels.empty()) {

@@ -13,6 +13,7 @@ void BenchSink::Params::describe(ParamSpec& spec) {
   spec.field("report", report, "JSON report file (empty: log only)");
   spec.field("expect", expect, "write the report after this many cues; 0 = at the end").at_least(0);
   spec.field("warmup", warmup, "cues left out of the latency figures").at_least(0);
+  spec.field("log_every", log_every, "log a progress line this often; 0s = never");
 }
 
 struct BenchSink::Ports {
@@ -71,6 +72,22 @@ BenchSink::~BenchSink() = default;
 
 void BenchSink::process(Cycle& cycle) {
   ports_->consume(cycle, stats_, params_.warmup);
+  if (params_.log_every.count() > 0 && cycle.now() - last_log_ >= params_.log_every.count()) {
+    if (last_log_ != 0) {
+      const double seconds = static_cast<double>(cycle.now() - last_log_) / 1e9;
+      const auto recent = std::vector<std::int64_t>(
+          stats_.delivery_ns.end() -
+              static_cast<std::ptrdiff_t>(std::min<std::size_t>(
+                  stats_.delivery_ns.size(), stats_.received - received_at_last_log_)),
+          stats_.delivery_ns.end());
+      cycle.log().info("{}: {} cues ({:.1f} Hz), last seq {}, gaps {}, latency p50 {:.0f} us, {} stamps",
+                       params_.type, stats_.received,
+                       static_cast<double>(stats_.received - received_at_last_log_) / seconds,
+                       stats_.last_seq, stats_.gaps, percentiles_us(recent).p50, stats_.stamps_max);
+    }
+    last_log_ = cycle.now();
+    received_at_last_log_ = stats_.received;
+  }
   if (params_.expect > 0 && !reported_ &&
       static_cast<std::int64_t>(stats_.received) >= params_.expect) {
     write_report();

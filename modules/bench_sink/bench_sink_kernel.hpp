@@ -1,5 +1,6 @@
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -21,6 +22,7 @@ class BenchSink final : public Kernel {
     std::string report;       ///< JSON report file; empty = only log
     std::int64_t expect = 0;  ///< write the report once this many cues arrived; 0 = at the end
     std::int64_t warmup = 0;  ///< cues to leave out of the latency figures
+    std::chrono::nanoseconds log_every{0};  ///< log a progress line this often; 0 = never
     void describe(ParamSpec& spec);
   };
   struct Stats {
@@ -44,6 +46,8 @@ class BenchSink final : public Kernel {
   std::unique_ptr<Ports> ports_;
   Stats stats_;
   bool reported_ = false;
+  Stamp last_log_ = 0;
+  std::uint64_t received_at_last_log_ = 0;
 };
 
 }  // namespace oscar::modules
