@@ -191,6 +191,11 @@ DdsParticipant::~DdsParticipant() {
 }
 
 dds::Topic& DdsParticipant::topic(const std::string& name, dds::TopicDataType* type) {
+  // No type objects in discovery: Fast DDS 2.9 crashes building a dynamic type from a remote
+  // type object holding a sequence of structs (TypeObjectFactory::get_sequence_identifier, seen
+  // with LineSeg3DSeq). Types are matched by name; OSCAR's own registry knows them.
+  type->auto_fill_type_object(false);
+  type->auto_fill_type_information(false);
   dds::TypeSupport support(type);  // owns `type` from here on
   std::lock_guard lock(mutex_);
   if (auto it = topics_.find(name); it != topics_.end()) {

@@ -9,7 +9,7 @@
 
 #include "oscar/config_client.hpp"
 #include "oscar/module.hpp"
-#include "process.hpp"
+#include "process.hpp"  // tests/common
 #include "test_kernels.hpp"
 
 namespace oscar {

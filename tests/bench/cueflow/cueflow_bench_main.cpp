@@ -1,0 +1,180 @@
+// oscar bench cueflow: seed 004 Abb. 8 (cue transfer time of Bool, LineSeg3DSeq with 100 lines
+// and a 768x576 GvImage) for the multi-core and local constellations, against raw Fast DDS with
+// the same type, QoS and transport, measured in the same run. Prints a table, or JSON (--json).
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <thread>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "process.hpp"  // tests/common
+
+namespace {
+using namespace std::chrono_literals;
+using oscar::test::Process;
+
+struct Row {
+  std::string type;
+  std::size_t bytes;
+  double seed_multicore_us, seed_local_us;
+  int period_us;
+};
+const Row kRows[] = {
+    {"Bool", 1, 86, 1736, 2000},
+    {"LineSeg3DSeq", 4800, 254, 5782, 2000},
+    {"GvImage", 442368, 7851, 140157, 10000},
+};
+
+struct Latency {
+  double p50 = 0, p90 = 0, max = 0;
+  long samples = 0;
+};
+
+std::string bin(const std::string& name) {
+  return (std::filesystem::read_symlink("/proc/self/exe").parent_path() / name).string();
+}
+
+std::optional<Latency> await_report(const std::string& file, std::chrono::seconds limit) {
+  const auto until = std::chrono::steady_clock::now() + limit;
+  while (!std::filesystem::exists(file)) {
+    if (std::chrono::steady_clock::now() > until) return std::nullopt;
+    std::this_thread::sleep_for(20ms);
+  }
+  const auto j = nlohmann::json::parse(std::ifstream(file));
+  const auto& d = j["delivery_us"];
+  return Latency{d["p50"], d["p90"], d["max"], j["samples"]};
+}
+
+class Bench {
+ public:
+  Bench(int count, int warmup, int domain, std::string dir)
+      : count_(count), warmup_(warmup), domain_(domain), dir_(std::move(dir)) {}
+
+  std::optional<Latency> framework(const Row& r, bool multicore) {
+    const auto report = file("oscar", r, multicore);
+    const std::vector<std::string> sink{"-k", "bench_sink:sink", "-p", "sink.type=" + r.type,
+                                        "-p", "sink.report=" + report, "-p",
+                                        fmt::format("sink.expect={}", count_ + warmup_), "-p",
+                                        fmt::format("sink.warmup={}", warmup_), "-i",
+                                        "sink.in=src/out"};
+    const std::vector<std::string> source{"-k", "bench_source:src", "-p", "src.type=" + r.type};
+    const auto cycle = fmt::format("continuous:{}us", r.period_us);
+    std::vector<std::unique_ptr<Process>> procs;
+    if (multicore) {
+      auto args = join({bin("oscar-run"), "--name", "bench", "--domain", dom()}, source, sink);
+      args.insert(args.end(), {"-m", cycle});
+      procs.push_back(std::make_unique<Process>(args, log("multicore")));
+    } else {
+      auto s = join({bin("oscar-run"), "--name", "sink", "--domain", dom()}, sink, {"-m", "single_step"});
+      procs.push_back(std::make_unique<Process>(s, log("sink")));
+      std::this_thread::sleep_for(300ms);
+      auto p = join({bin("oscar-run"), "--name", "src", "--domain", dom()}, source, {"-m", cycle});
+      procs.push_back(std::make_unique<Process>(p, log("src")));
+    }
+    return await_report(report, limit(r));
+  }
+
+  std::optional<Latency> raw(const Row& r, bool multicore) {
+    const auto report = file("raw", r, multicore);
+    const std::vector<std::string> common{"--type", r.type, "--domain", dom(), "--period-us",
+                                          std::to_string(r.period_us)};
+    const std::vector<std::string> sub{"--report", report, "--expect",
+                                       std::to_string(count_ + warmup_), "--warmup",
+                                       std::to_string(warmup_)};
+    const std::vector<std::string> pub{"--count", std::to_string(10 * (count_ + warmup_))};
+    std::vector<std::unique_ptr<Process>> procs;
+    if (multicore) {
+      procs.push_back(std::make_unique<Process>(
+          join(join({bin("oscar-bench-raw"), "both"}, common, sub), pub, {}), log("raw")));
+    } else {
+      procs.push_back(std::make_unique<Process>(join({bin("oscar-bench-raw"), "sub"}, common, sub),
+                                                log("raw_sub")));
+      std::this_thread::sleep_for(300ms);
+      procs.push_back(std::make_unique<Process>(join({bin("oscar-bench-raw"), "pub"}, common, pub),
+                                                log("raw_pub")));
+    }
+    return await_report(report, limit(r));
+  }
+
+ private:
+  static std::vector<std::string> join(std::vector<std::string> a, const std::vector<std::string>& b,
+                                       const std::vector<std::string>& c) {
+    a.insert(a.end(), b.begin(), b.end());
+    a.insert(a.end(), c.begin(), c.end());
+    return a;
+  }
+  std::string dom() const { return std::to_string(domain_); }
+  std::string file(const char* who, const Row& r, bool multicore) {
+    auto f = fmt::format("{}/{}_{}_{}.json", dir_, who, r.type, multicore ? "multicore" : "local");
+    std::filesystem::remove(f);
+    return f;
+  }
+  std::string log(const char* who) const { return fmt::format("{}/{}.log", dir_, who); }
+  std::chrono::seconds limit(const Row& r) const {
+    return std::chrono::seconds(30 + (count_ + warmup_) * r.period_us / 1'000'000 * 3);
+  }
+  int count_, warmup_, domain_;
+  std::string dir_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"oscar bench cueflow: one-way cue latency, OSCAR vs raw Fast DDS (seed 004 Abb. 8)"};
+  bool json = false;
+  int count = 1000, warmup = 50, domain = 90;
+  std::vector<std::string> types{"Bool", "LineSeg3DSeq", "GvImage"};
+  std::vector<std::string> constellations{"multicore", "local"};
+  app.add_flag("--json", json, "print JSON instead of a table");
+  app.add_option("--count", count, "measured cues per row (after the warm-up)")->check(CLI::PositiveNumber);
+  app.add_option("--warmup", warmup, "cues left out at the start of each row");
+  app.add_option("--domain", domain, "DDS domain for the run");
+  app.add_option("--types", types, "rows to run")->delimiter(',');
+  app.add_option("--constellations", constellations, "multicore, local")->delimiter(',');
+  CLI11_PARSE(app, argc, argv);
+
+  const auto dir = std::filesystem::temp_directory_path() / fmt::format("oscar_bench_{}", getpid());
+  std::filesystem::create_directories(dir);
+  Bench bench(count, warmup, domain, dir.string());
+  nlohmann::json rows = nlohmann::json::array();
+  int failures = 0;
+  if (!json) {
+    std::cout << fmt::format("{:<13} {:>7} {:<10} {:>9} {:>9} {:>9} {:>10} {:>7} {:>10}\n", "type",
+                             "bytes", "constell.", "p50 us", "p90 us", "max us", "raw p50", "ratio",
+                             "seed us");
+  }
+  for (const auto& r : kRows) {
+    if (std::find(types.begin(), types.end(), r.type) == types.end()) continue;
+    for (const auto& c : constellations) {
+      const bool multicore = c == "multicore";
+      std::cerr << fmt::format("bench cueflow: {} {} ({} cues)...\n", r.type, c, count);
+      const auto ours = bench.framework(r, multicore);
+      const auto raw = bench.raw(r, multicore);
+      if (!ours || !raw) {
+        std::cerr << fmt::format("bench cueflow: {} {}: no report from {} (logs in {})\n", r.type,
+                                 c, ours ? "raw Fast DDS" : "OSCAR", dir.string());
+        ++failures;
+        continue;
+      }
+      const double seed = multicore ? r.seed_multicore_us : r.seed_local_us;
+      const double ratio = raw->p50 > 0 ? ours->p50 / raw->p50 : 0;
+      rows.push_back({{"type", r.type}, {"bytes", r.bytes}, {"constellation", c},
+                      {"p50_us", ours->p50}, {"p90_us", ours->p90}, {"max_us", ours->max},
+                      {"raw_p50_us", raw->p50}, {"raw_p90_us", raw->p90}, {"raw_max_us", raw->max},
+                      {"ratio", ratio}, {"samples", ours->samples}, {"seed_us", seed}});
+      if (!json) {
+        std::cout << fmt::format("{:<13} {:>7} {:<10} {:>9.1f} {:>9.1f} {:>9.1f} {:>10.1f} {:>7.2f} {:>10.0f}\n",
+                                 r.type, r.bytes, c, ours->p50, ours->p90, ours->max, raw->p50,
+                                 ratio, seed)
+                  << std::flush;
+      }
+    }
+  }
+  if (json) std::cout << nlohmann::json{{"rows", rows}}.dump() << "\n";
+  if (failures == 0) std::filesystem::remove_all(dir);
+  return failures == 0 ? 0 : 1;
+}
