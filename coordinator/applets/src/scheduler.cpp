@@ -268,8 +268,8 @@ void Scheduler::update_handover() {
     revoking_[b] = Revocation{now_ + options_.revoke_wait, 0};
     std::set<AppletId> to;
     for (BundleId g = 0; g < n; ++g) {
-      if (g != b && plan_.bundle_granted[g] && model_.bundle(g).applet != model_.bundle(b).applet &&
-          conflicts(g, b)) {
+      if (g != b && plan_.bundle_granted[g] && !active_[g] &&
+          model_.bundle(g).applet != model_.bundle(b).applet && conflicts(g, b)) {
         to.insert(model_.bundle(g).applet);
       }
     }
@@ -319,6 +319,21 @@ std::string Scheduler::holder(ServiceId service) const {
   const Access probe =
       model_.service(service).exclusive_only ? Access::kExclusive : Access::kShared;
   return can_grant(model_, plan_, service, probe) ? "undef" : "blocked";
+}
+
+std::string Scheduler::active_holder(ServiceId service) const {
+  std::set<std::string> names;
+  for (BundleId b = 0; b < active_.size(); ++b) {
+    if (!active_[b]) continue;
+    for (ResourceId r : model_.bundle(b).resources) {
+      if (model_.resource(r).service == service) {
+        names.insert(model_.applet(model_.bundle(b).applet).name);
+      }
+    }
+  }
+  std::string out;
+  for (const auto& name : names) out += (out.empty() ? "" : ",") + name;
+  return out.empty() ? "none" : out;
 }
 
 std::vector<Notification> Scheduler::take_notifications() {

@@ -97,6 +97,9 @@ class Scheduler {
   /// The planned holder of a service for people: applet names (sorted, joined by ','), "blocked"
   /// (requested but not granted, or held up by a dependency) or "undef" (nobody asked).
   std::string holder(ServiceId service) const;
+  /// Who may use a service right now (handed over, seed Abb. 4.2): applet names joined by ',',
+  /// or "none". Differs from holder() while a reassignment is under way.
+  std::string active_holder(ServiceId service) const;
 
   /// Notifications since the last call, in order.
   std::vector<Notification> take_notifications();
