@@ -1,0 +1,238 @@
+#include "oscar/applets/runtime.hpp"
+
+#include <algorithm>
+
+namespace oscar::applets {
+namespace {
+double ms_between(std::chrono::steady_clock::time_point a,
+                  std::chrono::steady_clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+}  // namespace
+
+BundleId AppletContext::bundle_id(const std::string& bundle) const {
+  return runtime_.scheduler_.model().bundle_id(applet_, bundle);
+}
+
+void AppletContext::request(const std::string& bundle) {
+  const BundleId b = bundle_id(bundle);
+  runtime_.with_scheduler([&](Scheduler& s) {
+    if (!s.requested(b)) runtime_.waiting_since_[b] = Runtime::Clock::now();
+    s.request(b);
+  });
+}
+void AppletContext::release(const std::string& bundle) {
+  const BundleId b = bundle_id(bundle);
+  runtime_.with_scheduler([&](Scheduler& s) { s.release(b); });
+}
+void AppletContext::yield(const std::string& bundle) {
+  const BundleId b = bundle_id(bundle);
+  runtime_.with_scheduler([&](Scheduler& s) {
+    if (s.revoke_deadline(b)) runtime_.waiting_since_[b] = Runtime::Clock::now();
+    s.yield(b);
+  });
+}
+void AppletContext::trigger(const std::string& bundle) {
+  const BundleId b = bundle_id(bundle);
+  runtime_.with_scheduler([&](Scheduler& s) { s.trigger(b); });
+}
+void AppletContext::set_priority(const std::string& bundle, int priority) {
+  const BundleId b = bundle_id(bundle);
+  runtime_.with_scheduler([&](Scheduler& s) { s.set_priority(b, priority); });
+}
+void AppletContext::set_deadline(const std::string& bundle, std::optional<Deadline> deadline) {
+  const BundleId b = bundle_id(bundle);
+  runtime_.with_scheduler([&](Scheduler& s) { s.set_deadline(b, deadline); });
+}
+Notification AppletContext::negotiate(const std::string& bundle, const Negotiation& answer) {
+  const BundleId b = bundle_id(bundle);
+  Notification n;
+  runtime_.with_scheduler([&](Scheduler& s) { n = s.negotiate(b, answer); });
+  return n;
+}
+
+bool AppletContext::granted(const std::string& bundle) const {
+  const BundleId b = bundle_id(bundle);
+  std::lock_guard lock(runtime_.mutex_);
+  return runtime_.scheduler_.active(b);
+}
+
+bool AppletContext::use(const std::string& bundle, const std::function<void()>& body) {
+  const BundleId b = bundle_id(bundle);
+  {
+    std::unique_lock lock(runtime_.mutex_);
+    if (!runtime_.scheduler_.active(b)) {
+      if (runtime_.scheduler_.model().applet(applet_).fail_stop) {
+        throw ResourceRevoked("applet '" + runtime_.scheduler_.model().applet(applet_).name +
+                              "' used bundle '" + bundle + "' which is not granted (fail-stop)");
+      }
+      const auto asked = Runtime::Clock::now();
+      runtime_.changed_.wait(lock,
+                             [&] { return runtime_.stopping_ || runtime_.scheduler_.active(b); });
+      if (runtime_.stopping_) return false;
+      const auto now = Runtime::Clock::now();
+      // Scheduling overhead: from the grant (or the ask, if later) to running again.
+      runtime_.stats_.overhead_ms.push_back(
+          ms_between(std::max(asked, runtime_.granted_at_[b]), now));
+    }
+    if (runtime_.waiting_since_[b] != Runtime::Clock::time_point{}) {
+      runtime_.stats_.wait_ms.push_back(
+          ms_between(runtime_.waiting_since_[b], Runtime::Clock::now()));
+      runtime_.waiting_since_[b] = {};
+    }
+  }
+  // The body runs without the lock: the seed revokes only between steps (or by force after the
+  // wait limit, which the next use() then notices).
+  body();
+  return true;
+}
+
+Runtime::Runtime(Model model, SchedulerOptions options)
+    : scheduler_(std::move(model), options), start_(Clock::now()) {
+  slots_.resize(scheduler_.model().applets().size());
+  waiting_since_.assign(scheduler_.model().bundles().size(), {});
+  granted_at_.assign(scheduler_.model().bundles().size(), {});
+}
+
+Runtime::~Runtime() { stop(); }
+
+milliseconds Runtime::clock() const {
+  return std::chrono::duration_cast<milliseconds>(Clock::now() - start_);
+}
+
+void Runtime::set_code(const std::string& applet, AppletCode code) {
+  std::lock_guard lock(mutex_);
+  const AppletId id = scheduler_.model().applet_id(applet);
+  if (running_) throw std::invalid_argument("applet '" + applet + "': set code before start()");
+  if (!code.step) throw std::invalid_argument("applet '" + applet + "': code needs a step");
+  slots_[id].code = std::move(code);
+  slots_[id].has_code = true;
+}
+
+void Runtime::start() {
+  std::lock_guard lock(mutex_);
+  if (running_) return;
+  running_ = true;
+  stopping_ = false;
+  for (AppletId a = 0; a < slots_.size(); ++a) {
+    if (slots_[a].has_code) slots_[a].thread = std::thread([this, a] { applet_main(a); });
+  }
+  reassigner_ = std::thread([this] { reassigner_main(); });
+}
+
+void Runtime::stop() {
+  {
+    std::lock_guard lock(mutex_);
+    if (!running_) return;
+    stopping_ = true;
+  }
+  changed_.notify_all();
+  for (Slot& s : slots_) {
+    if (s.thread.joinable()) s.thread.join();
+  }
+  if (reassigner_.joinable()) reassigner_.join();
+  std::lock_guard lock(mutex_);
+  running_ = false;
+}
+
+void Runtime::pause(const std::string& applet, bool paused) {
+  std::lock_guard lock(mutex_);
+  slots_[scheduler_.model().applet_id(applet)].paused = paused;
+  changed_.notify_all();
+}
+
+bool Runtime::crashed(const std::string& applet) const {
+  std::lock_guard lock(mutex_);
+  return slots_[scheduler_.model().applet_id(applet)].crashed;
+}
+
+void Runtime::with_scheduler(const std::function<void(Scheduler&)>& f) {
+  std::unique_lock lock(mutex_);
+  locked_call(f);
+}
+
+void Runtime::locked_call(const std::function<void(Scheduler&)>& f) {
+  scheduler_.advance_to(std::max(scheduler_.now(), clock()));
+  f(scheduler_);
+  deliver();
+  changed_.notify_all();
+}
+
+void Runtime::deliver() {
+  for (Notification& n : scheduler_.take_notifications()) {
+    if (n.kind == Notification::Kind::kGranted) {
+      ++stats_.grants;
+      granted_at_[n.bundle] = Clock::now();
+    }
+    if (n.kind == Notification::Kind::kRevokedByForce) waiting_since_[n.bundle] = Clock::now();
+    slots_[n.applet].interrupts.push_back(std::move(n));
+  }
+}
+
+RuntimeStats Runtime::stats() const {
+  std::lock_guard lock(mutex_);
+  return stats_;
+}
+
+// The applet wrapper (seed §4.6.2 "Fail-Stop"): whatever the code throws ends this applet only;
+// its bundles are released and everything else goes on.
+void Runtime::applet_main(AppletId id) {
+  Slot& slot = slots_[id];
+  AppletContext ctx(*this, id);
+  try {
+    if (slot.code.init) slot.code.init(ctx);  // Abb. 4.12 lines 1–3
+    auto next = Clock::now();
+    for (;;) {
+      std::deque<Notification> queue;
+      {
+        std::unique_lock lock(mutex_);
+        if (stopping_) return;
+        queue.swap(slot.interrupts);
+      }
+      for (const Notification& n : queue) {  // Abb. 4.12 line 4: interrupt handlers first
+        if (slot.code.on_interrupt) {
+          slot.code.on_interrupt(ctx, n);
+        } else if (n.kind == Notification::Kind::kRevokeRequested) {
+          ctx.yield(scheduler_.model().bundle(n.bundle).name);
+        }
+      }
+      bool paused;
+      {
+        std::lock_guard lock(mutex_);
+        paused = slot.paused;
+      }
+      if (!paused) slot.code.step(ctx);  // line 5
+      next += slot.code.period;          // lines 6–7
+      std::unique_lock lock(mutex_);
+      changed_.wait_until(lock, next, [&] { return stopping_; });
+      if (stopping_) return;
+    }
+  } catch (const std::exception&) {
+    std::lock_guard lock(mutex_);
+    slot.crashed = true;
+    stats_.crashed.push_back(scheduler_.model().applet(id).name);
+    locked_call([id](Scheduler& s) { s.crash(id); });
+  }
+}
+
+// Revokes by force when a wait limit passes (seed §4.6.1).
+void Runtime::reassigner_main() {
+  std::unique_lock lock(mutex_);
+  while (!stopping_) {
+    milliseconds next = milliseconds::max();
+    for (BundleId b = 0; b < scheduler_.model().bundles().size(); ++b) {
+      if (auto until = scheduler_.revoke_deadline(b)) next = std::min(next, *until);
+    }
+    if (next == milliseconds::max()) {
+      changed_.wait(lock);
+    } else {
+      changed_.wait_until(lock, start_ + next);
+    }
+    if (stopping_) break;
+    scheduler_.advance_to(std::max(scheduler_.now(), clock()));
+    deliver();
+    changed_.notify_all();
+  }
+}
+
+}  // namespace oscar::applets
