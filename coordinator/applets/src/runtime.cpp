@@ -67,8 +67,8 @@ bool AppletContext::use(const std::string& bundle, const std::function<void()>& 
                               "' used bundle '" + bundle + "' which is not granted (fail-stop)");
       }
       const auto asked = Runtime::Clock::now();
-      runtime_.changed_.wait(lock,
-                             [&] { return runtime_.stopping_ || runtime_.scheduler_.active(b); });
+      runtime_.slots_[applet_]->cv.wait(
+          lock, [&] { return runtime_.stopping_ || runtime_.scheduler_.active(b); });
       if (runtime_.stopping_) return false;
       const auto now = Runtime::Clock::now();
       // Scheduling overhead: from the grant (or the ask, if later) to running again.
@@ -89,7 +89,9 @@ bool AppletContext::use(const std::string& bundle, const std::function<void()>& 
 
 Runtime::Runtime(Model model, SchedulerOptions options)
     : scheduler_(std::move(model), options), start_(Clock::now()) {
-  slots_.resize(scheduler_.model().applets().size());
+  for (std::size_t a = 0; a < scheduler_.model().applets().size(); ++a) {
+    slots_.push_back(std::make_unique<Slot>());
+  }
   waiting_since_.assign(scheduler_.model().bundles().size(), {});
   granted_at_.assign(scheduler_.model().bundles().size(), {});
 }
@@ -105,8 +107,8 @@ void Runtime::set_code(const std::string& applet, AppletCode code) {
   const AppletId id = scheduler_.model().applet_id(applet);
   if (running_) throw std::invalid_argument("applet '" + applet + "': set code before start()");
   if (!code.step) throw std::invalid_argument("applet '" + applet + "': code needs a step");
-  slots_[id].code = std::move(code);
-  slots_[id].has_code = true;
+  slots_[id]->code = std::move(code);
+  slots_[id]->has_code = true;
 }
 
 void Runtime::start() {
@@ -115,7 +117,7 @@ void Runtime::start() {
   running_ = true;
   stopping_ = false;
   for (AppletId a = 0; a < slots_.size(); ++a) {
-    if (slots_[a].has_code) slots_[a].thread = std::thread([this, a] { applet_main(a); });
+    if (slots_[a]->has_code) slots_[a]->thread = std::thread([this, a] { applet_main(a); });
   }
   reassigner_ = std::thread([this] { reassigner_main(); });
 }
@@ -127,8 +129,12 @@ void Runtime::stop() {
     stopping_ = true;
   }
   changed_.notify_all();
-  for (Slot& s : slots_) {
-    if (s.thread.joinable()) s.thread.join();
+  for (auto& s : slots_) {
+    {
+      std::lock_guard lock(mutex_);  // no lost wake-up between a check and a wait
+      s->cv.notify_all();
+    }
+    if (s->thread.joinable()) s->thread.join();
   }
   if (reassigner_.joinable()) reassigner_.join();
   std::lock_guard lock(mutex_);
@@ -137,13 +143,13 @@ void Runtime::stop() {
 
 void Runtime::pause(const std::string& applet, bool paused) {
   std::lock_guard lock(mutex_);
-  slots_[scheduler_.model().applet_id(applet)].paused = paused;
-  changed_.notify_all();
+  slots_[scheduler_.model().applet_id(applet)]->paused = paused;
+  slots_[scheduler_.model().applet_id(applet)]->cv.notify_all();
 }
 
 bool Runtime::crashed(const std::string& applet) const {
   std::lock_guard lock(mutex_);
-  return slots_[scheduler_.model().applet_id(applet)].crashed;
+  return slots_[scheduler_.model().applet_id(applet)]->crashed;
 }
 
 void Runtime::with_scheduler(const std::function<void(Scheduler&)>& f) {
@@ -165,7 +171,9 @@ void Runtime::deliver() {
       granted_at_[n.bundle] = Clock::now();
     }
     if (n.kind == Notification::Kind::kRevokedByForce) waiting_since_[n.bundle] = Clock::now();
-    slots_[n.applet].interrupts.push_back(std::move(n));
+    Slot& slot = *slots_[n.applet];
+    slot.interrupts.push_back(std::move(n));
+    slot.cv.notify_all();
   }
 }
 
@@ -177,7 +185,7 @@ RuntimeStats Runtime::stats() const {
 // The applet wrapper (seed §4.6.2 "Fail-Stop"): whatever the code throws ends this applet only;
 // its bundles are released and everything else goes on.
 void Runtime::applet_main(AppletId id) {
-  Slot& slot = slots_[id];
+  Slot& slot = *slots_[id];
   AppletContext ctx(*this, id);
   try {
     if (slot.code.init) slot.code.init(ctx);  // Abb. 4.12 lines 1–3
@@ -204,7 +212,7 @@ void Runtime::applet_main(AppletId id) {
       if (!paused) slot.code.step(ctx);  // line 5
       next += slot.code.period;          // lines 6–7
       std::unique_lock lock(mutex_);
-      changed_.wait_until(lock, next, [&] { return stopping_; });
+      slot.cv.wait_until(lock, next, [&] { return stopping_; });
       if (stopping_) return;
     }
   } catch (const std::exception&) {
@@ -231,7 +239,6 @@ void Runtime::reassigner_main() {
     if (stopping_) break;
     scheduler_.advance_to(std::max(scheduler_.now(), clock()));
     deliver();
-    changed_.notify_all();
   }
 }
 

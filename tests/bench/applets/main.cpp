@@ -45,7 +45,7 @@ struct StressResult {
 };
 
 StressResult stress(unsigned seed, double max_seconds, std::uint64_t target, int applets,
-                    int services) {
+                    int services, int period_ms) {
   Model m;
   std::mt19937 rng(seed);
   for (int s = 0; s < services; ++s) m.add_service("S" + std::to_string(s), s % 3 == 0);
@@ -70,7 +70,7 @@ StressResult stress(unsigned seed, double max_seconds, std::uint64_t target, int
     auto r = std::make_shared<std::mt19937>(seed * 1000 + a);
     auto current = std::make_shared<std::string>();
     // Cycle times like the seed's applets: 100 ms and more, scaled down to get enough events.
-    code.period = std::chrono::milliseconds{20 + static_cast<int>((*r)() % 40)};
+    code.period = std::chrono::milliseconds{period_ms + static_cast<int>((*r)() % (2 * period_ms))};
     code.step = [r, current, &done](AppletContext& ctx) {
       if (done) return;
       const unsigned dice = (*r)() % 10;
@@ -158,7 +158,8 @@ int main(int argc, char** argv) {
   double duration_s = 90;
   std::uint64_t target = 5000;
   int max_resources = 100000;
-  int applets = 16, services = 6;
+  int applets = 24, services = 6;
+  int period_ms = 10;
   unsigned seed = 1;
   app.add_flag("--json", json, "Print JSON");
   app.add_option("--duration-s", duration_s, "Longest stress-test time in seconds");
@@ -167,12 +168,13 @@ int main(int argc, char** argv) {
   app.add_option("--applets", applets, "Applets in the stress test");
   app.add_option("--services", services, "Services in the stress test (>= 3)");
   app.add_option("--seed", seed, "Random seed");
+  app.add_option("--period-ms", period_ms, "Shortest applet cycle; cycles are 1-3 times it");
   CLI11_PARSE(app, argc, argv);
-  if (services < 3 || applets < 2) {
-    std::cerr << "oscar bench applets: --services must be >= 3 and --applets >= 2\n";
+  if (services < 3 || applets < 2 || period_ms < 1) {
+    std::cerr << "oscar bench applets: needs --services >= 3, --applets >= 2, --period-ms >= 1\n";
     return 2;
   }
-  const StressResult s = stress(seed, duration_s, target, applets, services);
+  const StressResult s = stress(seed, duration_s, target, applets, services, period_ms);
   std::map<int, double> plans;
   for (int n = 10; n <= max_resources; n *= 10) plans[n] = plan_us(n, seed);
   if (json) {
@@ -190,8 +192,8 @@ int main(int argc, char** argv) {
     std::cout << j.dump(2) << "\n";
     return 0;
   }
-  std::printf("stress test (seed 000 §5.2.2): %d applets, %d services, %.1f s\n", s.applets,
-              s.services, s.seconds);
+  std::printf("stress test (seed 000 §5.2.2): %d applets, %d services, cycles %d-%d ms, %.1f s\n",
+              s.applets, s.services, period_ms, 3 * period_ms - 1, s.seconds);
   std::printf("  reassignments        %llu\n", static_cast<unsigned long long>(s.reassignments));
   std::printf("  wait ms     avg %8.2f  max %8.2f\n", s.wait.avg, s.wait.max);
   std::printf("  overhead ms avg %8.3f  p99 %8.3f  max %8.3f\n", s.overhead.avg, s.overhead.p99,

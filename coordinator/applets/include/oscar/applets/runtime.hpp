@@ -101,6 +101,7 @@ class Runtime {
     bool paused = false;
     bool crashed = false;
     bool has_code = false;
+    std::condition_variable cv;  // wakes this applet only (no thundering herd)
     std::thread thread;
   };
   using Clock = std::chrono::steady_clock;
@@ -112,9 +113,9 @@ class Runtime {
   void reassigner_main();
 
   mutable std::mutex mutex_;
-  std::condition_variable changed_;
+  std::condition_variable changed_;  // wakes the reassigner
   Scheduler scheduler_;
-  std::vector<Slot> slots_;
+  std::vector<std::unique_ptr<Slot>> slots_;
   std::vector<Clock::time_point> waiting_since_;  // per bundle: asked, not yet granted
   std::vector<Clock::time_point> granted_at_;     // per bundle
   RuntimeStats stats_;
