@@ -51,6 +51,26 @@ Notification AppletContext::negotiate(const std::string& bundle, const Negotiati
   return n;
 }
 
+Notification AppletContext::negotiate(const std::string& bundle, const NegotiationRound& round) {
+  Notification reply;
+  const NegotiationRound* r = &round;
+  while (r != nullptr) {
+    if (r->first) r->first();
+    if (!being_revoked(bundle)) break;  // forced meanwhile, or the plan gave it back
+    reply = negotiate(bundle, r->answer);
+    r = (reply.kind == Notification::Kind::kNegotiationAccepted ? r->on_accept : r->on_reject)
+            .get();
+  }
+  yield(bundle);
+  return reply;
+}
+
+bool AppletContext::being_revoked(const std::string& bundle) const {
+  const BundleId b = bundle_id(bundle);
+  std::lock_guard lock(runtime_.mutex_);
+  return runtime_.scheduler_.revoke_deadline(b).has_value();
+}
+
 bool AppletContext::granted(const std::string& bundle) const {
   const BundleId b = bundle_id(bundle);
   std::lock_guard lock(runtime_.mutex_);

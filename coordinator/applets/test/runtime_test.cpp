@@ -204,6 +204,57 @@ TEST(Runtime, HolderThatDoesNotYieldIsRevokedByForceAndToldWhoGetsIt) {
   EXPECT_TRUE(forced);
 }
 
+// Seed §4.5.3: the docked battery applet asks for time, and in the accepted follow-up round
+// undocks before the drive gets the pilot; a rejected vote runs the reject round instead.
+TEST(Runtime, NegotiationRoundsRunTheirCodeBeforeTheHandOver) {
+  for (const bool vote : {true, false}) {
+    Model m;
+    const ServiceId pilot = m.add_service("Pilot");
+    const ServiceId dock = m.add_service("Dock");
+    m.add_dependency(dock, pilot);
+    m.add_bundle(m.add_applet("Battery"), "dock", {{dock, kX}});
+    const BundleId drive = m.add_bundle(m.add_applet("DriveTo"), "p", {{pilot, kX}}, kPriorityHigh);
+    Runtime rt(m);
+    std::atomic<bool> undocked{false}, stopped_hard{false}, docked{false};
+    std::atomic<int> drives_docked{0}, drives{0};
+    std::atomic<int> reply{-1};
+    rt.set_code("Battery", {[](AppletContext& c) { c.request("dock"); },
+                            [&](AppletContext& c) { c.use("dock", [&] { docked = true; }); },
+                            [&, vote](AppletContext& c, const Notification& n) {
+                              if (n.kind != Notification::Kind::kRevokeRequested) return;
+                              auto undock = std::make_shared<NegotiationRound>();
+                              undock->first = [&] { undocked = true; };
+                              undock->answer = {0ms, 0ms, true};
+                              auto hard = std::make_shared<NegotiationRound>();
+                              hard->first = [&] { stopped_hard = true; };
+                              NegotiationRound ask{{50ms, 200ms, vote}, {}, undock, hard};
+                              reply = static_cast<int>(c.negotiate("dock", ask).kind);
+                            },
+                            2ms});
+    rt.set_code("DriveTo", {{},
+                            [&](AppletContext& c) {
+                              c.use("p", [&] {
+                                ++drives;
+                                if (!undocked && !stopped_hard) ++drives_docked;
+                              });
+                            },
+                            {},
+                            2ms});
+    rt.start();
+    ASSERT_TRUE(eventually([&] { return docked.load(); }));
+    rt.with_scheduler([&](Scheduler& s) { s.request(drive); });
+    ASSERT_TRUE(eventually([&] { return drives > 0; }));
+    rt.stop();
+    EXPECT_EQ(drives_docked.load(), 0) << "the pilot moved while docked";
+    EXPECT_EQ(undocked.load(), vote);
+    EXPECT_EQ(stopped_hard.load(), !vote);
+    // The last reply: the undock round's "accept, no time" is accepted; the reject round
+    // answers with the default (a vote against), which is rejected.
+    EXPECT_EQ(reply.load(), static_cast<int>(vote ? Notification::Kind::kNegotiationAccepted
+                                                  : Notification::Kind::kNegotiationRejected));
+  }
+}
+
 TEST(Runtime, FailStopAppletGetsAnExceptionInsteadOfBlocking) {
   Model m;
   const ServiceId s = m.add_service("S");

@@ -27,6 +27,16 @@ class ResourceRevoked : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// One negotiation round as an applet defines it (seed §4.5.3): its answer (minimum and maximum
+/// time still needed, vote), code to run first, and the follow-up round for the scheduler's
+/// acceptance and for its rejection (each a full round again).
+struct NegotiationRound {
+  Negotiation answer;
+  std::function<void()> first;
+  std::shared_ptr<NegotiationRound> on_accept;
+  std::shared_ptr<NegotiationRound> on_reject;
+};
+
 /// What an applet's code sees: its bundles and the scheduler's calls, by bundle name.
 class AppletContext {
  public:
@@ -40,6 +50,13 @@ class AppletContext {
   void set_priority(const std::string& bundle, int priority);
   void set_deadline(const std::string& bundle, std::optional<Deadline> deadline);
   Notification negotiate(const std::string& bundle, const Negotiation& answer);
+  /// Runs a chain of rounds: each round's `first`, then its answer, then the follow-up for the
+  /// reply, until a round has none or the bundle is no longer being revoked; then yields the
+  /// bundle (seed §4.5.3: when the defined behaviour has run, the resource is taken). Call it from
+  /// the interrupt handler for kRevokeRequested. Returns the last reply.
+  Notification negotiate(const std::string& bundle, const NegotiationRound& round);
+  /// Whether the bundle is being revoked (revoke requested, not yet yielded or forced).
+  bool being_revoked(const std::string& bundle) const;
   /// Runs `body` while the bundle is granted. If it is not, blocks until it is granted again, or
   /// throws ResourceRevoked in a fail-stop applet. Returns false if the runtime stops meanwhile.
   bool use(const std::string& bundle, const std::function<void()>& body);
