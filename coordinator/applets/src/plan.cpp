@@ -4,7 +4,6 @@
 #include <cstdint>
 #include <limits>
 #include <map>
-#include <unordered_map>
 
 namespace oscar::applets {
 namespace {
@@ -13,16 +12,15 @@ namespace {
 // half-way leaves no trace (all or nothing, seed Abb. 4.6 and 4.9).
 class Assignment {
  public:
-  Assignment(const Model& model, std::size_t expected_uses)
+  explicit Assignment(const Model& model)
       : model_(model),
         uses_(model.services().size()),
         exclusive_(model.services().size(), 0),
-        expanded_(model.services().size(), 0) {
-    index_.reserve(expected_uses);
-  }
+        expanded_(model.services().size(), 0),
+        resource_used_(model.resources().size(), 0) {}
 
   void add_existing(const GrantedUse& g) {
-    index_.emplace(key(g.use), 0);
+    if (g.use.by == Use::By::kResource) resource_used_[g.use.holder] = 1;
     uses_[g.use.service].push_back(g);
     if (g.use.access == Access::kExclusive) exclusive_[g.use.service] = 1;
     expanded_[g.use.service] = 1;
@@ -64,20 +62,17 @@ class Assignment {
     ServiceId service;
   };
 
-  static std::uint64_t key(const Use& u) {
-    return (std::uint64_t{u.service} << 33) | (std::uint64_t{u.by == Use::By::kService} << 32) |
-           u.holder;
-  }
-
   // Abb. 4.21 steps 1–2: a service given exclusively admits nobody else; an exclusive use
-  // admits nobody before it. The same holder using the same service again is no new use.
+  // admits nobody before it. A resource already in use is no new use (a service applet's
+  // resource needed by two of its services); a service's own uses are added once, when it is
+  // expanded, so they need no such check.
   bool use(const Use& u, BundleId root) {
-    const std::uint64_t k = key(u);
-    if (index_.count(k)) return true;
+    const bool by_resource = u.by == Use::By::kResource;
+    if (by_resource && resource_used_[u.holder]) return true;
     auto& list = uses_[u.service];
     if (exclusive_[u.service]) return false;
     if (u.access == Access::kExclusive && !list.empty()) return false;
-    index_.emplace(k, 0);
+    if (by_resource) resource_used_[u.holder] = 1;
     list.push_back(GrantedUse{u, root});
     if (u.access == Access::kExclusive) exclusive_[u.service] = 1;
     journal_.push_back(Entry{Entry::kUse, u.service});
@@ -106,12 +101,10 @@ class Assignment {
         continue;
       }
       auto& list = uses_[e.service];
-      index_.erase(key(list.back().use));
+      if (list.back().use.by == Use::By::kResource) resource_used_[list.back().use.holder] = 0;
       list.pop_back();
-      exclusive_[e.service] = 0;  // only a sole use can have been exclusive
-      for (const GrantedUse& g : list) {
-        if (g.use.access == Access::kExclusive) exclusive_[e.service] = 1;
-      }
+      // An exclusive use is always a sole use: after removing any use, none is left exclusive.
+      exclusive_[e.service] = 0;
     }
   }
 
@@ -119,7 +112,7 @@ class Assignment {
   std::vector<std::vector<GrantedUse>> uses_;
   std::vector<char> exclusive_;
   std::vector<char> expanded_;
-  std::unordered_map<std::uint64_t, char> index_;
+  std::vector<char> resource_used_;
   std::vector<Entry> journal_;
 };
 
@@ -195,7 +188,7 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
   });
 
   // Abb. 4.19 step 3: greedy from the highest priority down.
-  Assignment assignment(model, plan.order.size() * 2);
+  Assignment assignment(model);
   for (BundleId b : plan.order) {
     if (assignment.try_grant(bundle_uses(model, b), b)) plan.bundle_granted[b] = 1;
   }
@@ -232,7 +225,7 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
 }
 
 bool can_grant(const Model& model, const Plan& plan, ServiceId service, Access access) {
-  Assignment assignment(model, 64);
+  Assignment assignment(model);
   for (const auto& list : plan.uses) {
     for (const GrantedUse& g : list) assignment.add_existing(g);
   }
