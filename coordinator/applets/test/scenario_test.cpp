@@ -3,6 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 namespace oscar::applets {
 namespace {
 
@@ -76,6 +78,17 @@ timeline:
 TEST(Scenario, AppendixCounterScenarioSwitchesSharedAndExclusive) {
   const Scenario s = Scenario::load_file(scenario_path("appendix_counter.yaml"));
   for (const auto& r : s.run()) EXPECT_TRUE(r.mismatches.empty()) << r.mismatches[0];
+}
+
+TEST(Scenario, PrioritiesDeadlinesScenarioReportsTheOverlapToBoth) {
+  const Scenario s = Scenario::load_file(scenario_path("priorities_deadlines.yaml"));
+  const auto results = s.run();
+  for (const auto& r : results) EXPECT_TRUE(r.mismatches.empty()) << r.mismatches[0];
+  const auto& notes = results.at(4).notes;
+  EXPECT_NE(std::find(notes.begin(), notes.end(), "App3/s2: deadline overlaps App4/s2"),
+            notes.end());
+  EXPECT_NE(std::find(notes.begin(), notes.end(), "App4/s2: deadline overlaps App3/s2"),
+            notes.end());
 }
 
 TEST(Scenario, NegotiationScenarioRunsAsDocumented) {
