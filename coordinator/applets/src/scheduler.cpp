@@ -286,7 +286,8 @@ void Scheduler::update_handover() {
   }
   for (BundleId b = 0; b < n; ++b) {
     if (active_[b] || !plan_.bundle_granted[b]) continue;
-    if (!state_[b].requested) continue;  // granted only through inheritance: nobody to notify
+    // Bundles granted only through inheritance (a service applet's resources that a user of its
+    // service needs) are handed over too: the service applet must be able to use them.
     bool free = true;
     for (BundleId x : giving_back) free = free && !conflicts(b, x);
     if (!free) continue;

@@ -149,6 +149,29 @@ TEST(Scheduler, PlanTakenBackCancelsTheRevocation) {
   EXPECT_TRUE(s.active(t.low));
 }
 
+TEST(Scheduler, ServiceAppletGetsItsInheritedBundleHandedOver) {
+  Model m;
+  const ServiceId monitor = m.add_service("Monitor", true);
+  const ServiceId ui = m.add_service("UI", true);
+  const AppletId provider = m.add_applet("UIService");
+  m.provide(provider, ui);
+  const BundleId io = m.add_bundle(provider, "io", {{monitor, kX}});
+  const BundleId menu = m.add_bundle(m.add_applet("Menu"), "ui", {{ui, kX}});
+  Scheduler s(m);
+  s.request(menu);  // the service applet never asked: inheritance grants its bundle
+  EXPECT_FALSE(s.requested(io));
+  EXPECT_TRUE(s.active(io));
+  bool told = false;
+  for (const Notification& n : s.take_notifications()) {
+    told = told || (n.kind == Notification::Kind::kGranted && n.bundle == io);
+  }
+  EXPECT_TRUE(told);
+  s.release(menu);
+  EXPECT_TRUE(s.revoke_deadline(io).has_value());  // given back like any other bundle
+  s.yield(io);
+  EXPECT_FALSE(s.active(io));
+}
+
 TEST(Scheduler, CrashReleasesOnlyTheCrashedAppletsBundles) {
   Model m;
   const ServiceId a = m.add_service("A");
