@@ -1,0 +1,65 @@
+#pragma once
+// What an applet's code sees of the threaded Runtime (seed 000 §4.4.1, §4.5.3, §4.6.2).
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "oscar/applets/scheduler.hpp"
+
+namespace oscar::applets {
+
+class Runtime;
+
+/// Thrown by AppletContext::use in a fail-stop applet when the bundle is not granted (§4.6.2).
+class ResourceRevoked : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// One negotiation round as an applet defines it (seed §4.5.3): its answer (minimum and maximum
+/// time still needed, vote), code to run first, and the follow-up round for the scheduler's
+/// acceptance and for its rejection (each a full round again).
+struct NegotiationRound {
+  Negotiation answer;
+  std::function<void()> first;
+  std::shared_ptr<NegotiationRound> on_accept;
+  std::shared_ptr<NegotiationRound> on_reject;
+};
+
+/// What an applet's code sees: its bundles and the scheduler's calls, by bundle name.
+class AppletContext {
+ public:
+  AppletContext(Runtime& runtime, AppletId applet) : runtime_(runtime), applet_(applet) {}
+
+  /// @throws std::invalid_argument on an unknown bundle or a refused request.
+  void request(const std::string& bundle);
+  void release(const std::string& bundle);
+  void yield(const std::string& bundle);
+  void trigger(const std::string& bundle);
+  void set_priority(const std::string& bundle, int priority);
+  void set_deadline(const std::string& bundle, std::optional<Deadline> deadline);
+  Notification negotiate(const std::string& bundle, const Negotiation& answer);
+  /// Runs a chain of rounds: each round's `first`, then its answer, then the follow-up for the
+  /// reply, until a round has none or the bundle is no longer being revoked; then yields the
+  /// bundle (seed §4.5.3: when the defined behaviour has run, the resource is taken). Call it from
+  /// the interrupt handler for kRevokeRequested. Returns the last reply.
+  Notification negotiate(const std::string& bundle, const NegotiationRound& round);
+  /// Whether the bundle is being revoked (revoke requested, not yet yielded or forced).
+  bool being_revoked(const std::string& bundle) const;
+  /// Runs `body` while the bundle is granted. If it is not, blocks until it is granted again, or
+  /// throws ResourceRevoked in a fail-stop applet. Returns false if the runtime stops meanwhile.
+  bool use(const std::string& bundle, const std::function<void()>& body);
+  /// Whether the bundle may be used now.
+  bool granted(const std::string& bundle) const;
+  AppletId id() const { return applet_; }
+
+ private:
+  BundleId bundle_id(const std::string& bundle) const;
+  Runtime& runtime_;
+  AppletId applet_;
+};
+
+}  // namespace oscar::applets

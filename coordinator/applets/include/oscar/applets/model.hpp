@@ -1,0 +1,145 @@
+#pragma once
+// The static structure of an applet system (seed 000 §4.1–4.2): services, applets, resource
+// bundles and hierarchical service dependencies. Dynamic state (requests, priorities, deadlines)
+// lives in the Scheduler.
+
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+namespace oscar::applets {
+
+using ServiceId = std::uint32_t;
+using AppletId = std::uint32_t;
+using ResourceId = std::uint32_t;
+using BundleId = std::uint32_t;
+
+/// How a resource wants to use its service (seed §4.2.2).
+enum class Access { kShared, kExclusive };
+
+/// Predefined priority levels; any int in between is allowed (seed §4.5.2).
+inline constexpr int kPriorityLow = 100;
+inline constexpr int kPriorityNormal = 200;
+inline constexpr int kPriorityHigh = 300;
+inline constexpr int kPrioritySystem = 400;
+
+/// A service a service depends on, declared in configuration (seed §4.2.3, Abb. 4.10).
+struct Dependency {
+  ServiceId service = 0;
+  Access access = Access::kExclusive;
+};
+
+/// A functional unit (pilot, docking controller, display, ...).
+struct Service {
+  std::string name;
+  bool exclusive_only = false;
+  std::optional<AppletId> provider;  ///< The service applet that provides it, if any.
+  std::vector<Dependency> dependencies;
+};
+
+/// An applet's proxy to one service (seed §4.2.2).
+struct Resource {
+  AppletId applet = 0;
+  ServiceId service = 0;
+  Access access = Access::kShared;
+  BundleId bundle = 0;
+};
+
+/// Resources granted all together or not at all (seed §4.2.2, Abb. 4.6). A single resource is a
+/// bundle of one: the plan works on bundles only (Abb. 4.19 step 1 removes bundle children).
+struct Bundle {
+  AppletId applet = 0;
+  std::string name;
+  std::vector<ResourceId> resources;
+  int priority = kPriorityNormal;  ///< Initial priority; the Scheduler may change it.
+};
+
+/// An applet or service applet (seed §4.1).
+struct Applet {
+  std::string name;
+  std::vector<ServiceId> provides;
+  std::vector<BundleId> bundles;
+  std::vector<ResourceId> resources;
+  bool fail_stop = false;  ///< Using a non-granted resource throws instead of blocking (§4.6.2).
+};
+
+/// One use of a service while a bundle is granted: by a resource or by a service (a dependency
+/// declared in configuration).
+struct Use {
+  enum class By : std::uint8_t { kResource, kService };
+  ServiceId service = 0;
+  Access access = Access::kShared;
+  By by = By::kResource;
+  std::uint32_t holder = 0;  ///< ResourceId or ServiceId, per `by`.
+};
+
+/// The static structure of an applet system. Every call validates its input and throws
+/// std::invalid_argument naming the thing and the rule.
+class Model {
+ public:
+  /// Adds a service. @throws std::invalid_argument on an empty or duplicate name.
+  ServiceId add_service(std::string name, bool exclusive_only = false);
+  /// Declares that `service` needs `dependency` (seed §4.2.3, declared only in configuration).
+  /// @throws std::invalid_argument on a self-dependency or a duplicate.
+  void add_dependency(ServiceId service, ServiceId dependency, Access access = Access::kExclusive);
+  /// Adds an applet. @throws std::invalid_argument on an empty or duplicate name.
+  AppletId add_applet(std::string name, bool fail_stop = false);
+  /// Makes `applet` the service applet providing `service`; the service needs all of the
+  /// applet's resources. @throws std::invalid_argument if another applet provides it.
+  void provide(AppletId applet, ServiceId service);
+  /// Adds a bundle of resources to an applet.
+  /// @throws std::invalid_argument on an empty bundle, a service twice in one bundle, a shared
+  /// resource on an exclusive-only service, or a duplicate bundle name.
+  BundleId add_bundle(AppletId applet, std::string name,
+                      const std::vector<std::pair<ServiceId, Access>>& resources,
+                      int priority = kPriorityNormal);
+
+  /// @throws std::invalid_argument "unknown service 'X'".
+  ServiceId service_id(std::string_view name) const;
+  /// @throws std::invalid_argument "unknown applet 'X'".
+  AppletId applet_id(std::string_view name) const;
+  /// @throws std::invalid_argument "applet 'A' has no bundle 'B'".
+  BundleId bundle_id(AppletId applet, std::string_view name) const;
+  std::optional<ServiceId> find_service(std::string_view name) const;
+
+  const std::vector<Service>& services() const { return services_; }
+  const std::vector<Applet>& applets() const { return applets_; }
+  const std::vector<Resource>& resources() const { return resources_; }
+  const std::vector<Bundle>& bundles() const { return bundles_; }
+  const Service& service(ServiceId id) const { return services_.at(id); }
+  const Applet& applet(AppletId id) const { return applets_.at(id); }
+  const Bundle& bundle(BundleId id) const { return bundles_.at(id); }
+  const Resource& resource(ResourceId id) const { return resources_.at(id); }
+
+  /// What granting `service` needs directly: its configured dependencies (used by the service)
+  /// and all resources of its providing service applet (neededServices(s), seed Abb. 4.21).
+  const std::vector<Use>& needs(ServiceId service) const;
+
+  /// Bundles that lie on a dependency cycle together with `bundle` (including itself), or empty
+  /// if it lies on none (seed §4.2.3, Abb. 4.9). Valid after the last change to the model.
+  const std::vector<BundleId>& cycle_of(BundleId bundle) const;
+
+ private:
+  void invalidate() { analysed_ = false; }
+  void analyse() const;
+
+  std::vector<Service> services_;
+  std::vector<Applet> applets_;
+  std::vector<Resource> resources_;
+  std::vector<Bundle> bundles_;
+  std::unordered_map<std::string, ServiceId> service_ids_;
+  std::unordered_map<std::string, AppletId> applet_ids_;
+
+  mutable bool analysed_ = false;
+  mutable std::vector<std::vector<Use>> needs_;
+  mutable std::vector<std::vector<BundleId>> cycles_;  // per bundle
+};
+
+/// "shared" or "exclusive".
+std::string_view to_string(Access access);
+
+}  // namespace oscar::applets

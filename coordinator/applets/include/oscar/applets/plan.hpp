@@ -1,0 +1,66 @@
+#pragma once
+// The resource plan: calculateAssignments of seed 000 Abb. 4.19–4.21, as a pure function.
+
+#include <chrono>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "oscar/applets/model.hpp"
+
+namespace oscar::applets {
+
+/// A deadline (seed §4.5.1, eq. 4.8–4.10): earliest start, duration and latest end of an access,
+/// in the scheduler's clock.
+struct Deadline {
+  std::chrono::milliseconds t_early{0};
+  std::chrono::milliseconds t_duration{0};
+  std::chrono::milliseconds t_finish{0};
+  /// The relative deadline t_finish - t_duration (eq. 4.8): the latest start.
+  std::chrono::milliseconds relative() const { return t_finish - t_duration; }
+};
+
+/// Dynamic state of one bundle as the plan sees it.
+struct BundleState {
+  bool requested = false;
+  int priority = kPriorityNormal;
+  bool boosted = false;  ///< Triggered: sorts just above its priority level (seed §4.5.2).
+  std::optional<Deadline> deadline;
+};
+
+/// One granted use of a service and the requested bundle whose grant brought it in.
+struct GrantedUse {
+  Use use;
+  BundleId root = 0;
+};
+
+/// The result of one plan.
+struct Plan {
+  /// The sorted working set W_t (requested bundles); the next plan starts from it.
+  std::vector<BundleId> order;
+  std::vector<char> bundle_granted;           ///< Per bundle: all its resources are granted.
+  std::vector<char> resource_granted;         ///< Per resource.
+  std::vector<std::vector<GrantedUse>> uses;  ///< Per service: who uses it.
+  /// Requested bundles of one priority whose deadlines overlap (eq. 4.11), each pair once.
+  std::vector<std::pair<BundleId, BundleId>> deadline_overlaps;
+  /// Per bundle: the priority it was sorted with (cycles take their highest, seed §4.5.1).
+  std::vector<int> effective_priority;
+};
+
+/// Computes the plan (seed Abb. 4.19): the working set `previous_order` extended by new requests,
+/// stably sorted by priority (descending; a triggered bundle just above its level), then EDF on
+/// the relative deadline, then held bundles first; walked greedily, each bundle granted with
+/// everything it needs down the service hierarchy (priority inheritance) or not at all.
+/// Runs in O(n log n) for n bundles when the service hierarchy is bounded.
+Plan calculate_assignments(const Model& model, const std::vector<BundleState>& state,
+                           const std::vector<BundleId>& previous_order,
+                           const std::vector<char>& previously_granted,
+                           std::chrono::milliseconds context_switch = std::chrono::milliseconds{0});
+
+/// Whether a new use of `service` with `access` could be granted beside `plan` (with all it needs).
+bool can_grant(const Model& model, const Plan& plan, ServiceId service, Access access);
+
+/// Eq. 4.11 with the context-switch time c: min(t_early) + d_i + d_j + c > max(t_finish).
+bool deadlines_overlap(const Deadline& a, const Deadline& b, std::chrono::milliseconds c);
+
+}  // namespace oscar::applets

@@ -1,0 +1,95 @@
+#pragma once
+// The threaded runtime (seed 000 §4.4, §4.6.2): every applet in its own thread inside a wrapper
+// that contains crashes; interrupt handlers queued to the applet and run between its main-loop
+// steps (Abb. 4.12); a reassigner thread that revokes by force when the wait limit passes. The
+// decisions are the deterministic Scheduler's, driven by the steady clock.
+
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "oscar/applets/applet_context.hpp"
+#include "oscar/applets/scheduler.hpp"
+
+namespace oscar::applets {
+
+/// The code of one applet (Abb. 4.12): init once, then step every period; `on_interrupt` runs
+/// queued notifications between steps. By default a revoked bundle is yielded at once.
+struct AppletCode {
+  std::function<void(AppletContext&)> init;
+  std::function<void(AppletContext&)> step;
+  std::function<void(AppletContext&, const Notification&)> on_interrupt;
+  std::chrono::milliseconds period{10};
+};
+
+/// Measured figures of a run.
+struct RuntimeStats {
+  std::uint64_t grants = 0;          ///< Bundles handed to an applet (re)assignments.
+  std::vector<double> wait_ms;       ///< Request (or revocation) to the first use again.
+  std::vector<double> overhead_ms;   ///< Grant to the waiting applet running: scheduling cost.
+  std::vector<std::string> crashed;  ///< Applets whose code threw.
+};
+
+/// Runs applets in threads around one Scheduler. Construct, add code, start, stop.
+class Runtime {
+ public:
+  explicit Runtime(Model model, SchedulerOptions options = {});
+  ~Runtime();
+  Runtime(const Runtime&) = delete;
+  Runtime& operator=(const Runtime&) = delete;
+
+  /// Sets the code of a configured applet. @throws std::invalid_argument if unknown or started.
+  void set_code(const std::string& applet, AppletCode code);
+  /// Starts one thread per applet with code, and the reassigner.
+  void start();
+  /// Stops and joins all threads (also called by the destructor).
+  void stop();
+  /// Pauses an applet between steps; a paused applet releases nothing by itself.
+  void pause(const std::string& applet, bool paused);
+  /// Whether an applet's thread ended by an exception (its bundles were released).
+  bool crashed(const std::string& applet) const;
+
+  /// Calls `f` with the scheduler under the runtime's lock, then delivers notifications.
+  void with_scheduler(const std::function<void(Scheduler&)>& f);
+  RuntimeStats stats() const;
+
+ private:
+  friend class AppletContext;
+  struct Slot {
+    AppletCode code;
+    std::deque<Notification> interrupts;
+    bool paused = false;
+    bool crashed = false;
+    bool has_code = false;
+    std::condition_variable cv;  // wakes this applet only (no thundering herd)
+    std::thread thread;
+  };
+  using Clock = std::chrono::steady_clock;
+
+  milliseconds clock() const;
+  void locked_call(const std::function<void(Scheduler&)>& f);  // lock held by caller
+  void deliver();                                              // lock held
+  void applet_main(AppletId id);
+  void reassigner_main();
+
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;  // wakes the reassigner
+  Scheduler scheduler_;
+  std::vector<std::unique_ptr<Slot>> slots_;
+  std::vector<Clock::time_point> waiting_since_;  // per bundle: asked, not yet granted
+  std::vector<Clock::time_point> granted_at_;     // per bundle
+  RuntimeStats stats_;
+  Clock::time_point start_;
+  bool running_ = false;
+  bool stopping_ = false;
+  std::thread reassigner_;
+};
+
+}  // namespace oscar::applets

@@ -1,0 +1,133 @@
+#pragma once
+// The deterministic scheduler core (seed 000 §4.1–4.6): requests, priorities, deadlines and
+// triggering drive the plan; per-service reassignment (inform, negotiate, wait, revoke by force,
+// grant) runs on a logical clock. No threads: the threaded Runtime and the scenario runner both
+// drive this class.
+
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "oscar/applets/model.hpp"
+#include "oscar/applets/plan.hpp"
+
+namespace oscar::applets {
+
+using std::chrono::milliseconds;
+
+/// Tunables of the scheduler; defaults follow the seed.
+struct SchedulerOptions {
+  milliseconds context_switch{0};             ///< c in the footnote to eq. 4.9–4.10.
+  milliseconds revoke_wait{5000};             ///< Wait for a release before revoking by force.
+  milliseconds negotiation_round_max{20000};  ///< Longest time one negotiation round may grant.
+  int negotiation_rounds_max = 3;             ///< Rounds per revocation (the scheduler decides).
+};
+
+/// An applet's answer to a revocation (seed §4.5.3, "Verhandlungsrunden").
+struct Negotiation {
+  milliseconds min_needed{0};  ///< Least time the applet still needs the bundle.
+  milliseconds max_needed{0};  ///< Most time it needs.
+  bool accept = false;         ///< Vote: agrees to the revocation (after the time it needs).
+};
+
+/// What the scheduler tells an applet; delivered through the applet's interrupt queue.
+struct Notification {
+  enum class Kind {
+    kGranted,              ///< The bundle may be used (again).
+    kRevokeRequested,      ///< The plan gives the bundle to others: finish, yield or negotiate.
+    kNegotiationAccepted,  ///< More time granted, until `until`.
+    kNegotiationRejected,  ///< No more time; yield before `until`.
+    kRevokedByForce,       ///< The wait limit passed: the bundle is gone.
+    kDeadlineOverlap,      ///< Its deadline overlaps `other`'s (eq. 4.11); best effort.
+  };
+  Kind kind = Kind::kGranted;
+  AppletId applet = 0;
+  BundleId bundle = 0;
+  std::vector<AppletId> new_holders;  ///< Who gets the services (kRevokeRequested).
+  std::optional<BundleId> other;      ///< kDeadlineOverlap.
+  milliseconds until{0};              ///< Negotiation: the time by which to yield.
+};
+
+/// Pure scheduler: call its methods from one thread (the Runtime serialises them).
+class Scheduler {
+ public:
+  /// @throws std::invalid_argument if a bundle's initial priority is negative.
+  explicit Scheduler(Model model, SchedulerOptions options = {});
+
+  const Model& model() const { return model_; }
+  const SchedulerOptions& options() const { return options_; }
+  milliseconds now() const { return now_; }
+
+  /// Moves the logical clock forward and revokes by force where the wait limit passed.
+  /// @throws std::invalid_argument if `t` lies before now().
+  void advance_to(milliseconds t);
+
+  /// Asks for a bundle (again). @throws std::invalid_argument if another requested bundle of the
+  /// same applet uses one of its services and either asks for exclusive access.
+  void request(BundleId bundle);
+  /// Gives a bundle back and withdraws the request.
+  void release(BundleId bundle);
+  /// Hands a bundle back after a revocation but keeps the request (it is granted again later).
+  void yield(BundleId bundle);
+  /// Changes a bundle's priority. @throws std::invalid_argument if negative.
+  void set_priority(BundleId bundle, int priority);
+  /// Sets or clears a deadline (eq. 4.9–4.10 with the context-switch time).
+  /// @throws std::invalid_argument naming the violated inequality.
+  void set_deadline(BundleId bundle, std::optional<Deadline> deadline);
+  /// Raises a requested bundle just above its priority level for one plan, then restores it
+  /// (seed §4.5.2, Abb. 4.18). @throws std::invalid_argument if the bundle is not requested.
+  void trigger(BundleId bundle);
+  /// An applet crashed: all its bundles are released at once, nothing else is touched.
+  void crash(AppletId applet);
+  /// An applet answers a revocation. Returns the notification it gets (accepted or rejected).
+  /// @throws std::invalid_argument if the bundle is not being revoked.
+  Notification negotiate(BundleId bundle, const Negotiation& answer);
+
+  /// The current plan (what the scheduler intends).
+  const Plan& plan() const { return plan_; }
+  /// Whether a bundle may be used now (granted and handed over).
+  bool active(BundleId bundle) const { return active_.at(bundle) != 0; }
+  /// Whether the bundle is being revoked and by when it must be yielded.
+  std::optional<milliseconds> revoke_deadline(BundleId bundle) const;
+  bool requested(BundleId bundle) const { return state_.at(bundle).requested; }
+  int priority(BundleId bundle) const { return state_.at(bundle).priority; }
+
+  /// The planned holder of a service for people: applet names (sorted, joined by ','), "blocked"
+  /// (requested but not granted, or held up by a dependency) or "undef" (nobody asked).
+  std::string holder(ServiceId service) const;
+  /// Who may use a service right now (handed over, seed Abb. 4.2): applet names joined by ',',
+  /// or "none". Differs from holder() while a reassignment is under way.
+  std::string active_holder(ServiceId service) const;
+
+  /// Notifications since the last call, in order.
+  std::vector<Notification> take_notifications();
+  /// Number of plans computed so far.
+  std::uint64_t plans_computed() const { return plans_; }
+
+ private:
+  struct Revocation {
+    milliseconds until{0};
+    int rounds = 0;
+  };
+
+  void replan();
+  void update_handover();
+  const std::vector<ServiceId>& closure(ServiceId service) const;
+  bool conflicts(BundleId a, BundleId b) const;
+  void check_bundle(BundleId bundle) const;
+
+  Model model_;
+  SchedulerOptions options_;
+  milliseconds now_{0};
+  std::vector<BundleState> state_;
+  Plan plan_;
+  std::vector<char> active_;
+  std::vector<std::optional<Revocation>> revoking_;
+  std::vector<Notification> notifications_;
+  std::uint64_t plans_ = 0;
+  mutable std::vector<std::optional<std::vector<ServiceId>>> closure_cache_;
+};
+
+}  // namespace oscar::applets

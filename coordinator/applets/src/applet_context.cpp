@@ -1,0 +1,112 @@
+#include "oscar/applets/applet_context.hpp"
+
+#include <algorithm>
+
+#include "oscar/applets/runtime.hpp"
+
+namespace oscar::applets {
+namespace {
+double ms_between(std::chrono::steady_clock::time_point a,
+                  std::chrono::steady_clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+}  // namespace
+
+BundleId AppletContext::bundle_id(const std::string& bundle) const {
+  return runtime_.scheduler_.model().bundle_id(applet_, bundle);
+}
+
+void AppletContext::request(const std::string& bundle) {
+  const BundleId b = bundle_id(bundle);
+  runtime_.with_scheduler([&](Scheduler& s) {
+    if (!s.requested(b)) runtime_.waiting_since_[b] = Runtime::Clock::now();
+    s.request(b);
+  });
+}
+void AppletContext::release(const std::string& bundle) {
+  const BundleId b = bundle_id(bundle);
+  runtime_.with_scheduler([&](Scheduler& s) { s.release(b); });
+}
+void AppletContext::yield(const std::string& bundle) {
+  const BundleId b = bundle_id(bundle);
+  runtime_.with_scheduler([&](Scheduler& s) {
+    if (s.revoke_deadline(b)) runtime_.waiting_since_[b] = Runtime::Clock::now();
+    s.yield(b);
+  });
+}
+void AppletContext::trigger(const std::string& bundle) {
+  const BundleId b = bundle_id(bundle);
+  runtime_.with_scheduler([&](Scheduler& s) { s.trigger(b); });
+}
+void AppletContext::set_priority(const std::string& bundle, int priority) {
+  const BundleId b = bundle_id(bundle);
+  runtime_.with_scheduler([&](Scheduler& s) { s.set_priority(b, priority); });
+}
+void AppletContext::set_deadline(const std::string& bundle, std::optional<Deadline> deadline) {
+  const BundleId b = bundle_id(bundle);
+  runtime_.with_scheduler([&](Scheduler& s) { s.set_deadline(b, deadline); });
+}
+Notification AppletContext::negotiate(const std::string& bundle, const Negotiation& answer) {
+  const BundleId b = bundle_id(bundle);
+  Notification n;
+  runtime_.with_scheduler([&](Scheduler& s) { n = s.negotiate(b, answer); });
+  return n;
+}
+
+Notification AppletContext::negotiate(const std::string& bundle, const NegotiationRound& round) {
+  Notification reply;
+  const NegotiationRound* r = &round;
+  while (r != nullptr) {
+    if (r->first) r->first();
+    if (!being_revoked(bundle)) break;  // forced meanwhile, or the plan gave it back
+    reply = negotiate(bundle, r->answer);
+    r = (reply.kind == Notification::Kind::kNegotiationAccepted ? r->on_accept : r->on_reject)
+            .get();
+  }
+  yield(bundle);
+  return reply;
+}
+
+bool AppletContext::being_revoked(const std::string& bundle) const {
+  const BundleId b = bundle_id(bundle);
+  std::lock_guard lock(runtime_.mutex_);
+  return runtime_.scheduler_.revoke_deadline(b).has_value();
+}
+
+bool AppletContext::granted(const std::string& bundle) const {
+  const BundleId b = bundle_id(bundle);
+  std::lock_guard lock(runtime_.mutex_);
+  return runtime_.scheduler_.active(b);
+}
+
+bool AppletContext::use(const std::string& bundle, const std::function<void()>& body) {
+  const BundleId b = bundle_id(bundle);
+  {
+    std::unique_lock lock(runtime_.mutex_);
+    if (!runtime_.scheduler_.active(b)) {
+      if (runtime_.scheduler_.model().applet(applet_).fail_stop) {
+        throw ResourceRevoked("applet '" + runtime_.scheduler_.model().applet(applet_).name +
+                              "' used bundle '" + bundle + "' which is not granted (fail-stop)");
+      }
+      const auto asked = Runtime::Clock::now();
+      runtime_.slots_[applet_]->cv.wait(
+          lock, [&] { return runtime_.stopping_ || runtime_.scheduler_.active(b); });
+      if (runtime_.stopping_) return false;
+      const auto now = Runtime::Clock::now();
+      // Scheduling overhead: from the grant (or the ask, if later) to running again.
+      runtime_.stats_.overhead_ms.push_back(
+          ms_between(std::max(asked, runtime_.granted_at_[b]), now));
+    }
+    if (runtime_.waiting_since_[b] != Runtime::Clock::time_point{}) {
+      runtime_.stats_.wait_ms.push_back(
+          ms_between(runtime_.waiting_since_[b], Runtime::Clock::now()));
+      runtime_.waiting_since_[b] = {};
+    }
+  }
+  // The body runs without the lock: the seed revokes only between steps (or by force after the
+  // wait limit, which the next use() then notices).
+  body();
+  return true;
+}
+
+}  // namespace oscar::applets

@@ -1,0 +1,218 @@
+#include "oscar/applets/config.hpp"
+
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace oscar::applets {
+namespace {
+
+[[noreturn]] void fail_at(const YAML::Node& node, const std::string& file, const std::string& m) {
+  throw std::invalid_argument(where(node, file) + ": " + m);
+}
+
+void allow_keys(const YAML::Node& node, const std::string& file, const std::string& what,
+                const std::set<std::string>& keys) {
+  if (!node.IsMap()) fail_at(node, file, what + " must be a mapping");
+  for (const auto& kv : node) {
+    const auto key = kv.first.as<std::string>();
+    if (!keys.count(key)) {
+      std::string list;
+      for (const auto& k : keys) list += (list.empty() ? "" : ", ") + k;
+      fail_at(kv.first, file, what + ": unknown key '" + key + "' (allowed: " + list + ")");
+    }
+  }
+}
+
+std::string text(const YAML::Node& node, const std::string& file, const std::string& what) {
+  if (!node || !node.IsScalar()) fail_at(node, file, what + " must be a text value");
+  return node.as<std::string>();
+}
+
+long long number(const YAML::Node& node, const std::string& file, const std::string& what) {
+  if (!node || !node.IsScalar()) fail_at(node, file, what + " must be a number");
+  try {
+    return node.as<long long>();
+  } catch (const YAML::Exception&) {
+    fail_at(node, file, what + " must be a whole number, not '" + node.as<std::string>() + "'");
+  }
+}
+
+Access access_of(const YAML::Node& node, const std::string& file) {
+  const std::string a = text(node, file, "access");
+  if (a == "exclusive") return Access::kExclusive;
+  if (a == "shared") return Access::kShared;
+  fail_at(node, file, "access '" + a + "' must be 'shared' or 'exclusive'");
+}
+
+ServiceId service_at(const Model& model, const YAML::Node& node, const std::string& file,
+                     const std::string& who) {
+  const std::string name = text(node, file, "service");
+  if (auto id = model.find_service(name)) return *id;
+  fail_at(node, file, who + ": unknown service '" + name + "' (declare it under services:)");
+}
+
+std::map<std::string, std::string> params_of(const YAML::Node& node, const std::string& file) {
+  std::map<std::string, std::string> out;
+  if (!node) return out;
+  if (!node.IsMap()) fail_at(node, file, "params must be a mapping of names to values");
+  for (const auto& kv : node) {
+    out[kv.first.as<std::string>()] =
+        kv.second.IsScalar() ? kv.second.as<std::string>() : YAML::Dump(kv.second);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string where(const YAML::Node& node, const std::string& file) {
+  if (!node || node.Mark().line < 0) return file;
+  return file + ":" + std::to_string(node.Mark().line + 1);
+}
+
+std::string read_text_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument(path + ": cannot read the file");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+YAML::Node parse_yaml(const std::string& content, const std::string& file) {
+  try {
+    return YAML::Load(content);
+  } catch (const YAML::ParserException& e) {
+    throw std::invalid_argument(file + ":" + std::to_string(e.mark.line + 1) + ":" +
+                                std::to_string(e.mark.column + 1) + ": malformed YAML: " + e.msg);
+  }
+}
+
+int parse_priority(const YAML::Node& node, const std::string& file) {
+  const std::string v = text(node, file, "priority");
+  if (v == "low") return kPriorityLow;
+  if (v == "normal") return kPriorityNormal;
+  if (v == "high") return kPriorityHigh;
+  if (v == "system") return kPrioritySystem;
+  long long p = 0;
+  try {
+    p = node.as<long long>();
+  } catch (const YAML::Exception&) {
+    fail_at(node, file,
+            "priority '" + v + "' must be low, normal, high, system or a whole number >= 0");
+  }
+  if (p < 0 || p > 1000000) fail_at(node, file, "priority " + v + " must lie in 0..1000000");
+  return static_cast<int>(p);
+}
+
+SystemConfig load_system(const YAML::Node& root, const std::string& file) {
+  SystemConfig c;
+  if (!root || !root.IsMap()) fail_at(root, file, "the document must be a mapping");
+  if (const auto s = root["scheduler"]) {
+    allow_keys(
+        s, file, "scheduler",
+        {"context_switch_ms", "revoke_wait_ms", "negotiation_round_ms", "negotiation_rounds"});
+    auto ms_of = [&](const char* key, milliseconds& out) {
+      if (!s[key]) return;
+      const long long v = number(s[key], file, key);
+      if (v < 0) fail_at(s[key], file, std::string(key) + " must not be negative");
+      out = milliseconds{v};
+    };
+    ms_of("context_switch_ms", c.options.context_switch);
+    ms_of("revoke_wait_ms", c.options.revoke_wait);
+    ms_of("negotiation_round_ms", c.options.negotiation_round_max);
+    if (s["negotiation_rounds"]) {
+      const long long v = number(s["negotiation_rounds"], file, "negotiation_rounds");
+      if (v < 0) fail_at(s["negotiation_rounds"], file, "negotiation_rounds must not be negative");
+      c.options.negotiation_rounds_max = static_cast<int>(v);
+    }
+  }
+  const YAML::Node services = root["services"];
+  if (!services || !services.IsSequence()) {
+    fail_at(services ? services : root, file, "'services' must be a list of services");
+  }
+  for (const auto& s : services) {
+    allow_keys(s, file, "service", {"name", "exclusive_only", "depends_on", "params"});
+    const std::string name = text(s["name"], file, "service name");
+    try {
+      c.model.add_service(name, s["exclusive_only"] && s["exclusive_only"].as<bool>());
+    } catch (const std::invalid_argument& e) {
+      fail_at(s["name"], file, e.what());
+    } catch (const YAML::Exception&) {
+      fail_at(s["exclusive_only"], file, "exclusive_only must be true or false");
+    }
+    c.service_params[name] = params_of(s["params"], file);
+  }
+  // Dependencies in a second pass so that their order in the file does not matter.
+  for (const auto& s : services) {
+    const YAML::Node deps = s["depends_on"];
+    if (!deps) continue;
+    const std::string name = s["name"].as<std::string>();
+    if (!deps.IsSequence())
+      fail_at(deps, file, "service '" + name + "': depends_on must be a list");
+    for (const auto& d : deps) {
+      YAML::Node svc = d;
+      Access access = Access::kExclusive;
+      if (d.IsMap()) {
+        allow_keys(d, file, "dependency", {"service", "access"});
+        svc = d["service"];
+        if (d["access"]) access = access_of(d["access"], file);
+      }
+      const std::string dep = text(svc, file, "dependency");
+      const auto id = c.model.find_service(dep);
+      if (!id) {
+        fail_at(svc, file, "service '" + name + "' depends on unknown service '" + dep + "'");
+      }
+      try {
+        c.model.add_dependency(c.model.service_id(name), *id, access);
+      } catch (const std::invalid_argument& e) {
+        fail_at(svc, file, e.what());
+      }
+    }
+  }
+  const YAML::Node applets = root["applets"];
+  if (applets && !applets.IsSequence()) fail_at(applets, file, "'applets' must be a list");
+  for (const auto& a : applets) {
+    allow_keys(a, file, "applet", {"name", "provides", "bundles", "params", "fail_stop"});
+    const std::string name = text(a["name"], file, "applet name");
+    AppletId id = 0;
+    try {
+      id = c.model.add_applet(name, a["fail_stop"] && a["fail_stop"].as<bool>());
+    } catch (const std::invalid_argument& e) {
+      fail_at(a["name"], file, e.what());
+    }
+    c.applet_params[name] = params_of(a["params"], file);
+    for (const auto& p : a["provides"]) {
+      try {
+        c.model.provide(id, service_at(c.model, p, file, "applet '" + name + "' provides"));
+      } catch (const std::invalid_argument& e) {
+        if (std::string(e.what()).rfind(file, 0) == 0) throw;
+        fail_at(p, file, e.what());
+      }
+    }
+    for (const auto& b : a["bundles"]) {
+      allow_keys(b, file, "bundle", {"name", "priority", "resources", "requested"});
+      const std::string bname = text(b["name"], file, "bundle name");
+      const std::string who = "applet '" + name + "' bundle '" + bname + "'";
+      std::vector<std::pair<ServiceId, Access>> resources;
+      if (!b["resources"] || !b["resources"].IsSequence()) {
+        fail_at(b, file, who + ": 'resources' must be a list");
+      }
+      for (const auto& r : b["resources"]) {
+        allow_keys(r, file, "resource", {"service", "access"});
+        const Access access = r["access"] ? access_of(r["access"], file) : Access::kExclusive;
+        resources.emplace_back(service_at(c.model, r["service"], file, who), access);
+      }
+      const int prio = b["priority"] ? parse_priority(b["priority"], file) : kPriorityNormal;
+      try {
+        const BundleId bid = c.model.add_bundle(id, bname, resources, prio);
+        if (b["requested"] && b["requested"].as<bool>()) c.requested_at_start.push_back(bid);
+      } catch (const std::invalid_argument& e) {
+        fail_at(b, file, e.what());
+      }
+    }
+  }
+  return c;
+}
+
+}  // namespace oscar::applets

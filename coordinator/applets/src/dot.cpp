@@ -1,0 +1,110 @@
+#include "oscar/applets/dot.hpp"
+
+#include <cstdlib>
+#include <fstream>
+#include <stdexcept>
+
+namespace oscar::applets {
+namespace {
+
+std::string quote(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '\n') {
+      out += "\\n";
+      continue;
+    }
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string priority_name(int p) {
+  switch (p) {
+    case kPriorityLow:
+      return "low";
+    case kPriorityNormal:
+      return "normal";
+    case kPriorityHigh:
+      return "high";
+    case kPrioritySystem:
+      return "system";
+    default:
+      return std::to_string(p);
+  }
+}
+
+}  // namespace
+
+std::string to_dot(const Scheduler& s) {
+  const Model& m = s.model();
+  const Plan& plan = s.plan();
+  std::string out = "digraph applets {\n  rankdir=LR;\n  node [fontname=\"Helvetica\"];\n";
+  for (ServiceId id = 0; id < m.services().size(); ++id) {
+    const Service& svc = m.service(id);
+    out +=
+        "  " + quote("s:" + svc.name) + " [shape=ellipse, style=filled, fillcolor=" +
+        (plan.uses[id].empty() ? "white" : "lightblue") + ", label=" +
+        quote(svc.name + (svc.exclusive_only ? "\n(exclusive only)" : "") + "\n" + s.holder(id)) +
+        "];\n";
+    for (const Dependency& d : svc.dependencies) {
+      out += "  " + quote("s:" + svc.name) + " -> " + quote("s:" + m.service(d.service).name) +
+             " [style=dashed, label=" + quote("needs " + std::string(to_string(d.access))) + "];\n";
+    }
+  }
+  for (AppletId a = 0; a < m.applets().size(); ++a) {
+    const Applet& ap = m.applet(a);
+    out += "  subgraph " + quote("cluster_" + ap.name) +
+           " {\n    label=" + quote(ap.name + (ap.provides.empty() ? "" : " (service applet)")) +
+           ";\n";
+    for (BundleId b : ap.bundles) {
+      const Bundle& bundle = m.bundle(b);
+      const std::string state = !s.requested(b)          ? "idle"
+                                : s.active(b)            ? "active"
+                                : plan.bundle_granted[b] ? "granted, waiting for hand-over"
+                                                         : "blocked";
+      const std::string colour = state == "idle"      ? "white"
+                                 : state == "active"  ? "palegreen"
+                                 : state == "blocked" ? "lightgrey"
+                                                      : "khaki";
+      out += "    " + quote("b:" + ap.name + "/" + bundle.name) + " [shape=box, style=filled, " +
+             "fillcolor=" + colour + ", label=" +
+             quote(bundle.name + "\nprio " + priority_name(s.priority(b)) + "\n" + state) + "];\n";
+    }
+    out += "  }\n";
+    for (ServiceId p : ap.provides) {
+      out += "  " +
+             quote("b:" + ap.name + "/" + m.bundle(ap.bundles.empty() ? 0 : ap.bundles[0]).name) +
+             " -> " + quote("s:" + m.service(p).name) +
+             " [dir=back, color=darkgreen, label=provides];\n";
+    }
+    for (BundleId b : ap.bundles) {
+      for (ResourceId r : m.bundle(b).resources) {
+        const Resource& res = m.resource(r);
+        const bool exclusive = res.access == Access::kExclusive;
+        out += "  " + quote("b:" + ap.name + "/" + m.bundle(b).name) + " -> " +
+               quote("s:" + m.service(res.service).name) +
+               " [color=" + (plan.resource_granted[r] ? (exclusive ? "red" : "blue") : "grey") +
+               ", label=" + quote(std::string(to_string(res.access))) + "];\n";
+      }
+    }
+  }
+  return out + "}\n";
+}
+
+bool write_picture(const Scheduler& s, const std::string& path) {
+  const bool svg = path.size() > 4 && path.substr(path.size() - 4) == ".svg";
+  const std::string dot_path = svg ? path + ".dot" : path;
+  {
+    std::ofstream out(dot_path);
+    if (!out) throw std::invalid_argument(dot_path + ": cannot write the picture");
+    out << to_dot(s);
+  }
+  if (!svg) return true;
+  if (std::system("command -v dot >/dev/null 2>&1") != 0) return false;
+  const std::string cmd = "dot -Tsvg '" + dot_path + "' -o '" + path + "'";
+  return std::system(cmd.c_str()) == 0;
+}
+
+}  // namespace oscar::applets

@@ -1,0 +1,39 @@
+#include "oscar/applets/dot.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "oscar/applets/scenario.hpp"
+
+namespace oscar::applets {
+namespace {
+
+using ::testing::HasSubstr;
+
+TEST(Dot, ShowsAppletsBundlesServicesStatesAndPriorities) {
+  const auto s = Scenario::parse(
+      R"(services: [{name: Pilot}, {name: Dock, depends_on: [Pilot]}, {name: UI, exclusive_only: true}]
+applets:
+  - {name: UIService, provides: [UI], bundles: [{name: io, priority: system, resources: [{service: Pilot, access: shared}]}]}
+  - {name: Battery, bundles: [{name: d, priority: 250, resources: [{service: Dock}]}]}
+timeline:
+  - {request: Battery/d}
+)",
+      "d.yaml");
+  Scheduler final_state(s.system().model, s.system().options);
+  s.run(&final_state);
+  const std::string dot = to_dot(final_state);
+  EXPECT_THAT(dot, HasSubstr("digraph applets"));
+  EXPECT_THAT(dot, HasSubstr("UIService (service applet)"));
+  EXPECT_THAT(
+      dot,
+      HasSubstr(
+          R"("b:Battery/d" [shape=box, style=filled, fillcolor=palegreen, label="d\nprio 250\nactive"])"));
+  EXPECT_THAT(dot, HasSubstr(R"(label="io\nprio system\nidle")"));
+  EXPECT_THAT(dot, HasSubstr(R"("s:Dock" -> "s:Pilot" [style=dashed, label="needs exclusive"])"));
+  EXPECT_THAT(dot, HasSubstr(R"(label="UI\n(exclusive only)\nblocked")"));
+  EXPECT_THAT(dot, HasSubstr(R"("b:Battery/d" -> "s:Dock" [color=red)"));
+}
+
+}  // namespace
+}  // namespace oscar::applets

@@ -1,0 +1,196 @@
+#include "oscar/applets/scheduler.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+namespace oscar::applets {
+namespace {
+
+using std::chrono::milliseconds;
+using ::testing::HasSubstr;
+constexpr auto kX = Access::kExclusive;
+
+template <typename F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "no exception";
+}
+
+struct TwoApplets {
+  Model m;
+  ServiceId svc = m.add_service("S");
+  BundleId low = m.add_bundle(m.add_applet("Low"), "s", {{svc, kX}}, kPriorityNormal);
+  BundleId high = m.add_bundle(m.add_applet("High"), "s", {{svc, kX}}, kPriorityHigh);
+};
+
+TEST(Scheduler, InvalidDeadlinesNameTheInequality) {
+  TwoApplets t;
+  Scheduler s(t.m, SchedulerOptions{milliseconds{50}});
+  EXPECT_THAT(
+      error_of([&] {
+        s.set_deadline(t.low, Deadline{milliseconds{0}, milliseconds{960}, milliseconds{1000}});
+      }),
+      HasSubstr("(eq. 4.9)"));
+  s.advance_to(milliseconds{500});
+  EXPECT_THAT(
+      error_of([&] {
+        s.set_deadline(t.low, Deadline{milliseconds{0}, milliseconds{460}, milliseconds{1000}});
+      }),
+      HasSubstr("now + t_duration + c <= t_finish (eq. 4.10)"));
+  EXPECT_THAT(error_of([&] { s.advance_to(milliseconds{100}); }), HasSubstr("time only advances"));
+}
+
+TEST(Scheduler, SameExclusiveServiceInTwoRequestedBundlesOfOneAppletIsRejected) {
+  Model m;
+  const ServiceId ui = m.add_service("UI", true);
+  const ServiceId pilot = m.add_service("Pilot");
+  const AppletId a = m.add_applet("Battery");
+  const BundleId b1 = m.add_bundle(a, "warn", {{ui, kX}});
+  const BundleId b2 = m.add_bundle(a, "dock", {{ui, kX}, {pilot, kX}});
+  Scheduler s(m);
+  s.request(b1);
+  EXPECT_THAT(error_of([&] { s.request(b2); }),
+              HasSubstr("bundle 'dock' with service 'UI' which its requested bundle 'warn'"));
+  s.release(b1);
+  s.request(b2);
+  EXPECT_TRUE(s.requested(b2));
+}
+
+TEST(Scheduler, TriggerOfAnUnrequestedBundleIsRejected) {
+  TwoApplets t;
+  Scheduler s(t.m);
+  EXPECT_THAT(error_of([&] { s.trigger(t.low); }), HasSubstr("request it first"));
+}
+
+TEST(Scheduler, RevocationWaitsForYieldThenHandsOver) {
+  TwoApplets t;
+  Scheduler s(t.m);
+  s.request(t.low);
+  EXPECT_TRUE(s.active(t.low));
+  s.take_notifications();
+  s.request(t.high);
+  EXPECT_TRUE(s.plan().bundle_granted[t.high]);
+  EXPECT_FALSE(s.active(t.high));  // Low still uses it
+  auto notes = s.take_notifications();
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_EQ(notes[0].kind, Notification::Kind::kRevokeRequested);
+  EXPECT_EQ(notes[0].new_holders, std::vector<AppletId>{t.m.bundle(t.high).applet});
+  s.yield(t.low);
+  EXPECT_TRUE(s.active(t.high));
+  EXPECT_FALSE(s.active(t.low));
+  s.release(t.high);
+  EXPECT_TRUE(s.active(t.low));  // still requested: granted again
+}
+
+TEST(Scheduler, RevokesByForceAfterTheWaitLimit) {
+  TwoApplets t;
+  Scheduler s(t.m, SchedulerOptions{milliseconds{0}, milliseconds{5000}});
+  s.request(t.low);
+  s.request(t.high);
+  s.advance_to(milliseconds{4999});
+  EXPECT_TRUE(s.active(t.low));
+  s.take_notifications();
+  s.advance_to(milliseconds{5000});
+  EXPECT_FALSE(s.active(t.low));
+  EXPECT_TRUE(s.active(t.high));
+  auto notes = s.take_notifications();
+  ASSERT_GE(notes.size(), 2u);
+  EXPECT_EQ(notes[0].kind, Notification::Kind::kRevokedByForce);
+  EXPECT_EQ(notes[1].kind, Notification::Kind::kGranted);
+}
+
+TEST(Scheduler, NegotiationExtendsTheWaitWithinTheRoundLimit) {
+  TwoApplets t;
+  SchedulerOptions o;
+  o.revoke_wait = milliseconds{1000};
+  o.negotiation_round_max = milliseconds{20000};
+  o.negotiation_rounds_max = 2;
+  Scheduler s(t.m, o);
+  s.request(t.low);
+  s.request(t.high);
+  auto n = s.negotiate(t.low, Negotiation{milliseconds{3000}, milliseconds{8000}, true});
+  EXPECT_EQ(n.kind, Notification::Kind::kNegotiationAccepted);
+  EXPECT_EQ(n.until, milliseconds{8000});
+  n = s.negotiate(t.low, Negotiation{milliseconds{0}, milliseconds{0}, false});
+  EXPECT_EQ(n.kind, Notification::Kind::kNegotiationRejected);
+  n = s.negotiate(t.low, Negotiation{milliseconds{100}, milliseconds{100}, true});
+  EXPECT_EQ(n.kind, Notification::Kind::kNegotiationRejected);  // third round > 2
+  s.advance_to(milliseconds{7999});
+  EXPECT_TRUE(s.active(t.low));
+  s.advance_to(milliseconds{8000});
+  EXPECT_TRUE(s.active(t.high));
+}
+
+TEST(Scheduler, NegotiationCannotPassTheRoundLimitOrANewHoldersDeadline) {
+  TwoApplets t;
+  Scheduler s(t.m);
+  s.request(t.low);
+  s.request(t.high);
+  s.set_deadline(t.high, Deadline{milliseconds{0}, milliseconds{1000}, milliseconds{3000}});
+  auto n = s.negotiate(t.low, Negotiation{milliseconds{1500}, milliseconds{25000}, true});
+  EXPECT_EQ(n.kind, Notification::Kind::kNegotiationAccepted);
+  EXPECT_EQ(n.until, milliseconds{5000});  // min 1500 fits the deadline; the wait is longer
+  n = s.negotiate(t.low, Negotiation{milliseconds{2500}, milliseconds{2500}, true});
+  EXPECT_EQ(n.kind, Notification::Kind::kNegotiationRejected);  // latest start is 2000 ms
+}
+
+TEST(Scheduler, PlanTakenBackCancelsTheRevocation) {
+  TwoApplets t;
+  Scheduler s(t.m);
+  s.request(t.low);
+  s.request(t.high);
+  EXPECT_TRUE(s.revoke_deadline(t.low).has_value());
+  s.release(t.high);
+  EXPECT_FALSE(s.revoke_deadline(t.low).has_value());
+  EXPECT_TRUE(s.active(t.low));
+}
+
+TEST(Scheduler, ServiceAppletGetsItsInheritedBundleHandedOver) {
+  Model m;
+  const ServiceId monitor = m.add_service("Monitor", true);
+  const ServiceId ui = m.add_service("UI", true);
+  const AppletId provider = m.add_applet("UIService");
+  m.provide(provider, ui);
+  const BundleId io = m.add_bundle(provider, "io", {{monitor, kX}});
+  const BundleId menu = m.add_bundle(m.add_applet("Menu"), "ui", {{ui, kX}});
+  Scheduler s(m);
+  s.request(menu);  // the service applet never asked: inheritance grants its bundle
+  EXPECT_FALSE(s.requested(io));
+  EXPECT_TRUE(s.active(io));
+  bool told = false;
+  for (const Notification& n : s.take_notifications()) {
+    told = told || (n.kind == Notification::Kind::kGranted && n.bundle == io);
+  }
+  EXPECT_TRUE(told);
+  s.release(menu);
+  EXPECT_TRUE(s.revoke_deadline(io).has_value());  // given back like any other bundle
+  s.yield(io);
+  EXPECT_FALSE(s.active(io));
+}
+
+TEST(Scheduler, CrashReleasesOnlyTheCrashedAppletsBundles) {
+  Model m;
+  const ServiceId a = m.add_service("A");
+  const ServiceId b = m.add_service("B");
+  const AppletId bad = m.add_applet("Bad");
+  const BundleId ba = m.add_bundle(bad, "a", {{a, kX}});
+  const BundleId good = m.add_bundle(m.add_applet("Good"), "b", {{b, kX}});
+  const BundleId waiting = m.add_bundle(m.add_applet("Waiting"), "a", {{a, kX}});
+  Scheduler s(m);
+  s.request(ba);
+  s.request(good);
+  s.request(waiting);
+  EXPECT_EQ(s.holder(a), "Bad");
+  s.crash(bad);
+  EXPECT_EQ(s.holder(a), "Waiting");
+  EXPECT_TRUE(s.active(waiting));
+  EXPECT_TRUE(s.active(good));
+  EXPECT_FALSE(s.requested(ba));
+}
+
+}  // namespace
+}  // namespace oscar::applets

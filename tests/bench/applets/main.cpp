@@ -1,0 +1,204 @@
+// oscar-bench-applets [--json] [--duration-s S] [--reassignments N] [--max-resources N]
+// 1. The stress test of seed 000 §5.2.2: applets in threads do random things (request, trigger,
+//    use, release, change priority) until N reassignments happened or S seconds passed; prints
+//    the waiting time for a resource and the scheduling overhead beyond the applets' own cycles.
+// 2. The time of one plan (calculateAssignments) for 10 ... 100 000 resources.
+// A benchmark, not a test: it prints figures and never fails on time.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <numeric>
+#include <random>
+
+#include "oscar/applets/runtime.hpp"
+
+using namespace oscar::applets;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+struct Summary {
+  double avg = 0, p99 = 0, max = 0;
+};
+
+Summary summarize(std::vector<double> v) {
+  Summary s;
+  if (v.empty()) return s;
+  std::sort(v.begin(), v.end());
+  s.avg = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+  s.p99 = v[std::min(v.size() - 1, static_cast<std::size_t>(0.99 * static_cast<double>(v.size())))];
+  s.max = v.back();
+  return s;
+}
+
+struct StressResult {
+  std::uint64_t reassignments = 0;
+  Summary wait, overhead;
+  double seconds = 0;
+  int applets = 0, services = 0;
+};
+
+StressResult stress(unsigned seed, double max_seconds, std::uint64_t target, int applets,
+                    int services, int period_ms) {
+  Model m;
+  std::mt19937 rng(seed);
+  for (int s = 0; s < services; ++s) m.add_service("S" + std::to_string(s), s % 3 == 0);
+  m.add_dependency(1, 2);  // a second-degree conflict, as the docking controller and pilot
+  for (int a = 0; a < applets; ++a) {
+    const AppletId id = m.add_applet("A" + std::to_string(a));
+    const auto s1 = static_cast<ServiceId>(rng() % services);
+    auto s2 = static_cast<ServiceId>(rng() % services);
+    if (s2 == s1) s2 = (s2 + 1) % services;
+    auto access = [&](ServiceId s) {
+      return m.service(s).exclusive_only || rng() % 2 ? Access::kExclusive : Access::kShared;
+    };
+    m.add_bundle(id, "one", {{s1, access(s1)}}, kPriorityLow + 100 * static_cast<int>(rng() % 3));
+    m.add_bundle(id, "two", {{s1, access(s1)}, {s2, access(s2)}}, kPriorityNormal);
+  }
+  SchedulerOptions o;
+  o.revoke_wait = std::chrono::milliseconds{500};
+  Runtime rt(m, o);
+  std::atomic<bool> done{false};
+  for (int a = 0; a < applets; ++a) {
+    AppletCode code;
+    auto r = std::make_shared<std::mt19937>(seed * 1000 + a);
+    auto current = std::make_shared<std::string>();
+    // Cycle times like the seed's applets: 100 ms and more, scaled down to get enough events.
+    code.period = std::chrono::milliseconds{period_ms + static_cast<int>((*r)() % (2 * period_ms))};
+    code.step = [r, current, &done](AppletContext& ctx) {
+      if (done) return;
+      const unsigned dice = (*r)() % 10;
+      if (current->empty()) {
+        if (dice < 6) {
+          *current = dice < 3 ? "one" : "two";
+          try {
+            ctx.request(*current);
+            if (dice == 0) ctx.trigger(*current);
+          } catch (const std::invalid_argument&) {
+            current->clear();
+          }
+        }
+        return;
+      }
+      if (dice < 6) {
+        ctx.use(*current, [] {});  // blocks until granted: the waiting the seed measured
+      } else if (dice < 8) {
+        ctx.release(*current);
+        current->clear();
+      } else {
+        ctx.set_priority(*current, kPriorityLow + 100 * static_cast<int>((*r)() % 3));
+      }
+    };
+    rt.set_code("A" + std::to_string(a), std::move(code));
+  }
+  const auto t0 = Clock::now();
+  rt.start();
+  while (rt.stats().grants < target &&
+         std::chrono::duration<double>(Clock::now() - t0).count() < max_seconds) {
+    std::this_thread::sleep_for(std::chrono::milliseconds{50});
+  }
+  done = true;
+  rt.stop();
+  const RuntimeStats st = rt.stats();
+  StressResult res;
+  res.reassignments = st.grants;
+  res.wait = summarize(st.wait_ms);
+  res.overhead = summarize(st.overhead_ms);
+  res.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  res.applets = applets;
+  res.services = services;
+  return res;
+}
+
+// One plan over n single-resource bundles, with configured dependencies and service applets.
+double plan_us(int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  Model m;
+  const int services = std::max(2, n / 4);
+  for (int s = 0; s < services; ++s) m.add_service("S" + std::to_string(s));
+  for (int s = 1; s < services; ++s) {
+    if (rng() % 5 == 0) m.add_dependency(s, static_cast<ServiceId>(rng() % s), Access::kShared);
+  }
+  std::vector<BundleState> state;
+  for (int a = 0; a < n; ++a) {
+    const AppletId id = m.add_applet("A" + std::to_string(a));
+    const auto s = static_cast<ServiceId>(rng() % services);
+    const auto provided = static_cast<ServiceId>(rng() % services);
+    if (rng() % 20 == 0 && !m.service(provided).provider) m.provide(id, provided);
+    m.add_bundle(id, "b", {{s, rng() % 4 == 0 ? Access::kExclusive : Access::kShared}},
+                 kPriorityLow + 10 * static_cast<int>(rng() % 30));
+    state.push_back(BundleState{true, m.bundles().back().priority, false, std::nullopt});
+  }
+  (void)m.needs(0);  // static analysis done once, outside the timing (seed §4.5.3)
+  Plan previous = calculate_assignments(m, state, {}, {});
+  std::vector<double> times;
+  const int reps = std::clamp(200000 / n, 3, 200);
+  for (int k = 0; k < reps; ++k) {
+    state[rng() % n].priority = kPriorityLow + 10 * static_cast<int>(rng() % 30);  // a change
+    const auto t0 = Clock::now();
+    Plan p = calculate_assignments(m, state, previous.order, previous.bundle_granted);
+    times.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
+    previous = std::move(p);
+  }
+  std::sort(times.begin(), times.end());
+  return times[times.size() / 2];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Applet scheduler benchmark (seed 000 §5.2.2 stress test, plan scaling)"};
+  bool json = false;
+  double duration_s = 90;
+  std::uint64_t target = 5000;
+  int max_resources = 100000;
+  int applets = 24, services = 6;
+  int period_ms = 10;
+  unsigned seed = 1;
+  app.add_flag("--json", json, "Print JSON");
+  app.add_option("--duration-s", duration_s, "Longest stress-test time in seconds");
+  app.add_option("--reassignments", target, "Stop the stress test after this many");
+  app.add_option("--max-resources", max_resources, "Largest plan size (10, 100, ... up to it)");
+  app.add_option("--applets", applets, "Applets in the stress test");
+  app.add_option("--services", services, "Services in the stress test (>= 3)");
+  app.add_option("--seed", seed, "Random seed");
+  app.add_option("--period-ms", period_ms, "Shortest applet cycle; cycles are 1-3 times it");
+  CLI11_PARSE(app, argc, argv);
+  if (services < 3 || applets < 2 || period_ms < 1) {
+    std::cerr << "oscar bench applets: needs --services >= 3, --applets >= 2, --period-ms >= 1\n";
+    return 2;
+  }
+  const StressResult s = stress(seed, duration_s, target, applets, services, period_ms);
+  std::map<int, double> plans;
+  for (int n = 10; n <= max_resources; n *= 10) plans[n] = plan_us(n, seed);
+  if (json) {
+    nlohmann::ordered_json j;
+    j["reassignments"] = s.reassignments;
+    j["wait_ms_avg"] = s.wait.avg;
+    j["wait_ms_max"] = s.wait.max;
+    j["overhead_ms_avg"] = s.overhead.avg;
+    j["overhead_ms_p99"] = s.overhead.p99;
+    j["overhead_ms_max"] = s.overhead.max;
+    j["stress_seconds"] = s.seconds;
+    nlohmann::ordered_json p;
+    for (auto [n, us] : plans) p[std::to_string(n)] = us;
+    j["plan_us"] = p;
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+  std::printf("stress test (seed 000 §5.2.2): %d applets, %d services, cycles %d-%d ms, %.1f s\n",
+              s.applets, s.services, period_ms, 3 * period_ms - 1, s.seconds);
+  std::printf("  reassignments        %llu\n", static_cast<unsigned long long>(s.reassignments));
+  std::printf("  wait ms     avg %8.2f  max %8.2f\n", s.wait.avg, s.wait.max);
+  std::printf("  overhead ms avg %8.3f  p99 %8.3f  max %8.3f\n", s.overhead.avg, s.overhead.p99,
+              s.overhead.max);
+  std::printf("one plan (median):\n  %10s  %12s  %10s\n", "resources", "plan_us", "us/res");
+  for (auto [n, us] : plans) std::printf("  %10d  %12.1f  %10.3f\n", n, us, us / n);
+  return 0;
+}
