@@ -1,6 +1,7 @@
 // oscar bench cueflow: seed 004 Abb. 8 (cue transfer time of Bool, LineSeg3DSeq with 100 lines
 // and a 768x576 GvImage) for the multi-core and local constellations, against raw Fast DDS with
 // the same type, QoS and transport, measured in the same run. Prints a table, or JSON (--json).
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -33,6 +34,24 @@ struct Latency {
   double p50 = 0, p90 = 0, max = 0;
   long samples = 0;
 };
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
+
+// The median of each figure over repeated runs.
+Latency median_of(const std::vector<Latency>& runs) {
+  std::vector<double> p50, p90, max;
+  long samples = 0;
+  for (const auto& r : runs) {
+    p50.push_back(r.p50);
+    p90.push_back(r.p90);
+    max.push_back(r.max);
+    samples += r.samples;
+  }
+  return {median(p50), median(p90), median(max), samples};
+}
 
 std::string bin(const std::string& name) {
   return (std::filesystem::read_symlink("/proc/self/exe").parent_path() / name).string();
@@ -126,13 +145,15 @@ class Bench {
 int main(int argc, char** argv) {
   CLI::App app{"oscar bench cueflow: one-way cue latency, OSCAR vs raw Fast DDS (seed 004 Abb. 8)"};
   bool json = false;
-  int count = 1000, warmup = 50, domain = 90;
+  int count = 1000, warmup = 50, domain = 90, repeat = 3;
   std::vector<std::string> types{"Bool", "LineSeg3DSeq", "GvImage"};
   std::vector<std::string> constellations{"multicore", "local"};
   app.add_flag("--json", json, "print JSON instead of a table");
   app.add_option("--count", count, "measured cues per row (after the warm-up)")->check(CLI::PositiveNumber);
   app.add_option("--warmup", warmup, "cues left out at the start of each row");
   app.add_option("--domain", domain, "DDS domain for the run");
+  app.add_option("--repeat", repeat, "runs per row, OSCAR and raw alternating; medians reported")
+      ->check(CLI::PositiveNumber);
   app.add_option("--types", types, "rows to run")->delimiter(',');
   app.add_option("--constellations", constellations, "multicore, local")->delimiter(',');
   CLI11_PARSE(app, argc, argv);
@@ -151,24 +172,34 @@ int main(int argc, char** argv) {
     if (std::find(types.begin(), types.end(), r.type) == types.end()) continue;
     for (const auto& c : constellations) {
       const bool multicore = c == "multicore";
-      std::cerr << fmt::format("bench cueflow: {} {} ({} cues)...\n", r.type, c, count);
-      const auto ours = bench.framework(r, multicore);
-      const auto raw = bench.raw(r, multicore);
-      if (!ours || !raw) {
-        std::cerr << fmt::format("bench cueflow: {} {}: no report from {} (logs in {})\n", r.type,
-                                 c, ours ? "raw Fast DDS" : "OSCAR", dir.string());
-        ++failures;
-        continue;
+      std::vector<Latency> ours_runs, raw_runs;
+      for (int i = 1; i <= repeat; ++i) {
+        std::cerr << fmt::format("bench cueflow: {} {} run {}/{} ({} cues)...\n", r.type, c, i,
+                                 repeat, count);
+        const auto o = bench.framework(r, multicore);
+        const auto w = bench.raw(r, multicore);
+        if (!o || !w) {
+          std::cerr << fmt::format("bench cueflow: {} {}: no report from {} (logs in {})\n",
+                                   r.type, c, o ? "raw Fast DDS" : "OSCAR", dir.string());
+          ++failures;
+          continue;
+        }
+        ours_runs.push_back(*o);
+        raw_runs.push_back(*w);
       }
+      if (ours_runs.empty()) continue;
+      const auto ours = median_of(ours_runs);
+      const auto raw = median_of(raw_runs);
       const double seed = multicore ? r.seed_multicore_us : r.seed_local_us;
-      const double ratio = raw->p50 > 0 ? ours->p50 / raw->p50 : 0;
+      // The ratio of medians: each run's p50 is a median already, runs alternate OSCAR and raw.
+      const double ratio = raw.p50 > 0 ? ours.p50 / raw.p50 : 0;
       rows.push_back({{"type", r.type}, {"bytes", r.bytes}, {"constellation", c},
-                      {"p50_us", ours->p50}, {"p90_us", ours->p90}, {"max_us", ours->max},
-                      {"raw_p50_us", raw->p50}, {"raw_p90_us", raw->p90}, {"raw_max_us", raw->max},
-                      {"ratio", ratio}, {"samples", ours->samples}, {"seed_us", seed}});
+                      {"p50_us", ours.p50}, {"p90_us", ours.p90}, {"max_us", ours.max},
+                      {"raw_p50_us", raw.p50}, {"raw_p90_us", raw.p90}, {"raw_max_us", raw.max},
+                      {"ratio", ratio}, {"samples", ours.samples}, {"runs", ours_runs.size()}, {"seed_us", seed}});
       if (!json) {
         std::cout << fmt::format("{:<13} {:>7} {:<10} {:>9.1f} {:>9.1f} {:>9.1f} {:>10.1f} {:>7.2f} {:>10.0f}\n",
-                                 r.type, r.bytes, c, ours->p50, ours->p90, ours->max, raw->p50,
+                                 r.type, r.bytes, c, ours.p50, ours.p90, ours.max, raw.p50,
                                  ratio, seed)
                   << std::flush;
       }
