@@ -12,6 +12,7 @@ function(oscar_add_module)
   add_library(${objects} OBJECT ${A_SOURCES})
   target_link_libraries(${objects} PUBLIC oscar::framework ${A_LIBS})
   target_include_directories(${objects} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR})
+  set_target_properties(${objects} PROPERTIES POSITION_INDEPENDENT_CODE ON)  # for the plugin
   if(A_IDL)
     oscar_generate_idl(${objects} IDL ${A_IDL} SUBDIR ${A_NAME})
   endif()

@@ -117,6 +117,24 @@ std::vector<std::string> plugin_search_path() {
   return path;
 }
 
+std::vector<std::string> available_kernel_types(const std::vector<std::string>& search_path) {
+  auto types = kernel_type_names();
+  const std::string prefix = "liboscar_kernel_", suffix = ".so";
+  for (const auto& dir : search_path) {
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+      const auto name = e.path().filename().string();
+      if (name.size() > prefix.size() + suffix.size() && name.starts_with(prefix) &&
+          name.ends_with(suffix)) {
+        types.push_back(name.substr(prefix.size(), name.size() - prefix.size() - suffix.size()));
+      }
+    }
+  }
+  std::sort(types.begin(), types.end());
+  types.erase(std::unique(types.begin(), types.end()), types.end());
+  return types;
+}
+
 std::vector<std::string> load_plugin(const std::string& path) {
   const auto before = kernel_type_names();
   // RTLD_GLOBAL: kernels of one module may share cue types defined in another plugin.

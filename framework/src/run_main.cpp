@@ -85,7 +85,7 @@ int run_main(int argc, char** argv) {
     register_standard_cue_types();
     for (const auto& p : plugins) load_plugin(p);
     if (list) {
-      for (const auto& t : kernel_type_names()) std::cout << t << "\n";
+      for (const auto& t : available_kernel_types(plugin_search_path())) std::cout << t << "\n";
       return 0;
     }
     if (modules) {

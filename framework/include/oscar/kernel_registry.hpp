@@ -31,6 +31,10 @@ std::vector<std::string> plugin_search_path();
 const KernelTypeInfo& load_kernel_type(const std::string& type,
                                        const std::vector<std::string>& search_path);
 
+/// Every kernel type that can be had: those registered, and those whose plugin
+/// (`liboscar_kernel_<type>.so`) lies on the search path. Sorted, without duplicates.
+std::vector<std::string> available_kernel_types(const std::vector<std::string>& search_path);
+
 /// Loads one plugin file and returns the kernel types it registered.
 /// @throws std::runtime_error with the loader's message if it cannot be loaded.
 std::vector<std::string> load_plugin(const std::string& path);

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Proves find_package(oscar): installs this build into a temporary prefix, builds the module in
+# tests/out_of_tree/module against it, runs its unit test, and loads its plugin with the
+# installed oscar-run.
+set -euo pipefail
+build_dir="$1"
+here="$(cd "$(dirname "$0")" && pwd)"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+cmake --install "$build_dir" --prefix "$work/prefix" >/dev/null
+cmake -S "$here/module" -B "$work/build" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" \
+  -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$work/build" -j2 >/dev/null
+ctest --test-dir "$work/build" --output-on-failure
+types="$(OSCAR_PLUGIN_PATH="$work/build/lib/oscar/plugins" \
+  LD_LIBRARY_PATH="$work/prefix/lib" "$work/prefix/bin/oscar-run" --list-types)"
+echo "installed oscar-run loads: $(echo $types)"
+echo "$types" | grep -qx blinker || { echo "the out-of-tree plugin was not loaded"; exit 1; }
+"$work/build/bin/oscar-module-blinker" --name b -k blinker:b --check
