@@ -12,6 +12,7 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "dds_log_sink.hpp"
 #include "module_dds.hpp"
 #include "module_slot.hpp"
 #include "ring_pull_source.hpp"
@@ -29,12 +30,16 @@ std::string source_channel(const std::string& source) {
 
 Module::Module(ModuleSpec spec, const std::vector<std::string>& plugin_path)
     : spec_(std::move(spec)) {
-  log_ = spdlog::get(spec_.name);
-  if (!log_) {
-    log_ = std::make_shared<spdlog::logger>(
-        spec_.name, std::make_shared<spdlog::sinks::stdout_color_sink_mt>());
-    log_->set_pattern("%H:%M:%S.%e %^%-5l%$ [%n] %v");
-  }
+  // Every line goes to stdout and, once the module is on DDS, to oscar/log.
+  log_sink_ = std::make_shared<internal::DdsLogSink>(spec_.name);
+  const spdlog::sinks_init_list sinks{std::make_shared<spdlog::sinks::stdout_color_sink_mt>(),
+                                      log_sink_};
+  const auto make_logger = [&](const std::string& name) {
+    auto logger = std::make_shared<spdlog::logger>(name, sinks);
+    logger->set_pattern("%H:%M:%S.%e %^%-5l%$ [%n] %v");
+    return logger;
+  };
+  log_ = make_logger(spec_.name);
   for (const auto& k : spec_.kernels) {
     const auto& type = [&]() -> const KernelTypeInfo& {
       try {
@@ -53,7 +58,8 @@ Module::Module(ModuleSpec spec, const std::vector<std::string>& plugin_path)
     auto slot = std::make_unique<Slot>();
     slot->spec = &k;
     try {
-      slot->instance = std::make_unique<KernelInstance>(type, k.name, k.params, options, log_);
+      slot->instance = std::make_unique<KernelInstance>(type, k.name, k.params, options,
+                                                        make_logger(spec_.name + "/" + k.name));
       // Declared defaults stand unless the YAML set depth/transfer explicitly.
       for (const auto& [input, wiring] : k.inputs) {
         auto* port = slot->instance->ports().find_input(input);

@@ -1,5 +1,7 @@
 #include "module_dds.hpp"
 
+#include "dds_log_sink.hpp"
+
 #include <unistd.h>
 
 #include <chrono>
@@ -119,6 +121,7 @@ Module::Dds::Dds(Module& module, int domain)
     : module_(module), participant_(domain, "oscar:" + module.spec_.name, module.spec_.network) {}
 
 Module::Dds::~Dds() {
+  module_.log_sink_->attach(nullptr);
   stop_config();
   {
     std::lock_guard lock(readers_mutex_);
@@ -210,7 +213,13 @@ void Module::Dds::start_config() {
   config_reader_ = participant_.subscriber().create_datareader(
       &participant_.topic("oscar/config/" + name, new ConfigCommandPubSubType()), config_qos,
       config_listener_.get(), dds::StatusMask::data_available());
-  if (!state_writer_ || !reply_writer_ || !config_reader_) {
+  dds::DataWriterQos log_qos = dds::DATAWRITER_QOS_DEFAULT;
+  log_qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  log_qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  log_qos.history().depth = 100;
+  log_writer_ = participant_.publisher().create_datawriter(
+      &participant_.topic("oscar/log", new LogRecordPubSubType()), log_qos);
+  if (!state_writer_ || !reply_writer_ || !config_reader_ || !log_writer_) {
     throw std::runtime_error("cannot create the configuration endpoints of module " + name);
   }
   {
@@ -218,6 +227,7 @@ void Module::Dds::start_config() {
     serving_ = true;
   }
   config_thread_ = std::thread([this] { serve_config(); });
+  module_.log_sink_->attach(log_writer_);
 }
 
 // Commands are applied on their own thread, never inside a DDS callback: a rewire creates and

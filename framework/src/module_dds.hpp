@@ -55,6 +55,7 @@ class Module::Dds {
 
   eprosima::fastdds::dds::DataWriter* state_writer_ = nullptr;
   eprosima::fastdds::dds::DataWriter* reply_writer_ = nullptr;
+  eprosima::fastdds::dds::DataWriter* log_writer_ = nullptr;
   eprosima::fastdds::dds::DataReader* config_reader_ = nullptr;
   std::unique_ptr<ConfigListener> config_listener_;
   std::mutex queue_mutex_;

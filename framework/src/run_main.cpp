@@ -102,7 +102,8 @@ int run_main(int argc, char** argv) {
     if (stub) spec.stub = true;
     Module module(std::move(spec), plugin_search_path());
     if (check) {
-      for (const auto& k : module.state().kernels()) {
+      const auto state = module.state();  // kept: a range-for would not extend its life
+      for (const auto& k : state.kernels()) {
         std::cout << k.name() << " (" << k.type() << "): " << k.mode() << "\n";
       }
       return 0;

@@ -16,4 +16,6 @@ types="$(OSCAR_PLUGIN_PATH="$work/build/lib/oscar/plugins" \
   LD_LIBRARY_PATH="$work/prefix/lib" "$work/prefix/bin/oscar-run" --list-types)"
 echo "installed oscar-run loads: $(echo $types)"
 echo "$types" | grep -qx blinker || { echo "the out-of-tree plugin was not loaded"; exit 1; }
-"$work/build/bin/oscar-module-blinker" --name b -k blinker:b --check
+check="$("$work/build/bin/oscar-module-blinker" --name b -k blinker:b -m continuous:10ms --check)"
+echo "stand-alone runner: $check"
+[ "$check" = "b (blinker): continuous" ] || { echo "unexpected --check output"; exit 1; }

@@ -20,6 +20,9 @@
 namespace oscar {
 
 class DdsParticipant;
+namespace internal {
+class DdsLogSink;
+}
 
 class Module {
  public:
@@ -65,7 +68,8 @@ class Module {
 
   ModuleSpec spec_;
   std::vector<std::unique_ptr<Slot>> slots_;
-  std::shared_ptr<spdlog::logger> log_;
+  std::shared_ptr<spdlog::logger> log_;  // the frame's; each kernel logs as "<module>/<kernel>"
+  std::shared_ptr<internal::DdsLogSink> log_sink_;
 
   mutable std::mutex mutex_;
   std::condition_variable wake_;
