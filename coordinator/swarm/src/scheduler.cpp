@@ -49,6 +49,8 @@ Scheduler::Scheduler(World world, SchedulerSettings settings)
 }
 
 Scheduler::~Scheduler() = default;
+Scheduler::Scheduler(Scheduler&&) noexcept = default;
+Scheduler& Scheduler::operator=(Scheduler&&) noexcept = default;
 
 Scheduler::NodeState& Scheduler::state(const std::string& id) {
   for (auto& n : nodes_) {
@@ -79,7 +81,7 @@ const std::vector<Job>& Scheduler::jobs(const std::string& node, bool committed)
   return committed ? n.committed_jobs : n.working_jobs;
 }
 
-const SpatialPathFinder& Scheduler::finder(const NodeState& n) {
+const SpatialPathFinder& Scheduler::finder(const NodeState& n) const {
   auto& f = finders_[n.spec.radius_m];
   if (!f) {
     std::vector<Polygon> grown;

@@ -31,9 +31,9 @@ std::optional<double> next_free_start(const std::vector<std::pair<double, double
 
 }  // namespace
 
-bool Scheduler::try_candidate(const Candidate& c, const JobSpec& spec, TransactionId tx,
+bool Scheduler::try_candidate(const Slot& c, const JobSpec& spec, TransactionId tx,
                               Job& scheduled) {
-  NodeState& n = *c.node;
+  NodeState& n = state(c.node);
   const double v = n.spec.max_speed_mps;
   const double t_min = std::max(spec.earliest_start, frozen_horizon_time());
   const double t_max = spec.latest_finish - spec.duration;  // latest start
@@ -92,31 +92,8 @@ bool Scheduler::try_schedule(const JobSpec& spec, TransactionId tx, const std::o
   bool any_location = false;
   bool any_slot = false;
   for (const auto& p : locations) {
-    std::vector<Candidate> candidates;
-    for (auto& node : nodes_) {
-      NodeState& n = *node;
-      if (!finder(n).is_free(p)) continue;
-      any_location = true;
-      const double v = n.spec.max_speed_mps;
-      for (std::size_t k = 0; k <= n.working_jobs.size(); ++k) {
-        const double t1 = k == 0 ? n.spec.t : n.working_jobs[k - 1].end();
-        const double t2 = k < n.working_jobs.size() ? n.working_jobs[k].start : kForever;
-        if (t2 <= t_fh) continue;
-        const double t1p = std::max(t1, t_fh);
-        const Point from = n.working.position_at(t1p);
-        const double s1 = distance(from, p);
-        const double s2 = k < n.working_jobs.size() ? distance(p, n.working_jobs[k].location()) : 0;
-        if (t_max - t1p < s1 / v) continue;                              // eq. 4.2
-        if (t2 - t_min < s2 / v + spec.duration) continue;               // eq. 4.3
-        if (t2 - t1p < (s1 + s2) / v + spec.duration) continue;          // eq. 4.4
-        if (locked_by_other(n, tx, t1p, t2)) continue;                   // §4.2.7
-        const double s12 =
-            k < n.working_jobs.size() ? distance(from, n.working_jobs[k].location()) : 0;
-        candidates.push_back({&n, k, t1p, t2, from, p, s1 + s2 - s12});  // eq. 4.5
-      }
-    }
-    std::stable_sort(candidates.begin(), candidates.end(),
-                     [](const Candidate& a, const Candidate& b) { return a.detour < b.detour; });
+    const auto candidates = qualifying_slots(spec, p, tx);
+    for (const auto& node : nodes_) any_location = any_location || finder(*node).is_free(p);
     any_slot = any_slot || !candidates.empty();
     for (const auto& c : candidates) {
       if (try_candidate(c, spec, tx, scheduled)) return true;
@@ -130,6 +107,37 @@ bool Scheduler::try_schedule(const JobSpec& spec, TransactionId tx, const std::o
     reason = fmt::format("job '{}': no collision-free trajectory for any location and slot", spec.id);
   }
   return false;
+}
+
+std::vector<Slot> Scheduler::qualifying_slots(const JobSpec& spec, const Point& p,
+                                              TransactionId tx) const {
+  const double t_fh = frozen_horizon_time();
+  const double t_min = std::max(spec.earliest_start, t_fh);  // t'_min of §4.2.1
+  const double t_max = spec.latest_finish - spec.duration;
+  std::vector<Slot> candidates;
+  for (const auto& node : nodes_) {
+    const NodeState& n = *node;
+    if (!finder(n).is_free(p)) continue;
+    const double v = n.spec.max_speed_mps;
+    for (std::size_t k = 0; k <= n.working_jobs.size(); ++k) {
+      const double t1 = k == 0 ? n.spec.t : n.working_jobs[k - 1].end();
+      const double t2 = k < n.working_jobs.size() ? n.working_jobs[k].start : kForever;
+      if (t2 <= t_fh) continue;
+      const double t1p = std::max(t1, t_fh);
+      const Point from = n.working.position_at(t1p);
+      const double s1 = distance(from, p);
+      const double s2 = k < n.working_jobs.size() ? distance(p, n.working_jobs[k].location()) : 0;
+      if (t_max - t1p < s1 / v) continue;                      // eq. 4.2
+      if (t2 - t_min < s2 / v + spec.duration) continue;       // eq. 4.3
+      if (t2 - t1p < (s1 + s2) / v + spec.duration) continue;  // eq. 4.4
+      if (locked_by_other(n, tx, t1p, t2)) continue;           // §4.2.7
+      const double s12 = k < n.working_jobs.size() ? distance(from, n.working_jobs[k].location()) : 0;
+      candidates.push_back({n.spec.id, k, t1p, t2, from, p, s1 + s2 - s12});  // eq. 4.5
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Slot& a, const Slot& b) { return a.detour < b.detour; });
+  return candidates;
 }
 
 ScheduleResult Scheduler::schedule(const JobSpec& spec) {

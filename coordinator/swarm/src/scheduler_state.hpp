@@ -28,15 +28,6 @@ struct Scheduler::Change {
   std::vector<Job> removed;
 };
 
-// A slot (pause) of a node that satisfies conditions 4.2–4.4 for a location.
-struct Scheduler::Candidate {
-  NodeState* node = nullptr;
-  std::size_t index = 0;  // the job after the pause (== jobs.size() for the open end)
-  double t1 = 0, t2 = 0;  // pause, t1 already moved to the frozen horizon
-  Point from, at;
-  double detour = 0;      // eq. 4.5
-};
-
 // Precision limit of seed §5.3.1: doubles keep ~0.1 ns resolution up to this many seconds.
 inline constexpr double kMaxAbsTime = 1e6;
 

@@ -41,6 +41,17 @@ struct DependentSpec {
   std::map<std::string, std::vector<std::string>> depends;
 };
 
+/// An idle slot (pause) of a node that meets conditions 4.2–4.4 for a location (seed §4.2.1).
+struct Slot {
+  std::string node;
+  std::size_t index = 0;  ///< position of the new job in the node's job list
+  double t1 = 0;          ///< pause start, moved to the frozen horizon if earlier
+  double t2 = 0;          ///< pause end (kForever after the last job)
+  Point from;             ///< where the node is at t1
+  Point at;               ///< the job location
+  double detour = 0;      ///< Δs of eq. 4.5 (s1 + s2 - s12)
+};
+
 /// Schedules jobs onto nodes and plans their trajectories (seed ch. 4): location sampling, idle
 /// slots by conditions 4.2–4.4, least detour first (4.5), path-velocity decomposition (§4.3),
 /// periodic (A.2) and dependent (A.3) sets atomically, and transactions (§4.2.7) whose alternative
@@ -51,6 +62,8 @@ class Scheduler {
   /// @throws std::invalid_argument on non-finite or out-of-range settings.
   Scheduler(World world, SchedulerSettings settings);
   ~Scheduler();
+  Scheduler(Scheduler&&) noexcept;
+  Scheduler& operator=(Scheduler&&) noexcept;
 
   /// Adds a node idle at its start (seed §5.2 addNode).
   /// @throws std::invalid_argument on a duplicate id, bad numbers, or a start inside an obstacle
@@ -83,6 +96,10 @@ class Scheduler {
   /// The open transactions, oldest first.
   std::vector<TransactionId> open_transactions() const;
 
+  /// The slots of all nodes meeting conditions 4.2–4.4 for `spec` at `at`, least detour first
+  /// (eq. 4.5), excluding slots locked by transactions other than `tx` (§4.2.7).
+  std::vector<Slot> qualifying_slots(const JobSpec& spec, const Point& at, TransactionId tx = 0) const;
+
   /// Moves the present forward (§4.2.1).
   /// @throws std::invalid_argument if t is before the present or not finite.
   void set_present(double t);
@@ -102,19 +119,18 @@ class Scheduler {
 
  private:
   struct NodeState;
-  struct Candidate;
   struct Change;
   NodeState& state(const std::string& id);
   const NodeState& state(const std::string& id) const;
   TransactionId open_transaction();
   bool try_schedule(const JobSpec& spec, TransactionId tx, const std::optional<Point>& at,
                     std::string& reason, Job& scheduled);
-  bool try_candidate(const Candidate& c, const JobSpec& spec, TransactionId tx, Job& scheduled);
+  bool try_candidate(const Slot& c, const JobSpec& spec, TransactionId tx, Job& scheduled);
   bool try_unschedule(const std::string& job_id, TransactionId tx, bool replan, std::string& reason);
   bool locked_by_other(const NodeState& n, TransactionId tx, double lo, double hi) const;
   void record(TransactionId tx, NodeState& n, double lo, double hi);
   std::vector<Point> sample_locations(const Polygon& area);
-  const SpatialPathFinder& finder(const NodeState& n);
+  const SpatialPathFinder& finder(const NodeState& n) const;
   std::vector<MovingObstacle> obstacles_for(const NodeState& n) const;
   void validate(const JobSpec& spec, bool allow_existing) const;
   bool job_exists(const std::string& id) const;
@@ -123,7 +139,7 @@ class Scheduler {
   World world_;
   SchedulerSettings settings_;
   std::vector<std::unique_ptr<NodeState>> nodes_;
-  std::map<double, std::unique_ptr<SpatialPathFinder>> finders_;  // by node radius
+  mutable std::map<double, std::unique_ptr<SpatialPathFinder>> finders_;  // by node radius
   std::map<TransactionId, std::map<std::string, Change>> transactions_;
   TransactionId next_transaction_ = 1;
   unsigned sample_counter_ = 0;
