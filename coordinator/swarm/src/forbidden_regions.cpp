@@ -31,6 +31,12 @@ void clip_into(const std::vector<Point>& ring, double s0, double s1, double t0, 
   }
 }
 
+// Tiles are clipped a little beyond their path segment. Clipping exactly at s_i would leave the
+// line s = s_i on the boundary of two adjacent pieces, and a node waiting at a path vertex (a
+// vertical s-t edge along that line) would slip through an obstacle unseen, since boundaries are
+// passable. The overlap is conservative: it can only forbid a sliver more.
+constexpr double kTileOverlap = 1e-5;
+
 Point sub(const Point& a, const Point& b) { return Point(a.x() - b.x(), a.y() - b.y()); }
 double norm(const Point& a) { return std::hypot(a.x(), a.y()); }
 
@@ -115,7 +121,7 @@ ForbiddenRegions compute_forbidden_regions(const std::vector<Point>& path,
           const Eigen::Vector2d st = inv * Eigen::Vector2d(p.x() - path[i].x(), p.y() - path[i].y());
           ring.emplace_back(s0 + st.x(), seg.t0 + st.y());
         }
-        clip_into(ring, s0, s1, seg.t0, seg.t1, result.regions);
+        clip_into(ring, s0 - kTileOverlap, s1 + kTileOverlap, seg.t0, seg.t1, result.regions);
       } else {
         // Parallel case (eq. 4.19/4.20): the cut of the line g at t_j, shifted by (v·e_s)(t - t_j).
         const double w = seg.v.x() * e.x() + seg.v.y() * e.y();
@@ -125,7 +131,7 @@ ForbiddenRegions compute_forbidden_regions(const std::vector<Point>& path,
           const std::vector<Point> ring{Point(s0 + a, seg.t0), Point(s0 + b, seg.t0),
                                         Point(s0 + b + w * dt, seg.t1),
                                         Point(s0 + a + w * dt, seg.t1)};
-          clip_into(ring, s0, s1, seg.t0, seg.t1, result.regions);
+          clip_into(ring, s0 - kTileOverlap, s1 + kTileOverlap, seg.t0, seg.t1, result.regions);
         }
       }
     }

@@ -89,6 +89,20 @@ TEST(ForbiddenRegions, PathSegmentsMakeTiles) {
   EXPECT_TRUE(contains_vertex(r2, 14.5, 4.5));
 }
 
+// Regression (found by the property test, seed 4): a node waiting at the end of its path while an
+// obstacle crosses it must meet the region's interior, not slip along a clipped boundary.
+TEST(ForbiddenRegions, PathEndsAndVerticesLieInsideTheRegionWhenCovered) {
+  const auto r = compute_forbidden_regions(kPath, moving(10, -5, 0, 10, 5, 10), 0, 20);
+  bool end_inside = false;
+  for (const auto& p : r.regions) end_inside = end_inside || strictly_inside({10, 5}, p);
+  EXPECT_TRUE(end_inside);
+  const std::vector<Point> bent{{0, 0}, {5, 0}, {5, 5}};
+  const auto v = compute_forbidden_regions(bent, moving(5, -5, 0, 5, 5, 10), 0, 20);
+  bool vertex_inside = false;
+  for (const auto& p : v.regions) vertex_inside = vertex_inside || strictly_inside({5, 5}, p);
+  EXPECT_TRUE(vertex_inside);
+}
+
 TEST(ForbiddenRegions, StationaryCaseGivesBlockedTimes) {
   EXPECT_EQ(classify_tile({0, 0}, {0, 1}), TileCase::kStationary);
   const auto r = compute_forbidden_regions({{5, 0}}, moving(5, -5, 0, 5, 5, 10), 0, 20);

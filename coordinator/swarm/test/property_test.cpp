@@ -1,6 +1,7 @@
 // Random worlds, random operations, every result checked by the independent checker.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <random>
 #include <stdexcept>
 
@@ -136,6 +137,10 @@ void run_world(unsigned seed, Stats& stats) {
       continue;
     }
     ++stats.attempted;
+    if (std::getenv("SWARM_DEBUG")) {
+      std::printf("op %d pick %.2f ok %d %s\n", op, pick, r.ok, r.reason.c_str());
+      for (const auto& j : r.jobs) std::printf("  %s on %s at (%g,%g) [%g,%g]\n", j.id.c_str(), j.node.c_str(), j.x, j.y, j.start, j.end());
+    }
     if (r.ok) {
       ++stats.scheduled;
       for (const auto& j : r.jobs) scheduled_ids.push_back(j.id);
@@ -196,11 +201,23 @@ void run_world(unsigned seed, Stats& stats) {
     }
   }
   for (const auto& v : c.violations) ADD_FAILURE() << "seed " << seed << ": " << v;
+  if (!c.violations.empty() && std::getenv("SWARM_DEBUG")) {
+    for (const auto& b : nodes) {
+      std::printf("%s r=%g:", b.name.c_str(), b.radius);
+      for (const auto& w : b.trajectory) std::printf(" (%g,%g,%g)", w[0], w[1], w[2]);
+      std::printf("\n");
+    }
+    for (const auto& b : dynamics) {
+      std::printf("%s:", b.name.c_str());
+      for (const auto& w : b.trajectory) std::printf(" (%g,%g,%g)", w[0], w[1], w[2]);
+      std::printf(" shape %g\n", b.shape[1][0]);
+    }
+  }
 }
 
 TEST(PropertyTest, RandomWorldsPassTheIndependentChecker) {
   Stats stats;
-  for (unsigned seed = 1; seed <= 60; ++seed) {
+  for (unsigned seed = 1; seed <= 200; ++seed) {
     run_world(seed, stats);
     if (HasFatalFailure()) return;
   }
