@@ -81,6 +81,11 @@ const std::vector<Job>& Scheduler::jobs(const std::string& node, bool committed)
   return committed ? n.committed_jobs : n.working_jobs;
 }
 
+Load Scheduler::load(const std::string& node, double t0, double t1) const {
+  const auto& n = state(node);
+  return compute_load(n.committed, n.committed_jobs, n.spec.max_speed_mps, t0, t1);
+}
+
 const SpatialPathFinder& Scheduler::finder(const NodeState& n) const {
   auto& f = finders_[n.spec.radius_m];
   if (!f) {

@@ -63,6 +63,18 @@ TEST(Scheduler, WorkedExampleOfSection421PicksTheOnlyQualifyingPause) {
   EXPECT_NEAR(at_b.y(), 1, 1e-9);
 }
 
+TEST(Scheduler, LoadFiguresOfTheWorkedExample) {
+  Scheduler s = worked_example();
+  // n2 over [0, 60]: jobs A [10,20] and B [50,55] = 15 s; driving (3,1)->(7,1) at 0.5 m/s = 8 s.
+  const Load l = s.load("n2", 0, 60);
+  EXPECT_NEAR(l.job, 15.0 / 60, 1e-12);
+  EXPECT_NEAR(l.motion, 8.0 / 60, 1e-9);
+  EXPECT_NEAR(l.stationary, 1 - 23.0 / 60, 1e-9);
+  EXPECT_NEAR(l.total, 23.0 / 60, 1e-9);
+  EXPECT_NEAR(l.velocity, 4.0 / (0.5 * 60), 1e-9);
+  EXPECT_THROW(s.load("n2", 5, 5), std::invalid_argument);
+}
+
 TEST(Scheduler, InfeasibleJobIsAValueWithAReason) {
   Scheduler s = worked_example();
   const auto r = s.schedule(job("J1", square(4, 2, 6, 4), 10, 21, 10));  // nobody gets there

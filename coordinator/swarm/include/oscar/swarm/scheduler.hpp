@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "oscar/swarm/job.hpp"
+#include "oscar/swarm/load.hpp"
 #include "oscar/swarm/schedule_result.hpp"
 #include "oscar/swarm/spatial_path_finder.hpp"
 #include "oscar/swarm/trajectory.hpp"
@@ -114,6 +115,9 @@ class Scheduler {
   const Trajectory& trajectory(const std::string& node, bool committed = true) const;
   /// The committed (or working) jobs of a node, by start time.
   const std::vector<Job>& jobs(const std::string& node, bool committed = true) const;
+  /// Load figures of a node's committed schedule over [t0, t1] (seed §4.4).
+  /// @throws std::invalid_argument on an unknown node or an empty interval.
+  Load load(const std::string& node, double t0, double t1) const;
   const World& world() const { return world_; }
   const SchedulerSettings& settings() const { return settings_; }
 
