@@ -69,8 +69,8 @@ std::optional<std::vector<Point>> VelocityPlanner::fixed_arrival(double t_final)
   for (std::size_t i = 0; i < base; ++i) {
     for (std::size_t j = 0; j < base; ++j) {
       if (i == j) continue;
-      const Point& a = nodes[i];
-      const Point& b = nodes[j];
+      const Point a = nodes[i];  // copies: nodes grows below
+      const Point b = nodes[j];
       if (edge_ok(a, b)) boost::add_edge(i, j, cost(a, b) + 1e-9, graph);
       // §4.3.4: wait at s_a, then leave with v_L to reach b exactly.
       if (b.x() - a.x() > kEpsilon) {
