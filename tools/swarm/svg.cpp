@@ -55,29 +55,36 @@ std::string world_svg(const Scheduler& s) {
   for (const auto& id : s.node_ids()) {
     for (const auto& w : s.trajectory(id).points()) f.add(w.x, w.y);
   }
-  std::string out = header("oscar swarm plan: static (grey), moving obstacles (orange, dashed), "
-                           "node paths (colour), jobs (dots)");
-  for (const auto& p : s.world().static_obstacles) out += polygon(f, p, "fill=\"#bbb\" stroke=\"#666\"");
+  std::string out = header(
+      "oscar swarm plan: static (grey), moving obstacles (orange, dashed), "
+      "node paths (colour), jobs (dots)");
+  for (const auto& p : s.world().static_obstacles)
+    out += polygon(f, p, "fill=\"#bbb\" stroke=\"#666\"");
   for (const auto& o : s.world().dynamic_obstacles) {
     const auto& pts = o.trajectory.points();
     out += polygon(f, translate(o.shape, pts.front().x, pts.front().y),
                    "fill=\"#fdb\" stroke=\"#f80\" fill-opacity=\"0.6\"");
     std::string line;
     for (const auto& w : pts) line += fmt::format("{:.2f},{:.2f} ", f.sx(w.x), f.sy(w.y));
-    out += fmt::format("<polyline points=\"{}\" fill=\"none\" stroke=\"#f80\" stroke-dasharray=\"5,4\"/>\n", line);
+    out += fmt::format(
+        "<polyline points=\"{}\" fill=\"none\" stroke=\"#f80\" stroke-dasharray=\"5,4\"/>\n", line);
   }
   std::size_t k = 0;
   for (const auto& id : s.node_ids()) {
     const char* colour = kColours[k++ % kColours.size()];
     std::string line;
-    for (const auto& w : s.trajectory(id).points()) line += fmt::format("{:.2f},{:.2f} ", f.sx(w.x), f.sy(w.y));
-    out += fmt::format("<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"2\"/>\n", line, colour);
+    for (const auto& w : s.trajectory(id).points())
+      line += fmt::format("{:.2f},{:.2f} ", f.sx(w.x), f.sy(w.y));
+    out += fmt::format("<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"2\"/>\n",
+                       line, colour);
     const auto& start = s.trajectory(id).points().front();
     out += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\" fill=\"{}\">{}</text>\n", f.sx(start.x) + 4,
                        f.sy(start.y) - 4, colour, id);
     for (const auto& j : s.jobs(id)) {
-      out += fmt::format("<circle cx=\"{:.2f}\" cy=\"{:.2f}\" r=\"4\" fill=\"{}\"/>\n", f.sx(j.x), f.sy(j.y), colour);
-      out += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\">{} @{:.1f}</text>\n", f.sx(j.x) + 5, f.sy(j.y) + 12, j.id, j.start);
+      out += fmt::format("<circle cx=\"{:.2f}\" cy=\"{:.2f}\" r=\"4\" fill=\"{}\"/>\n", f.sx(j.x),
+                         f.sy(j.y), colour);
+      out += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\">{} @{:.1f}</text>\n", f.sx(j.x) + 5,
+                         f.sy(j.y) + 12, j.id, j.start);
     }
   }
   return out + "</svg>\n";
@@ -97,7 +104,8 @@ std::string st_svg(const Scheduler& s, const std::string& node) {
   }
   const double t_end = std::max(traj.end_time(), traj.start_time() + 1);
   std::vector<MovingObstacle> obstacles;
-  for (const auto& o : s.world().dynamic_obstacles) obstacles.push_back({inflate(o.shape, spec.radius_m), o.trajectory});
+  for (const auto& o : s.world().dynamic_obstacles)
+    obstacles.push_back({inflate(o.shape, spec.radius_m), o.trajectory});
   for (const auto& id : s.node_ids()) {
     if (id == node) continue;
     Trajectory t = s.trajectory(id);
@@ -108,7 +116,8 @@ std::string st_svg(const Scheduler& s, const std::string& node) {
   std::vector<Polygon> regions;
   if (path.size() >= 2) {
     for (const auto& o : obstacles) {
-      for (auto& r : compute_forbidden_regions(path, o, traj.start_time(), t_end).regions) regions.push_back(r);
+      for (auto& r : compute_forbidden_regions(path, o, traj.start_time(), t_end).regions)
+        regions.push_back(r);
     }
   }
   Frame f;
@@ -119,8 +128,10 @@ std::string st_svg(const Scheduler& s, const std::string& node) {
   const double ky = 760.0 / std::max(f.y1 - f.y0, 1e-9);
   auto X = [&](double v) { return 20 + (v - f.x0) * kx; };
   auto Y = [&](double v) { return 780 - (v - f.y0) * ky; };
-  std::string out = header(fmt::format("s-t diagram of {}: s 0..{:.2f} m (right), t {:.1f}..{:.1f} s (up); "
-                                       "forbidden regions grey, profile red", node, arc, f.y0, f.y1));
+  std::string out =
+      header(fmt::format("s-t diagram of {}: s 0..{:.2f} m (right), t {:.1f}..{:.1f} s (up); "
+                         "forbidden regions grey, profile red",
+                         node, arc, f.y0, f.y1));
   for (const auto& r : regions) {
     std::string pts;
     for (const auto& v : vertices(r)) pts += fmt::format("{:.2f},{:.2f} ", X(v.x()), Y(v.y()));
@@ -128,7 +139,8 @@ std::string st_svg(const Scheduler& s, const std::string& node) {
   }
   std::string line;
   for (const auto& p : profile) line += fmt::format("{:.2f},{:.2f} ", X(p.x()), Y(p.y()));
-  out += fmt::format("<polyline points=\"{}\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\"/>\n", line);
+  out += fmt::format(
+      "<polyline points=\"{}\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\"/>\n", line);
   return out + "</svg>\n";
 }
 

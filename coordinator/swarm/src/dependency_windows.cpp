@@ -1,9 +1,9 @@
 #include "oscar/swarm/dependency_windows.hpp"
 
+#include <fmt/format.h>
 #include <algorithm>
 #include <boost/graph/adjacency_list.hpp>
 #include <boost/graph/topological_sort.hpp>
-#include <fmt/format.h>
 #include <stdexcept>
 
 namespace oscar::swarm {
@@ -23,7 +23,8 @@ std::map<std::string, int> index_of(const std::vector<JobSpec>& jobs) {
 }  // namespace
 
 std::vector<std::string> topological_order(
-    const std::vector<JobSpec>& jobs, const std::map<std::string, std::vector<std::string>>& depends) {
+    const std::vector<JobSpec>& jobs,
+    const std::map<std::string, std::vector<std::string>>& depends) {
   const auto index = index_of(jobs);
   using Graph = boost::adjacency_list<boost::vecS, boost::vecS, boost::directedS>;
   Graph graph(jobs.size());
@@ -53,8 +54,9 @@ std::vector<std::string> topological_order(
 }
 
 std::map<std::string, ImplicitWindow> implicit_windows(
-    const std::vector<JobSpec>& jobs, const std::map<std::string, std::vector<std::string>>& depends,
-    double margin, const std::map<std::string, double>& fixed) {
+    const std::vector<JobSpec>& jobs,
+    const std::map<std::string, std::vector<std::string>>& depends, double margin,
+    const std::map<std::string, double>& fixed) {
   const auto order = topological_order(jobs, depends);
   const auto index = index_of(jobs);
   std::map<std::string, double> t_min, t_max, alpha, beta;

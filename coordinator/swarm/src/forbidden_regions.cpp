@@ -118,7 +118,8 @@ ForbiddenRegions compute_forbidden_regions(const std::vector<Point>& path,
         const Eigen::Matrix2d inv = a.inverse();
         std::vector<Point> ring;
         for (const auto& p : vertices(o)) {
-          const Eigen::Vector2d st = inv * Eigen::Vector2d(p.x() - path[i].x(), p.y() - path[i].y());
+          const Eigen::Vector2d st =
+              inv * Eigen::Vector2d(p.x() - path[i].x(), p.y() - path[i].y());
           ring.emplace_back(s0 + st.x(), seg.t0 + st.y());
         }
         clip_into(ring, s0 - kTileOverlap, s1 + kTileOverlap, seg.t0, seg.t1, result.regions);

@@ -1,9 +1,9 @@
 #include "oscar/swarm/geometry.hpp"
 
+#include <fmt/format.h>
 #include <algorithm>
 #include <boost/geometry.hpp>
 #include <cmath>
-#include <fmt/format.h>
 #include <stdexcept>
 
 namespace oscar::swarm {
@@ -111,8 +111,10 @@ bool segment_hits_interior(const Point& a, const Point& b, const Polygon& polygo
   if (d.x() == 0 && d.y() == 0) return strictly_inside(a, polygon);
   // Cheap rejection by bounding boxes.
   const auto box = bg::return_envelope<bg::model::box<Point>>(polygon);
-  if (std::max(a.x(), b.x()) < box.min_corner().x() || std::min(a.x(), b.x()) > box.max_corner().x() ||
-      std::max(a.y(), b.y()) < box.min_corner().y() || std::min(a.y(), b.y()) > box.max_corner().y()) {
+  if (std::max(a.x(), b.x()) < box.min_corner().x() ||
+      std::min(a.x(), b.x()) > box.max_corner().x() ||
+      std::max(a.y(), b.y()) < box.min_corner().y() ||
+      std::min(a.y(), b.y()) > box.max_corner().y()) {
     return false;
   }
   std::vector<double> u{0.0, 1.0};

@@ -1,8 +1,8 @@
 #include "oscar/swarm/load.hpp"
 
+#include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
-#include <fmt/format.h>
 #include <stdexcept>
 
 namespace oscar::swarm {
@@ -10,7 +10,8 @@ namespace oscar::swarm {
 Load compute_load(const Trajectory& trajectory, const std::vector<Job>& jobs, double max_speed,
                   double t0, double t1) {
   if (!std::isfinite(t0) || !std::isfinite(t1) || t0 >= t1) {
-    throw std::invalid_argument(fmt::format("load: need a finite interval t0 < t1, got [{}, {}]", t0, t1));
+    throw std::invalid_argument(
+        fmt::format("load: need a finite interval t0 < t1, got [{}, {}]", t0, t1));
   }
   if (!(max_speed > 0)) throw std::invalid_argument("load: max_speed must be > 0");
   const double dur = t1 - t0;

@@ -2,8 +2,8 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <cmath>
 #include <fmt/format.h>
+#include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -40,7 +40,8 @@ class Parser {
   double time(const YAML::Node& node, const std::string& what) const {
     const double t = number(node, what);
     if (std::abs(t) > 1e6) {
-      fail(node, fmt::format("{} = {}: times must lie within ±1e6 s (precision, seed §5.3.1)", what, t));
+      fail(node,
+           fmt::format("{} = {}: times must lie within ±1e6 s (precision, seed §5.3.1)", what, t));
     }
     return t;
   }
@@ -54,7 +55,8 @@ class Parser {
   }
 
   std::string text(const YAML::Node& node, const std::string& what) const {
-    if (!node.IsScalar() || node.Scalar().empty()) fail(node, what + ": expected a non-empty string");
+    if (!node.IsScalar() || node.Scalar().empty())
+      fail(node, what + ": expected a non-empty string");
     return node.Scalar();
   }
 
@@ -102,8 +104,8 @@ Problem parse_problem(const std::string& text, const std::string& source) {
   try {
     root = YAML::Load(text);
   } catch (const YAML::ParserException& e) {
-    throw std::invalid_argument(
-        fmt::format("{}:{}:{}: not valid YAML/JSON: {}", source, e.mark.line + 1, e.mark.column + 1, e.msg));
+    throw std::invalid_argument(fmt::format("{}:{}:{}: not valid YAML/JSON: {}", source,
+                                            e.mark.line + 1, e.mark.column + 1, e.msg));
   }
   if (!root.IsMap()) throw std::invalid_argument(source + ": expected a mapping at the top");
   Problem problem;
@@ -111,7 +113,8 @@ Problem parse_problem(const std::string& text, const std::string& source) {
   if (const auto world = root["world"]) {
     if (const auto st = world["static"]) {
       for (std::size_t i = 0; i < st.size(); ++i) {
-        problem.world.static_obstacles.push_back(p.polygon(st[i], fmt::format("world.static[{}]", i)));
+        problem.world.static_obstacles.push_back(
+            p.polygon(st[i], fmt::format("world.static[{}]", i)));
       }
     }
     if (const auto dyn = world["dynamic"]) {
@@ -120,12 +123,15 @@ Problem parse_problem(const std::string& text, const std::string& source) {
         MovingObstacle o;
         o.shape = p.polygon(p.required(dyn[i], "shape", what), what + " shape");
         const auto traj = p.required(dyn[i], "trajectory", what);
-        if (!traj.IsSequence() || traj.size() == 0) p.fail(traj, what + " trajectory: expected [[x, y, t], ...]");
+        if (!traj.IsSequence() || traj.size() == 0)
+          p.fail(traj, what + " trajectory: expected [[x, y, t], ...]");
         std::vector<Waypoint> w;
         for (const auto& q : traj) {
           if (!q.IsSequence() || q.size() != 3) p.fail(q, what + " trajectory: expected [x, y, t]");
-          w.push_back({p.number(q[0], what + " x"), p.number(q[1], what + " y"), p.time(q[2], what + " t")});
-          if (w.size() > 1 && w.back().t < w[w.size() - 2].t) p.fail(q, what + " trajectory: times must not decrease");
+          w.push_back({p.number(q[0], what + " x"), p.number(q[1], what + " y"),
+                       p.time(q[2], what + " t")});
+          if (w.size() > 1 && w.back().t < w[w.size() - 2].t)
+            p.fail(q, what + " trajectory: times must not decrease");
         }
         o.trajectory = Trajectory(std::move(w));
         problem.world.dynamic_obstacles.push_back(std::move(o));
@@ -144,25 +150,34 @@ Problem parse_problem(const std::string& text, const std::string& source) {
     if (s.radius_m < 0) p.fail(n["radius"], what + " radius: must be >= 0");
     if (s.max_speed_mps <= 0) p.fail(n["max_speed"], what + " max_speed: must be > 0");
     const auto start = p.required(n, "start", what);
-    if (!start.IsSequence() || start.size() != 3) p.fail(start, what + " start: expected [x, y, t]");
+    if (!start.IsSequence() || start.size() != 3)
+      p.fail(start, what + " start: expected [x, y, t]");
     s.x = p.number(start[0], what + " start x");
     s.y = p.number(start[1], what + " start y");
     s.t = p.time(start[2], what + " start t");
-    if (n["turning_radius"]) s.turning_radius_m = p.number(n["turning_radius"], what + " turning_radius");
+    if (n["turning_radius"])
+      s.turning_radius_m = p.number(n["turning_radius"], what + " turning_radius");
     if (s.turning_radius_m < 0) p.fail(n["turning_radius"], what + " turning_radius: must be >= 0");
     problem.nodes.push_back(s);
   }
   if (const auto st = root["settings"]) {
     auto& s = problem.settings;
     if (st["present"]) s.present = p.time(st["present"], "settings.present");
-    if (st["frozen_horizon"]) s.frozen_horizon = p.number(st["frozen_horizon"], "settings.frozen_horizon");
-    if (st["dependency_margin"]) s.dependency_margin = p.number(st["dependency_margin"], "settings.dependency_margin");
-    if (st["wait_threshold"]) s.wait_threshold = p.number(st["wait_threshold"], "settings.wait_threshold");
-    if (st["location_samples"]) s.location_samples = static_cast<int>(p.number(st["location_samples"], "settings.location_samples"));
+    if (st["frozen_horizon"])
+      s.frozen_horizon = p.number(st["frozen_horizon"], "settings.frozen_horizon");
+    if (st["dependency_margin"])
+      s.dependency_margin = p.number(st["dependency_margin"], "settings.dependency_margin");
+    if (st["wait_threshold"])
+      s.wait_threshold = p.number(st["wait_threshold"], "settings.wait_threshold");
+    if (st["location_samples"])
+      s.location_samples =
+          static_cast<int>(p.number(st["location_samples"], "settings.location_samples"));
     if (s.frozen_horizon < 0) p.fail(st["frozen_horizon"], "settings.frozen_horizon: must be >= 0");
-    if (s.dependency_margin < 0) p.fail(st["dependency_margin"], "settings.dependency_margin: must be >= 0");
+    if (s.dependency_margin < 0)
+      p.fail(st["dependency_margin"], "settings.dependency_margin: must be >= 0");
     if (s.wait_threshold < 0) p.fail(st["wait_threshold"], "settings.wait_threshold: must be >= 0");
-    if (s.location_samples < 1) p.fail(st["location_samples"], "settings.location_samples: must be >= 1");
+    if (s.location_samples < 1)
+      p.fail(st["location_samples"], "settings.location_samples: must be >= 1");
   }
   std::set<std::string> known_jobs;
   double present = problem.settings.present;
@@ -188,7 +203,8 @@ Problem parse_problem(const std::string& text, const std::string& source) {
         op.kind = K::kPeriodic;
         auto& ps = op.periodic;
         const auto ids = p.required(o, "ids", op.name);
-        if (!ids.IsSequence() || ids.size() == 0) p.fail(ids, "schedule_periodic ids: expected a non-empty list");
+        if (!ids.IsSequence() || ids.size() == 0)
+          p.fail(ids, "schedule_periodic ids: expected a non-empty list");
         for (const auto& id : ids) {
           ps.ids.push_back(p.text(id, "schedule_periodic id"));
           add_job_id(id, ps.ids.back());
@@ -222,28 +238,33 @@ Problem parse_problem(const std::string& text, const std::string& source) {
       } else if (op.name == "unschedule" || op.name == "remove") {
         op.kind = op.name == "unschedule" ? K::kUnschedule : K::kRemove;
         op.id = p.text(p.required(o, "id", op.name), op.name + " id");
-        if (!known_jobs.count(op.id)) p.fail(o, fmt::format("{}: unknown job id '{}'", op.name, op.id));
+        if (!known_jobs.count(op.id))
+          p.fail(o, fmt::format("{}: unknown job id '{}'", op.name, op.id));
       } else if (op.name == "commit" || op.name == "abort") {
         op.kind = op.name == "commit" ? K::kCommit : K::kAbort;
         if (o["transaction"]) {
           const double t = p.number(o["transaction"], op.name + " transaction");
-          if (t < 1 || t != std::floor(t)) p.fail(o["transaction"], op.name + " transaction: expected a positive integer");
+          if (t < 1 || t != std::floor(t))
+            p.fail(o["transaction"], op.name + " transaction: expected a positive integer");
           op.transaction = static_cast<TransactionId>(t);
         }
         if (o["node"]) {
           op.node = p.text(o["node"], op.name + " node");
-          if (!node_ids.count(op.node)) p.fail(o["node"], fmt::format("{}: unknown node id '{}'", op.name, op.node));
+          if (!node_ids.count(op.node))
+            p.fail(o["node"], fmt::format("{}: unknown node id '{}'", op.name, op.node));
         }
       } else if (op.name == "set_present") {
         op.kind = K::kSetPresent;
         op.t = p.time(p.required(o, "t", op.name), "set_present t");
         if (op.t < present) {
-          p.fail(o, fmt::format("set_present: present time must not go backwards ({} < {})", op.t, present));
+          p.fail(o, fmt::format("set_present: present time must not go backwards ({} < {})", op.t,
+                                present));
         }
         present = op.t;
       } else {
         p.fail(o, fmt::format("unknown op '{}' (schedule, schedule_periodic, schedule_dependent, "
-                              "unschedule, remove, reschedule, commit, abort, set_present)", op.name));
+                              "unschedule, remove, reschedule, commit, abort, set_present)",
+                              op.name));
       }
       problem.operations.push_back(std::move(op));
     }

@@ -21,12 +21,24 @@ void ProblemRunner::run() {
       ScheduleResult r;
       bool result_op = true;
       switch (op.kind) {
-        case K::kSchedule: r = scheduler_.schedule(op.job); break;
-        case K::kPeriodic: r = scheduler_.schedule(op.periodic); break;
-        case K::kDependent: r = scheduler_.schedule(op.dependent); break;
-        case K::kUnschedule: r = scheduler_.unschedule(op.id); break;
-        case K::kRemove: r = scheduler_.remove_job(op.id); break;
-        case K::kReschedule: r = scheduler_.reschedule(op.job); break;
+        case K::kSchedule:
+          r = scheduler_.schedule(op.job);
+          break;
+        case K::kPeriodic:
+          r = scheduler_.schedule(op.periodic);
+          break;
+        case K::kDependent:
+          r = scheduler_.schedule(op.dependent);
+          break;
+        case K::kUnschedule:
+          r = scheduler_.unschedule(op.id);
+          break;
+        case K::kRemove:
+          r = scheduler_.remove_job(op.id);
+          break;
+        case K::kReschedule:
+          r = scheduler_.reschedule(op.job);
+          break;
         case K::kCommit:
         case K::kAbort: {
           result_op = false;
@@ -82,8 +94,8 @@ nlohmann::json trajectory_json(const Trajectory& t) {
 }
 
 nlohmann::json job_json(const Job& j) {
-  return {{"id", j.id}, {"node", j.node}, {"x", j.x}, {"y", j.y}, {"start", j.start},
-          {"duration", j.duration}};
+  return {{"id", j.id}, {"node", j.node},   {"x", j.x},
+          {"y", j.y},   {"start", j.start}, {"duration", j.duration}};
 }
 
 }  // namespace
@@ -107,13 +119,16 @@ std::string ProblemRunner::to_json(int indent) const {
   for (const auto& id : scheduler_.node_ids()) {
     const auto& n = scheduler_.node(id);
     for (const auto& j : scheduler_.jobs(id)) doc["jobs"].push_back(job_json(j));
-    doc["nodes"].push_back({{"id", id}, {"radius", n.radius_m}, {"max_speed", n.max_speed_mps},
+    doc["nodes"].push_back({{"id", id},
+                            {"radius", n.radius_m},
+                            {"max_speed", n.max_speed_mps},
                             {"trajectory", trajectory_json(scheduler_.trajectory(id))}});
   }
   if (!scheduler_.open_transactions().empty()) {
     // Open transactions: the working view (all open transactions applied), per node.
     for (const auto& id : scheduler_.node_ids()) {
-      nlohmann::json n{{"node", id}, {"trajectory", trajectory_json(scheduler_.trajectory(id, false))}};
+      nlohmann::json n{{"node", id},
+                       {"trajectory", trajectory_json(scheduler_.trajectory(id, false))}};
       n["jobs"] = nlohmann::json::array();
       for (const auto& j : scheduler_.jobs(id, false)) n["jobs"].push_back(job_json(j));
       doc["open"].push_back(n);
@@ -123,7 +138,8 @@ std::string ProblemRunner::to_json(int indent) const {
   nlohmann::json world{{"static", nlohmann::json::array()}, {"dynamic", nlohmann::json::array()}};
   for (const auto& p : problem_.world.static_obstacles) world["static"].push_back(polygon_json(p));
   for (const auto& o : problem_.world.dynamic_obstacles) {
-    world["dynamic"].push_back({{"shape", polygon_json(o.shape)}, {"trajectory", trajectory_json(o.trajectory)}});
+    world["dynamic"].push_back(
+        {{"shape", polygon_json(o.shape)}, {"trajectory", trajectory_json(o.trajectory)}});
   }
   doc["world"] = world;
   return doc.dump(indent);

@@ -1,13 +1,14 @@
 #include "oscar/swarm/scheduler.hpp"
 
+#include <fmt/format.h>
 #include <algorithm>
 #include <boost/geometry.hpp>
 #include <boost/geometry/algorithms/point_on_surface.hpp>
 #include <cmath>
-#include <fmt/format.h>
 #include <random>
 #include <stdexcept>
 
+#include "oscar/swarm/dubins_path_finder.hpp"
 #include "oscar/swarm/trajectory_planner.hpp"
 #include "scheduler_state.hpp"
 
@@ -18,9 +19,10 @@ namespace bg = boost::geometry;
 void check_time(double t, const std::string& what) {
   if (!std::isfinite(t)) throw std::invalid_argument(fmt::format("{} must be finite", what));
   if (std::abs(t) > kMaxAbsTime) {
-    throw std::invalid_argument(fmt::format(
-        "{} = {} is beyond ±{} s, where times in double lose sub-nanosecond precision (seed §5.3.1)",
-        what, t, kMaxAbsTime));
+    throw std::invalid_argument(
+        fmt::format("{} = {} is beyond ±{} s, where times in double lose sub-nanosecond precision "
+                    "(seed §5.3.1)",
+                    what, t, kMaxAbsTime));
   }
 }
 
@@ -28,7 +30,8 @@ Scheduler::Scheduler(World world, SchedulerSettings settings)
     : world_(std::move(world)), settings_(settings) {
   check_time(settings_.present, "settings.present");
   check_time(settings_.frozen_horizon, "settings.frozen_horizon");
-  if (settings_.frozen_horizon < 0) throw std::invalid_argument("settings.frozen_horizon must be >= 0");
+  if (settings_.frozen_horizon < 0)
+    throw std::invalid_argument("settings.frozen_horizon must be >= 0");
   if (!std::isfinite(settings_.dependency_margin) || settings_.dependency_margin < 0) {
     throw std::invalid_argument("settings.dependency_margin must be finite and >= 0");
   }
@@ -91,10 +94,29 @@ const SpatialPathFinder& Scheduler::finder(const NodeState& n) const {
   if (!f) {
     std::vector<Polygon> grown;
     // A hair more than the radius so that driving along an inflated edge keeps the distance.
-    for (const auto& p : world_.static_obstacles) grown.push_back(inflate(p, n.spec.radius_m + 1e-6));
+    for (const auto& p : world_.static_obstacles)
+      grown.push_back(inflate(p, n.spec.radius_m + 1e-6));
     f = std::make_unique<SpatialPathFinder>(std::move(grown));
   }
   return *f;
+}
+
+TrajectoryPlanner::PathFunction Scheduler::path_function(const NodeState& n) const {
+  if (n.spec.turning_radius_m <= 0) {
+    const SpatialPathFinder* f = &finder(n);
+    return [f](const Point& a, const Point& b) { return f->find(a, b); };
+  }
+  // A node with a minimum turning radius: OMPL's Dubins planner on the same inflated obstacles.
+  auto& d = dubins_finders_[{n.spec.radius_m, n.spec.turning_radius_m}];
+  if (!d) {
+    std::vector<Polygon> grown;
+    for (const auto& p : world_.static_obstacles)
+      grown.push_back(inflate(p, n.spec.radius_m + 1e-6));
+    d = std::make_unique<DubinsPathFinder>(
+        std::move(grown), DubinsPathFinder::Settings{n.spec.turning_radius_m, 2000, 0.1});
+  }
+  const DubinsPathFinder* f = d.get();
+  return [f](const Point& a, const Point& b) { return f->find(a, b); };
 }
 
 std::vector<MovingObstacle> Scheduler::obstacles_for(const NodeState& n) const {
@@ -143,10 +165,6 @@ void Scheduler::add_node(const NodeSpec& spec) {
   if (!std::isfinite(spec.turning_radius_m) || spec.turning_radius_m < 0) {
     throw std::invalid_argument(what + ": turning_radius must be finite and >= 0");
   }
-  if (spec.turning_radius_m > 0) {
-    throw std::invalid_argument(
-        what + ": turning_radius > 0 needs the OMPL Dubins planner, which is not implemented yet");
-  }
   auto n = std::make_unique<NodeState>();
   n->spec = spec;
   n->committed = Trajectory({{spec.x, spec.y, spec.t}});
@@ -155,7 +173,7 @@ void Scheduler::add_node(const NodeSpec& spec) {
   if (!finder(*n).is_free(p)) {
     throw std::invalid_argument(what + ": start lies within radius of a static obstacle");
   }
-  TrajectoryPlanner planner(finder(*n), obstacles_for(*n), {spec.max_speed_mps, 0, 0});
+  TrajectoryPlanner planner(path_function(*n), obstacles_for(*n), {spec.max_speed_mps, 0, 0});
   if (!planner.blocked_times(p, spec.t, kForever).empty()) {
     throw std::invalid_argument(
         what + ": idling at the start collides with a moving obstacle or another node");
@@ -187,9 +205,9 @@ void Scheduler::validate(const JobSpec& spec, bool allow_existing) const {
     throw std::invalid_argument(what + ": duration must be finite and > 0");
   }
   if (spec.latest_finish - spec.earliest_start < spec.duration) {
-    throw std::invalid_argument(fmt::format(
-        "{}: window [{}, {}] is shorter than the duration {}", what, spec.earliest_start,
-        spec.latest_finish, spec.duration));
+    throw std::invalid_argument(fmt::format("{}: window [{}, {}] is shorter than the duration {}",
+                                            what, spec.earliest_start, spec.latest_finish,
+                                            spec.duration));
   }
 }
 

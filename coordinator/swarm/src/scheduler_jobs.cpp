@@ -1,7 +1,7 @@
 // Single jobs: schedule (seed §4.2.1, A.4), unschedule and remove (§4.2.5), reschedule (§4.2.6).
+#include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
-#include <fmt/format.h>
 
 #include "oscar/swarm/scheduler.hpp"
 #include "oscar/swarm/trajectory_planner.hpp"
@@ -38,7 +38,7 @@ bool Scheduler::try_candidate(const Slot& c, const JobSpec& spec, TransactionId 
   const double t_min = std::max(spec.earliest_start, frozen_horizon_time());
   const double t_max = spec.latest_finish - spec.duration;  // latest start
   const bool has_next = c.index < n.working_jobs.size();
-  TrajectoryPlanner planner(finder(n), obstacles_for(n), {v, 0, settings_.wait_threshold});
+  TrajectoryPlanner planner(path_function(n), obstacles_for(n), {v, 0, settings_.wait_threshold});
   const auto path1 = planner.path(c.from, c.at);
   if (!path1) return false;
   const auto arrival = planner.earliest_arrival(*path1, c.t1, t_max);
@@ -104,7 +104,8 @@ bool Scheduler::try_schedule(const JobSpec& spec, TransactionId tx, const std::o
   } else if (!any_slot) {
     reason = fmt::format("job '{}': no node has an idle slot meeting conditions 4.2-4.4", spec.id);
   } else {
-    reason = fmt::format("job '{}': no collision-free trajectory for any location and slot", spec.id);
+    reason =
+        fmt::format("job '{}': no collision-free trajectory for any location and slot", spec.id);
   }
   return false;
 }
@@ -131,7 +132,8 @@ std::vector<Slot> Scheduler::qualifying_slots(const JobSpec& spec, const Point& 
       if (t2 - t_min < s2 / v + spec.duration) continue;       // eq. 4.3
       if (t2 - t1p < (s1 + s2) / v + spec.duration) continue;  // eq. 4.4
       if (locked_by_other(n, tx, t1p, t2)) continue;           // §4.2.7
-      const double s12 = k < n.working_jobs.size() ? distance(from, n.working_jobs[k].location()) : 0;
+      const double s12 =
+          k < n.working_jobs.size() ? distance(from, n.working_jobs[k].location()) : 0;
       candidates.push_back({n.spec.id, k, t1p, t2, from, p, s1 + s2 - s12});  // eq. 4.5
     }
   }
@@ -160,12 +162,14 @@ bool Scheduler::try_unschedule(const std::string& job_id, TransactionId tx, bool
   for (auto& node : nodes_) {
     NodeState& n = *node;
     auto& list = n.working_jobs;
-    const auto it = std::find_if(list.begin(), list.end(), [&](const Job& j) { return j.id == job_id; });
+    const auto it =
+        std::find_if(list.begin(), list.end(), [&](const Job& j) { return j.id == job_id; });
     if (it == list.end()) continue;
     const std::size_t k = static_cast<std::size_t>(it - list.begin());
     const double t_fh = frozen_horizon_time();
     if (it->start < t_fh) {
-      reason = fmt::format("job '{}' starts at {}, before the frozen horizon {}", job_id, it->start, t_fh);
+      reason = fmt::format("job '{}' starts at {}, before the frozen horizon {}", job_id, it->start,
+                           t_fh);
       return false;
     }
     const double t1 = std::max(k == 0 ? n.spec.t : list[k - 1].end(), t_fh);
@@ -173,11 +177,12 @@ bool Scheduler::try_unschedule(const std::string& job_id, TransactionId tx, bool
     const double lo = replan ? t1 : it->start;
     const double hi = replan ? t2 : it->end();
     if (locked_by_other(n, tx, lo, hi)) {
-      reason = fmt::format("job '{}': its trajectory section is locked by another transaction", job_id);
+      reason =
+          fmt::format("job '{}': its trajectory section is locked by another transaction", job_id);
       return false;
     }
     if (replan) {
-      TrajectoryPlanner planner(finder(n), obstacles_for(n),
+      TrajectoryPlanner planner(path_function(n), obstacles_for(n),
                                 {n.spec.max_speed_mps, 0, settings_.wait_threshold});
       const Point from = n.working.position_at(t1);
       std::optional<Trajectory> section;

@@ -1,7 +1,7 @@
 // Atomic job sets: periodic (seed §4.2.3, A.2) and dependent (§4.2.4, A.3).
+#include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
-#include <fmt/format.h>
 #include <set>
 #include <stdexcept>
 
@@ -16,7 +16,8 @@ ScheduleResult Scheduler::schedule(const PeriodicSpec& spec) {
   check_time(spec.start, "periodic jobs: start");
   if (!std::isfinite(spec.period) || !std::isfinite(spec.duration) || spec.duration <= 0 ||
       spec.period < spec.duration) {
-    throw std::invalid_argument("periodic jobs: need 0 < duration <= period (seed §4.2.3, d_P >= d)");
+    throw std::invalid_argument(
+        "periodic jobs: need 0 < duration <= period (seed §4.2.3, d_P >= d)");
   }
   std::vector<JobSpec> jobs;
   std::set<std::string> seen;
@@ -31,7 +32,8 @@ ScheduleResult Scheduler::schedule(const PeriodicSpec& spec) {
   ScheduleResult result;
   // Same location: one location for all repetitions, tried in turn (A.2); independent: each job
   // samples its own.
-  const auto locations = spec.same_location ? sample_locations(spec.area) : std::vector<Point>{Point()};
+  const auto locations =
+      spec.same_location ? sample_locations(spec.area) : std::vector<Point>{Point()};
   for (const auto& p : locations) {
     const TransactionId tx = open_transaction();
     std::vector<Job> done;
@@ -65,9 +67,8 @@ ScheduleResult Scheduler::schedule(const DependentSpec& spec) {
   for (const auto& j : spec.jobs) {
     const auto& w = windows.at(j.id);
     if (w.earliest_start > w.latest_start) {
-      result.reason = fmt::format(
-          "job '{}': implicit window [{}, {}] is empty (eq. 4.10/4.11)", j.id, w.earliest_start,
-          w.latest_start);
+      result.reason = fmt::format("job '{}': implicit window [{}, {}] is empty (eq. 4.10/4.11)",
+                                  j.id, w.earliest_start, w.latest_start);
       return result;
     }
   }

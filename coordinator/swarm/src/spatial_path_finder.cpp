@@ -42,8 +42,9 @@ std::optional<std::vector<Point>> SpatialPathFinder::find(const Point& from,
                                                           const Point& to) const {
   if (!is_free(from) || !is_free(to)) return std::nullopt;
   if (visible(from, to)) return std::vector<Point>{from, to};
-  using Graph = boost::adjacency_list<boost::vecS, boost::vecS, boost::undirectedS, boost::no_property,
-                                      boost::property<boost::edge_weight_t, double>>;
+  using Graph =
+      boost::adjacency_list<boost::vecS, boost::vecS, boost::undirectedS, boost::no_property,
+                            boost::property<boost::edge_weight_t, double>>;
   const int n = static_cast<int>(corners_.size());
   const int start = n;
   const int goal = n + 1;
@@ -55,8 +56,8 @@ std::optional<std::vector<Point>> SpatialPathFinder::find(const Point& from,
   }
   std::vector<int> predecessor(n + 2);
   std::vector<double> dist(n + 2);
-  boost::dijkstra_shortest_paths(graph, start,
-                                 boost::predecessor_map(predecessor.data()).distance_map(dist.data()));
+  boost::dijkstra_shortest_paths(
+      graph, start, boost::predecessor_map(predecessor.data()).distance_map(dist.data()));
   if (predecessor[goal] == goal) return std::nullopt;
   std::vector<Point> path;
   for (int v = goal; v != start; v = predecessor[v]) {

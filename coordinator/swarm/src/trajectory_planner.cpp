@@ -50,13 +50,13 @@ Box path_box(const std::vector<Point>& path) {
 
 }  // namespace
 
-TrajectoryPlanner::TrajectoryPlanner(const SpatialPathFinder& finder,
-                                     std::vector<MovingObstacle> obstacles,
+TrajectoryPlanner::TrajectoryPlanner(PathFunction path, std::vector<MovingObstacle> obstacles,
                                      VelocityPlanner::Settings settings)
-    : finder_(finder), obstacles_(std::move(obstacles)), settings_(settings) {}
+    : path_(std::move(path)), obstacles_(std::move(obstacles)), settings_(settings) {}
 
-std::optional<std::vector<Point>> TrajectoryPlanner::path(const Point& from, const Point& to) const {
-  return finder_.find(from, to);
+std::optional<std::vector<Point>> TrajectoryPlanner::path(const Point& from,
+                                                          const Point& to) const {
+  return path_(from, to);
 }
 
 std::vector<Polygon> TrajectoryPlanner::regions(const std::vector<Point>& path, double lo,
@@ -72,7 +72,7 @@ std::vector<Polygon> TrajectoryPlanner::regions(const std::vector<Point>& path, 
 }
 
 std::vector<std::pair<double, double>> TrajectoryPlanner::blocked_times(const Point& p, double lo,
-                                                                         double hi) const {
+                                                                        double hi) const {
   std::vector<std::pair<double, double>> result;
   const std::vector<Point> path{p};
   const Box pb = path_box(path);
@@ -106,8 +106,8 @@ std::optional<double> TrajectoryPlanner::earliest_arrival(const std::vector<Poin
   return profile->back().y();
 }
 
-std::optional<Trajectory> TrajectoryPlanner::fixed_arrival(const std::vector<Point>& path, double t0,
-                                                           double t1) const {
+std::optional<Trajectory> TrajectoryPlanner::fixed_arrival(const std::vector<Point>& path,
+                                                           double t0, double t1) const {
   const double length = path_length(path);
   if (length <= kEpsilon) {
     if (overlaps_open(blocked_times(path.front(), t0, t1), t0, t1)) return std::nullopt;

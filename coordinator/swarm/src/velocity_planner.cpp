@@ -46,7 +46,8 @@ std::vector<Point> VelocityPlanner::corners(double t_max) const {
 std::optional<std::vector<Point>> VelocityPlanner::fixed_arrival(double t_final) const {
   const Point start(0, t_start_);
   const Point goal(s_final_, t_final);
-  if (t_final < t_start_ || s_final_ > settings_.v_max * (t_final - t_start_) * (1 + 1e-12) + 1e-12) {
+  if (t_final < t_start_ ||
+      s_final_ > settings_.v_max * (t_final - t_start_) * (1 + 1e-12) + 1e-12) {
     return std::nullopt;
   }
   std::vector<Point> nodes{start, goal};
@@ -59,8 +60,9 @@ std::optional<std::vector<Point>> VelocityPlanner::fixed_arrival(double t_final)
     if (t_final <= t_start_ || free(start, goal)) return std::vector<Point>{start, goal};
     return std::nullopt;
   }
-  using Graph = boost::adjacency_list<boost::vecS, boost::vecS, boost::directedS, boost::no_property,
-                                      boost::property<boost::edge_weight_t, double>>;
+  using Graph =
+      boost::adjacency_list<boost::vecS, boost::vecS, boost::directedS, boost::no_property,
+                            boost::property<boost::edge_weight_t, double>>;
   const std::size_t base = nodes.size();
   Graph graph(base);
   auto cost = [](const Point& a, const Point& b) {
@@ -88,8 +90,8 @@ std::optional<std::vector<Point>> VelocityPlanner::fixed_arrival(double t_final)
   const std::size_t n = boost::num_vertices(graph);
   std::vector<std::size_t> predecessor(n);
   std::vector<double> dist(n);
-  boost::dijkstra_shortest_paths(graph, 0,
-                                 boost::predecessor_map(predecessor.data()).distance_map(dist.data()));
+  boost::dijkstra_shortest_paths(
+      graph, 0, boost::predecessor_map(predecessor.data()).distance_map(dist.data()));
   if (predecessor[1] == 1) return std::nullopt;
   std::vector<Point> path;
   for (std::size_t v = 1; v != 0; v = predecessor[v]) path.push_back(nodes[v]);
@@ -105,7 +107,8 @@ std::optional<std::vector<Point>> VelocityPlanner::earliest_arrival(double t_lat
   }
   std::vector<Point> nodes{start};
   for (const auto& c : corners(t_latest)) nodes.push_back(c);
-  std::sort(nodes.begin() + 1, nodes.end(), [](const Point& a, const Point& b) { return a.y() < b.y(); });
+  std::sort(nodes.begin() + 1, nodes.end(),
+            [](const Point& a, const Point& b) { return a.y() < b.y(); });
   std::vector<char> reached(nodes.size(), 0);
   reached[0] = 1;
   double best = std::numeric_limits<double>::infinity();

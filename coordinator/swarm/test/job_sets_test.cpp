@@ -104,7 +104,7 @@ TEST(Scheduler, IncompletePeriodicOrDependentSetLeavesTheScheduleUnchanged) {
 
 TEST(Transactions, OpenAlternativeTrajectoriesAreObstaclesForOthers) {
   Scheduler s({}, {});
-  s.add_node({"n1", 0.5, 1, 5, 0, 0, 0});   // idles on the spot everyone wants
+  s.add_node({"n1", 0.5, 1, 5, 0, 0, 0});  // idles on the spot everyone wants
   s.add_node({"n2", 0.5, 1, 20, 0, 0, 0});
   // n1 leaves (5,0) in an open transaction; its committed trajectory still stays there.
   const auto away = s.schedule(JobSpec{"Away", square(-1, 9, 1, 11), 0, 100, 5});

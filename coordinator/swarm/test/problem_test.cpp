@@ -53,25 +53,33 @@ TEST(Problem, JsonInputWorksToo) {
 }
 
 TEST(Problem, BadInputNamesFileLineAndRule) {
-  expect_error(kNodes + "operations:\n  - { op: schedule, job: { id: J, area: [[0,0],[1,0],[1,1]], "
-                        "earliest_start: .nan, latest_finish: 60, duration: 10 } }\n",
+  expect_error(kNodes +
+                   "operations:\n  - { op: schedule, job: { id: J, area: [[0,0],[1,0],[1,1]], "
+                   "earliest_start: .nan, latest_finish: 60, duration: 10 } }\n",
                "p.yaml:5:");
-  expect_error(kNodes + "operations:\n  - { op: schedule, job: { id: J, area: [[0,0],[1,0],[1,1]], "
-                        "earliest_start: .nan, latest_finish: 60, duration: 10 } }\n",
+  expect_error(kNodes +
+                   "operations:\n  - { op: schedule, job: { id: J, area: [[0,0],[1,0],[1,1]], "
+                   "earliest_start: .nan, latest_finish: 60, duration: 10 } }\n",
                "must be finite");
-  expect_error(kNodes + "operations:\n  - { op: schedule, job: { id: J, area: [[0,0],[1,1],[1,0],[0,1]], "
-                        "earliest_start: 0, latest_finish: 60, duration: 10 } }\n",
-               "self-intersecting");
-  expect_error(kNodes + "operations:\n  - { op: schedule, job: { id: J, area: [], "
-                        "earliest_start: 0, latest_finish: 60, duration: 10 } }\n",
+  expect_error(
+      kNodes +
+          "operations:\n  - { op: schedule, job: { id: J, area: [[0,0],[1,1],[1,0],[0,1]], "
+          "earliest_start: 0, latest_finish: 60, duration: 10 } }\n",
+      "self-intersecting");
+  expect_error(kNodes +
+                   "operations:\n  - { op: schedule, job: { id: J, area: [], "
+                   "earliest_start: 0, latest_finish: 60, duration: 10 } }\n",
                "at least 3 vertices");
-  expect_error(kNodes + "operations:\n  - { op: schedule, job: { id: J, area: [[0,0],[1,0],[1,1]], "
-                        "earliest_start: 0, latest_finish: 5, duration: 10 } }\n",
+  expect_error(kNodes +
+                   "operations:\n  - { op: schedule, job: { id: J, area: [[0,0],[1,0],[1,1]], "
+                   "earliest_start: 0, latest_finish: 5, duration: 10 } }\n",
                "shorter than the duration");
-  expect_error(kNodes + "operations:\n  - { op: unschedule, id: Q }\n", "p.yaml:5:5: unschedule: unknown job id 'Q'");
+  expect_error(kNodes + "operations:\n  - { op: unschedule, id: Q }\n",
+               "p.yaml:5:5: unschedule: unknown job id 'Q'");
   expect_error(kNodes + "operations:\n  - { op: commit, node: n9 }\n", "unknown node id 'n9'");
-  expect_error(kNodes + "operations:\n  - { op: set_present, t: 5 }\n  - { op: set_present, t: 4 }\n",
-               "p.yaml:6:5: set_present: present time must not go backwards");
+  expect_error(
+      kNodes + "operations:\n  - { op: set_present, t: 5 }\n  - { op: set_present, t: 4 }\n",
+      "p.yaml:6:5: set_present: present time must not go backwards");
   expect_error(kNodes + R"(operations:
   - op: schedule_dependent
     jobs:

@@ -75,7 +75,8 @@ void run_world(unsigned seed, Stats& stats) {
   Scheduler s(world, settings);
   std::vector<check::Body> nodes;
   for (int i = 0, n = 2 + static_cast<int>(rng() % 3); i < n;) {
-    NodeSpec spec{"n" + std::to_string(i), uni(0.1, 0.4), uni(0.3, 1.5), uni(0, kSize), uni(0, kSize), 0, 0};
+    NodeSpec spec{
+        "n" + std::to_string(i), uni(0.1, 0.4), uni(0.3, 1.5), uni(0, kSize), uni(0, kSize), 0, 0};
     try {
       s.add_node(spec);
     } catch (const std::invalid_argument&) {
@@ -116,7 +117,8 @@ void run_world(unsigned seed, Stats& stats) {
       PeriodicSpec p{{}, to_polygon(rect(x, y, x + 1.5, y + 1.5)), coin(0.5), start, period, d};
       for (int i = 0; i < 3; ++i) {
         p.ids.push_back("P" + std::to_string(next_id++));
-        expected[p.ids.back()] = {rect(x, y, x + 1.5, y + 1.5), start + i * period, start + (i + 1) * period};
+        expected[p.ids.back()] = {rect(x, y, x + 1.5, y + 1.5), start + i * period,
+                                  start + (i + 1) * period};
       }
       r = s.schedule(p);
     } else if (pick < 0.8) {
@@ -139,7 +141,9 @@ void run_world(unsigned seed, Stats& stats) {
     ++stats.attempted;
     if (std::getenv("SWARM_DEBUG")) {
       std::printf("op %d pick %.2f ok %d %s\n", op, pick, r.ok, r.reason.c_str());
-      for (const auto& j : r.jobs) std::printf("  %s on %s at (%g,%g) [%g,%g]\n", j.id.c_str(), j.node.c_str(), j.x, j.y, j.start, j.end());
+      for (const auto& j : r.jobs)
+        std::printf("  %s on %s at (%g,%g) [%g,%g]\n", j.id.c_str(), j.node.c_str(), j.x, j.y,
+                    j.start, j.end());
     }
     if (r.ok) {
       ++stats.scheduled;
@@ -161,7 +165,8 @@ void run_world(unsigned seed, Stats& stats) {
       return true;
     });
     check::Checker c;
-    for (const auto& id : s.node_ids()) c.unchanged_before(id, before[id], to_xyt(s.trajectory(id)), t_frozen);
+    for (const auto& id : s.node_ids())
+      c.unchanged_before(id, before[id], to_xyt(s.trajectory(id)), t_frozen);
     ASSERT_TRUE(c.violations.empty()) << "seed " << seed << ": " << c.violations.front();
   }
   ASSERT_TRUE(s.open_transactions().empty());
@@ -185,7 +190,8 @@ void run_world(unsigned seed, Stats& stats) {
     std::vector<check::JobRecord> mine;
     for (const auto& j : s.jobs(b.name)) {
       const auto& e = expected.at(j.id);
-      check::JobRecord rec{j.id, j.node, {j.x, j.y}, j.start, j.duration, e.area, e.earliest_start, e.latest_finish};
+      check::JobRecord rec{j.id,       j.node, {j.x, j.y},       j.start,
+                           j.duration, e.area, e.earliest_start, e.latest_finish};
       c.job(b, rec);
       mine.push_back(rec);
       records[j.id] = rec;

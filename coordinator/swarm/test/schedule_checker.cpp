@@ -42,7 +42,8 @@ Xy position(const std::vector<Xyt>& tr, double t) {
     if (t <= tr[i][2]) {
       const double span = tr[i][2] - tr[i - 1][2];
       const double u = span > 0 ? (t - tr[i - 1][2]) / span : 1;
-      return {tr[i - 1][0] + u * (tr[i][0] - tr[i - 1][0]), tr[i - 1][1] + u * (tr[i][1] - tr[i - 1][1])};
+      return {tr[i - 1][0] + u * (tr[i][0] - tr[i - 1][0]),
+              tr[i - 1][1] + u * (tr[i][1] - tr[i - 1][1])};
     }
   }
   return {tr.back()[0], tr.back()[1]};
@@ -53,7 +54,8 @@ bool inside_polygon(const Xy& p, const std::vector<Xy>& poly) {
   for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
     if (dist_point_segment(p, poly[j], poly[i]) < 1e-12) return false;
     if ((poly[i][1] > p[1]) != (poly[j][1] > p[1]) &&
-        p[0] < poly[j][0] + (p[1] - poly[j][1]) * (poly[i][0] - poly[j][0]) / (poly[i][1] - poly[j][1])) {
+        p[0] < poly[j][0] +
+                   (p[1] - poly[j][1]) * (poly[i][0] - poly[j][0]) / (poly[i][1] - poly[j][1])) {
       in = !in;
     }
   }
@@ -65,8 +67,8 @@ double segment_polygon_distance(const Xy& a, const Xy& b, const std::vector<Xy>&
   double best = 1e300;
   for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
     if (segments_cross(a, b, poly[j], poly[i])) return -1;
-    best = std::min({best, dist_point_segment(a, poly[j], poly[i]), dist_point_segment(b, poly[j], poly[i]),
-                     dist_point_segment(poly[i], a, b)});
+    best = std::min({best, dist_point_segment(a, poly[j], poly[i]),
+                     dist_point_segment(b, poly[j], poly[i]), dist_point_segment(poly[i], a, b)});
   }
   // A segment through two vertices can pass the interior without crossing an edge properly.
   const Xy mid{(a[0] + b[0]) / 2, (a[1] + b[1]) / 2};
@@ -92,7 +94,8 @@ void Checker::static_clearance(const Body& n, const std::vector<std::vector<Xy>>
 void Checker::pair_clearance(const Body& a, const Body& b, double t_end) {
   // Common breakpoints: between them both move linearly, so the relative motion is a segment.
   const double lo = std::max(a.trajectory.front()[2], b.trajectory.front()[2]);
-  const double hi = std::min(a.forever ? t_end : a.trajectory.back()[2], b.forever ? t_end : b.trajectory.back()[2]);
+  const double hi = std::min(a.forever ? t_end : a.trajectory.back()[2],
+                             b.forever ? t_end : b.trajectory.back()[2]);
   if (hi < lo) return;
   std::vector<double> times{lo, hi};
   for (const auto* body : {&a, &b}) {
@@ -117,8 +120,8 @@ void Checker::pair_clearance(const Body& a, const Body& b, double t_end) {
       d = segment_polygon_distance(r0, r1, b.shape);
     }
     if (d < need - kTol) {
-      violations.push_back(a.name + " and " + b.name + " closer than " + fmt(need) + " during [" + fmt(t0) +
-                           ", " + fmt(t1) + "] (distance " + fmt(d) + ")");
+      violations.push_back(a.name + " and " + b.name + " closer than " + fmt(need) + " during [" +
+                           fmt(t0) + ", " + fmt(t1) + "] (distance " + fmt(d) + ")");
       return;
     }
   }
@@ -130,7 +133,8 @@ void Checker::speed(const Body& n) {
     const double ds = std::hypot(tr[i][0] - tr[i - 1][0], tr[i][1] - tr[i - 1][1]);
     const double dt = tr[i][2] - tr[i - 1][2];
     if (dt < 0 || ds > n.max_speed * dt * (1 + 1e-9) + 1e-9) {
-      violations.push_back(n.name + " too fast at t=" + fmt(tr[i - 1][2]) + ": " + fmt(ds) + " m in " + fmt(dt) + " s");
+      violations.push_back(n.name + " too fast at t=" + fmt(tr[i - 1][2]) + ": " + fmt(ds) +
+                           " m in " + fmt(dt) + " s");
     }
   }
 }
@@ -154,8 +158,9 @@ void Checker::job(const Body& n, const JobRecord& j) {
   }
   if (!in_area) violations.push_back("job " + j.id + ": location outside its area");
   if (j.start < j.earliest_start - 1e-9 || end > j.latest_finish + 1e-9) {
-    violations.push_back("job " + j.id + ": [" + fmt(j.start) + ", " + fmt(end) + "] outside its window [" +
-                         fmt(j.earliest_start) + ", " + fmt(j.latest_finish) + "]");
+    violations.push_back("job " + j.id + ": [" + fmt(j.start) + ", " + fmt(end) +
+                         "] outside its window [" + fmt(j.earliest_start) + ", " +
+                         fmt(j.latest_finish) + "]");
   }
 }
 
@@ -183,7 +188,8 @@ void Checker::unchanged_before(const std::string& name, const std::vector<Xyt>& 
     if (t < before.front()[2]) continue;
     const Xy p = position(before, t), q = position(after, t);
     if (std::hypot(p[0] - q[0], p[1] - q[1]) > 1e-9) {
-      violations.push_back(name + " changed before the frozen horizon " + fmt(t_frozen) + " at t=" + fmt(t));
+      violations.push_back(name + " changed before the frozen horizon " + fmt(t_frozen) +
+                           " at t=" + fmt(t));
       return;
     }
   }

@@ -14,11 +14,11 @@ using Xyt = std::array<double, 3>;
 
 struct Body {
   std::string name;
-  std::vector<Xy> shape;         // polygon relative to the trajectory point; empty = a point
-  double radius = 0;             // clearance required around the shape
-  std::vector<Xyt> trajectory;   // piecewise linear
-  bool forever = false;          // stays at the last point after the trajectory ends
-  double max_speed = 0;          // 0 = not checked
+  std::vector<Xy> shape;        // polygon relative to the trajectory point; empty = a point
+  double radius = 0;            // clearance required around the shape
+  std::vector<Xyt> trajectory;  // piecewise linear
+  bool forever = false;         // stays at the last point after the trajectory ends
+  double max_speed = 0;         // 0 = not checked
 };
 
 struct JobRecord {

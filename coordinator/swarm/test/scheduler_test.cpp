@@ -171,8 +171,7 @@ TEST(Scheduler, BadInputGetsClearErrors) {
 TEST(Scheduler, MovingObstacleMakesTheNodeWaitOrDodgeInTime) {
   World w;
   // A wall segment sweeping across the corridor x in [4, 6] during t in [0, 20].
-  w.dynamic_obstacles.push_back(
-      {square(-1, -0.5, 1, 0.5), Trajectory({{5, -10, 0}, {5, 10, 20}})});
+  w.dynamic_obstacles.push_back({square(-1, -0.5, 1, 0.5), Trajectory({{5, -10, 0}, {5, 10, 20}})});
   Scheduler s(std::move(w), {});
   s.add_node({"n", 0.2, 1, 0, 0, 0, 0});
   const auto r = s.schedule(job("J", square(9, -1, 11, 1), 0, 100, 5));

@@ -19,12 +19,14 @@ struct ImplicitWindow {
 /// for; `fixed` gives start times already assigned (t_min = t_max = t, §4.2.4).
 /// @throws std::invalid_argument on a dependency naming an unknown job, or a cycle.
 std::map<std::string, ImplicitWindow> implicit_windows(
-    const std::vector<JobSpec>& jobs, const std::map<std::string, std::vector<std::string>>& depends,
-    double margin, const std::map<std::string, double>& fixed = {});
+    const std::vector<JobSpec>& jobs,
+    const std::map<std::string, std::vector<std::string>>& depends, double margin,
+    const std::map<std::string, double>& fixed = {});
 
 /// The jobs in a topological order (dependencies first).
 /// @throws std::invalid_argument as implicit_windows.
 std::vector<std::string> topological_order(
-    const std::vector<JobSpec>& jobs, const std::map<std::string, std::vector<std::string>>& depends);
+    const std::vector<JobSpec>& jobs,
+    const std::map<std::string, std::vector<std::string>>& depends);
 
 }  // namespace oscar::swarm

@@ -17,12 +17,13 @@ struct ForbiddenRegions {
   std::vector<std::pair<double, double>> blocked_times;
 };
 
-/// Computes the forbidden regions of `obstacle` along `path` for times in [t_lo, t_hi], tile by tile
-/// over path segment × obstacle segment, with the regular (eq. 4.17/4.18), parallel (eq. 4.19/4.20)
-/// and stationary (eq. 4.21) cases. A path with one point (or only zero-length segments) is
-/// stationary and yields blocked_times.
+/// Computes the forbidden regions of `obstacle` along `path` for times in [t_lo, t_hi], tile by
+/// tile over path segment × obstacle segment, with the regular (eq. 4.17/4.18), parallel
+/// (eq. 4.19/4.20) and stationary (eq. 4.21) cases. A path with one point (or only zero-length
+/// segments) is stationary and yields blocked_times.
 ForbiddenRegions compute_forbidden_regions(const std::vector<Point>& path,
-                                           const MovingObstacle& obstacle, double t_lo, double t_hi);
+                                           const MovingObstacle& obstacle, double t_lo,
+                                           double t_hi);
 
 /// Which case of seed §4.3.3 (Abb. 4.18) a tile falls into.
 enum class TileCase { kRegular, kParallel, kStationary };

@@ -40,7 +40,8 @@ bool segment_hits_interior(const Point& a, const Point& b, const Polygon& polygo
 double point_segment_distance(const Point& p, const Point& a, const Point& b);
 
 /// The polygon grown outward by `distance_m` with mitred corners: a superset of the Minkowski sum
-/// with a disc of that radius, so a point outside it keeps at least that distance (seed §4.3, fn. 7).
+/// with a disc of that radius, so a point outside it keeps at least that distance (seed §4.3, fn.
+/// 7).
 Polygon inflate(const Polygon& polygon, double distance_m);
 
 /// A regular octagon around the origin that contains the disc of radius `radius_m`.

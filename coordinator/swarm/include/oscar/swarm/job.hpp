@@ -14,8 +14,8 @@ struct NodeSpec {
   double max_speed_mps = 1;
   double x = 0;  ///< initial location
   double y = 0;
-  double t = 0;  ///< initial time (s)
-  double turning_radius_m = 0;  ///< > 0: Dubins car, planned with OMPL (not yet implemented)
+  double t = 0;                 ///< initial time (s)
+  double turning_radius_m = 0;  ///< > 0: Dubins car, spatial paths planned with OMPL
 };
 
 /// A job specification (seed §4.2.1): where (area), when (window) and how long.

@@ -10,18 +10,27 @@ namespace oscar::swarm {
 
 /// One operation of a problem file.
 struct Operation {
-  enum class Kind { kSchedule, kPeriodic, kDependent, kUnschedule, kRemove, kReschedule, kCommit,
-                    kAbort, kSetPresent };
+  enum class Kind {
+    kSchedule,
+    kPeriodic,
+    kDependent,
+    kUnschedule,
+    kRemove,
+    kReschedule,
+    kCommit,
+    kAbort,
+    kSetPresent
+  };
   Kind kind = Kind::kSchedule;
-  std::string name;          ///< the op as written
-  JobSpec job;               ///< schedule, reschedule
-  PeriodicSpec periodic;     ///< schedule_periodic
-  DependentSpec dependent;   ///< schedule_dependent
-  std::string id;            ///< unschedule, remove
+  std::string name;               ///< the op as written
+  JobSpec job;                    ///< schedule, reschedule
+  PeriodicSpec periodic;          ///< schedule_periodic
+  DependentSpec dependent;        ///< schedule_dependent
+  std::string id;                 ///< unschedule, remove
   TransactionId transaction = 0;  ///< commit/abort; 0 = the last open one
-  std::string node;          ///< commit/abort of one node
-  double t = 0;              ///< set_present
-  int line = 0;              ///< 1-based line in the file
+  std::string node;               ///< commit/abort of one node
+  double t = 0;                   ///< set_present
+  int line = 0;                   ///< 1-based line in the file
 };
 
 /// A world, nodes, settings and operations.

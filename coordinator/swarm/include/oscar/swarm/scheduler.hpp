@@ -12,21 +12,25 @@
 #include "oscar/swarm/schedule_result.hpp"
 #include "oscar/swarm/spatial_path_finder.hpp"
 #include "oscar/swarm/trajectory.hpp"
+#include "oscar/swarm/trajectory_planner.hpp"
 #include "oscar/swarm/world.hpp"
 
 namespace oscar::swarm {
 
+class DubinsPathFinder;
+
 /// Scheduler settings (seed §4.2.1, §4.2.4, §4.3.4).
 struct SchedulerSettings {
-  double present = 0;               ///< present time (s)
-  double frozen_horizon = 0;        ///< t_FH = present + frozen_horizon (§4.2.1)
-  double dependency_margin = 0;     ///< d_m of eq. 4.10/4.11
-  int location_samples = 10;        ///< locations tried per job (§4.2.1, Ort)
-  double wait_threshold = 0;        ///< d_th of §4.3.4
-  unsigned seed = 1;                ///< seed of the location sampler
+  double present = 0;            ///< present time (s)
+  double frozen_horizon = 0;     ///< t_FH = present + frozen_horizon (§4.2.1)
+  double dependency_margin = 0;  ///< d_m of eq. 4.10/4.11
+  int location_samples = 10;     ///< locations tried per job (§4.2.1, Ort)
+  double wait_threshold = 0;     ///< d_th of §4.3.4
+  unsigned seed = 1;             ///< seed of the location sampler
 };
 
-/// A periodic job set (seed §4.2.3): job i starts within [start + i·period, start + (i+1)·period - d].
+/// A periodic job set (seed §4.2.3): job i starts within [start + i·period, start + (i+1)·period -
+/// d].
 struct PeriodicSpec {
   std::vector<std::string> ids;
   Polygon area;
@@ -99,7 +103,8 @@ class Scheduler {
 
   /// The slots of all nodes meeting conditions 4.2–4.4 for `spec` at `at`, least detour first
   /// (eq. 4.5), excluding slots locked by transactions other than `tx` (§4.2.7).
-  std::vector<Slot> qualifying_slots(const JobSpec& spec, const Point& at, TransactionId tx = 0) const;
+  std::vector<Slot> qualifying_slots(const JobSpec& spec, const Point& at,
+                                     TransactionId tx = 0) const;
 
   /// Moves the present forward (§4.2.1).
   /// @throws std::invalid_argument if t is before the present or not finite.
@@ -130,12 +135,14 @@ class Scheduler {
   bool try_schedule(const JobSpec& spec, TransactionId tx, const std::optional<Point>& at,
                     std::string& reason, Job& scheduled);
   bool try_candidate(const Slot& c, const JobSpec& spec, TransactionId tx, Job& scheduled);
-  bool try_unschedule(const std::string& job_id, TransactionId tx, bool replan, std::string& reason);
+  bool try_unschedule(const std::string& job_id, TransactionId tx, bool replan,
+                      std::string& reason);
   bool locked_by_other(const NodeState& n, TransactionId tx, double lo, double hi) const;
   void record(TransactionId tx, NodeState& n, double lo, double hi);
   std::vector<Point> sample_locations(const Polygon& area);
   const SpatialPathFinder& finder(const NodeState& n) const;
   std::vector<MovingObstacle> obstacles_for(const NodeState& n) const;
+  TrajectoryPlanner::PathFunction path_function(const NodeState& n) const;
   void validate(const JobSpec& spec, bool allow_existing) const;
   bool job_exists(const std::string& id) const;
   void finish(TransactionId tx, const std::string& node, bool commit);
@@ -144,6 +151,7 @@ class Scheduler {
   SchedulerSettings settings_;
   std::vector<std::unique_ptr<NodeState>> nodes_;
   mutable std::map<double, std::unique_ptr<SpatialPathFinder>> finders_;  // by node radius
+  mutable std::map<std::pair<double, double>, std::unique_ptr<DubinsPathFinder>> dubins_finders_;
   std::map<TransactionId, std::map<std::string, Change>> transactions_;
   TransactionId next_transaction_ = 1;
   unsigned sample_counter_ = 0;

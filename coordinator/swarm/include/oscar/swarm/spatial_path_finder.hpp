@@ -28,7 +28,7 @@ class SpatialPathFinder {
 
  private:
   std::vector<Polygon> obstacles_;
-  std::vector<Point> corners_;                   // corners that are free
+  std::vector<Point> corners_;                                     // corners that are free
   std::vector<std::vector<std::pair<int, double>>> corner_edges_;  // visibility among corners
 };
 

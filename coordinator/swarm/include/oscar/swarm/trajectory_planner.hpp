@@ -1,6 +1,7 @@
 #pragma once
 /// @file Path-velocity decomposition for one node (seed 002 §4.3).
 
+#include <functional>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -17,7 +18,10 @@ namespace oscar::swarm {
 /// all moving obstacles (already inflated by the node's radius), composed as in Abb. 4.15.
 class TrajectoryPlanner {
  public:
-  TrajectoryPlanner(const SpatialPathFinder& finder, std::vector<MovingObstacle> obstacles,
+  /// The spatial planner: the exact visibility graph or OMPL's Dubins planner (per node).
+  using PathFunction = std::function<std::optional<std::vector<Point>>(const Point&, const Point&)>;
+
+  TrajectoryPlanner(PathFunction path, std::vector<MovingObstacle> obstacles,
                     VelocityPlanner::Settings settings);
 
   /// Shortest spatial path, or nullopt.
@@ -37,7 +41,7 @@ class TrajectoryPlanner {
  private:
   std::vector<Polygon> regions(const std::vector<Point>& path, double lo, double hi) const;
 
-  const SpatialPathFinder& finder_;
+  PathFunction path_;
   std::vector<MovingObstacle> obstacles_;
   VelocityPlanner::Settings settings_;
 };

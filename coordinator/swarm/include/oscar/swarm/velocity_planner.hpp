@@ -9,8 +9,8 @@
 namespace oscar::swarm {
 
 /// Plans s(t) along a path of length s_final from (0, t_start), avoiding forbidden regions
-/// (seed §4.3.2): a visibility graph in s–t with edges forward in time (eq. 4.12) and no faster than
-/// v_max (eq. 4.13). Only forward motion along the path (Δs ≥ 0) is used.
+/// (seed §4.3.2): a visibility graph in s–t with edges forward in time (eq. 4.12) and no faster
+/// than v_max (eq. 4.13). Only forward motion along the path (Δs ≥ 0) is used.
 class VelocityPlanner {
  public:
   struct Settings {
