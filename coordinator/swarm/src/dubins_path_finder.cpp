@@ -64,13 +64,20 @@ std::optional<std::vector<Point>> DubinsPathFinder::find(const Point& from, cons
     path.append(start.get());
     path.append(goal.get());
   } else {
-    setup.setPlanner(
-        std::make_shared<og::RRT>(si));  // RRT* needs a symmetric metric; Dubins is not
-    ob::IterationTerminationCondition iterations(static_cast<unsigned>(settings_.iterations));
-    const ob::PlannerStatus status = setup.solve(iterations);
-    if (status != ob::PlannerStatus::EXACT_SOLUTION) return std::nullopt;
-    setup.simplifySolution();  // shortcutting keeps the validity checks
-    path = setup.getSolutionPath();
+    // RRT* needs a symmetric metric, which Dubins is not: plain RRT, restarted a few times,
+    // each result shortcut, the shortest kept.
+    setup.setPlanner(std::make_shared<og::RRT>(si));
+    bool found = false;
+    for (int attempt = 0; attempt < settings_.restarts; ++attempt) {
+      setup.clear();
+      ob::IterationTerminationCondition iterations(static_cast<unsigned>(settings_.iterations));
+      if (setup.solve(iterations) != ob::PlannerStatus::EXACT_SOLUTION) continue;
+      setup.simplifySolution();  // shortcutting keeps the validity checks
+      const og::PathGeometric& candidate = setup.getSolutionPath();
+      if (!found || candidate.length() < path.length()) path = candidate;
+      found = true;
+    }
+    if (!found) return std::nullopt;
   }
   last_length_ = path.length();
   path.interpolate(static_cast<unsigned>(std::ceil(path.length() / settings_.resolution_m)) + 2);

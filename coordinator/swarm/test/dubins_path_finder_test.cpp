@@ -31,8 +31,9 @@ TEST_F(DubinsPathFinderTest, MatchesTheExactPlannerWhereBothApply) {
 TEST_F(DubinsPathFinderTest, AroundAnObstacleNoShorterThanExactAndClose) {
   const std::vector<Polygon> obstacles{square(4, -2, 6, 2)};
   SpatialPathFinder exact(obstacles);
-  DubinsPathFinder dubins(obstacles,
-                          {.turning_radius_m = 0.5, .iterations = 3000, .resolution_m = 0.05});
+  DubinsPathFinder dubins(
+      obstacles,
+      {.turning_radius_m = 0.5, .iterations = 3000, .restarts = 8, .resolution_m = 0.05});
   const auto e = exact.find({0, 0}, {10, 0});
   const auto d = dubins.find({0, 0}, {10, 0});
   ASSERT_TRUE(e);

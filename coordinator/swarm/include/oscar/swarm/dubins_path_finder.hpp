@@ -20,7 +20,8 @@ class DubinsPathFinder {
  public:
   struct Settings {
     double turning_radius_m = 1;
-    int iterations = 2000;      ///< RRT* iterations per query
+    int iterations = 2000;      ///< RRT iterations per attempt
+    int restarts = 8;           ///< attempts per query; the shortest path is kept
     double resolution_m = 0.1;  ///< spacing of the returned polyline
   };
 
