@@ -37,6 +37,19 @@ void clip_into(const std::vector<Point>& ring, double s0, double s1, double t0, 
 // passable. The overlap is conservative: it can only forbid a sliver more.
 constexpr double kTileOverlap = 1e-5;
 
+using Box = bg::model::box<Point>;
+
+bool overlaps(const Box& a, const Box& b) {
+  return a.min_corner().x() <= b.max_corner().x() && b.min_corner().x() <= a.max_corner().x() &&
+         a.min_corner().y() <= b.max_corner().y() && b.min_corner().y() <= a.max_corner().y();
+}
+
+Box box_of(const std::vector<Point>& points) {
+  Box b(points.front(), points.front());
+  for (const auto& p : points) bg::expand(b, p);
+  return b;
+}
+
 Point sub(const Point& a, const Point& b) { return Point(a.x() - b.x(), a.y() - b.y()); }
 double norm(const Point& a) { return std::hypot(a.x(), a.y()); }
 
@@ -65,8 +78,11 @@ ForbiddenRegions compute_forbidden_regions(const std::vector<Point>& path,
   struct Segment {
     double t0, t1;
     Point p0, v;
+    Box swept;  // envelope of the obstacle during the segment (A.7 lines 9/14)
   };
+  const auto shape_box = bg::return_envelope<Box>(obstacle.shape);
   std::vector<Segment> segments;
+  const Box path_box = box_of(path);
   for (std::size_t j = 0; j + 1 < traj.size() || (traj.size() == 1 && j == 0); ++j) {
     const auto& a = traj[j];
     const auto& b = traj.size() == 1 ? traj[0] : traj[j + 1];
@@ -76,7 +92,14 @@ ForbiddenRegions compute_forbidden_regions(const std::vector<Point>& path,
     Point v(0, 0);
     if (b.t > a.t) v = Point((b.x - a.x) / (b.t - a.t), (b.y - a.y) / (b.t - a.t));
     const Point p0 = obstacle.trajectory.position_at(t0);
-    segments.push_back({t0, t1, p0, v});
+    const Point p1(p0.x() + v.x() * (t1 - t0), p0.y() + v.y() * (t1 - t0));
+    const Box swept(Point(std::min(p0.x(), p1.x()) + shape_box.min_corner().x(),
+                          std::min(p0.y(), p1.y()) + shape_box.min_corner().y()),
+                    Point(std::max(p0.x(), p1.x()) + shape_box.max_corner().x(),
+                          std::max(p0.y(), p1.y()) + shape_box.max_corner().y()));
+    // A.7 line 9: skip obstacle segments whose envelope misses the whole path.
+    if (!overlaps(swept, path_box)) continue;
+    segments.push_back({t0, t1, p0, v, swept});
   }
 
   if (s_total <= kEpsilon) {
@@ -108,8 +131,10 @@ ForbiddenRegions compute_forbidden_regions(const std::vector<Point>& path,
     const double s0 = s_i;
     const double s1 = s_i + len;
     s_i = s1;
+    const Box segment_box = box_of({path[i], path[i + 1]});
     for (const auto& seg : segments) {
       if (seg.t1 <= seg.t0) continue;  // an instant blocks no area of the s–t plane
+      if (!overlaps(seg.swept, segment_box)) continue;  // A.7 line 14
       const Polygon o = translate(obstacle.shape, seg.p0.x(), seg.p0.y());
       if (classify_tile(dx, seg.v) == TileCase::kRegular) {
         // eq. 4.18: [e_s, -v] (s - s_i, t - t_j)^T = p - x_i, solved for each obstacle corner.
