@@ -203,6 +203,14 @@ bool Scheduler::try_unschedule(const std::string& job_id, TransactionId tx, bool
     list.erase(it);
     return true;
   }
+  for (const auto& node : nodes_) {
+    for (const auto& j : node->committed_jobs) {
+      if (j.id == job_id) {  // §4.2.7: a job being removed is locked against another removal
+        reason = fmt::format("job '{}' is locked: an open transaction removes it", job_id);
+        return false;
+      }
+    }
+  }
   throw std::invalid_argument(fmt::format("unknown job id '{}'", job_id));
 }
 

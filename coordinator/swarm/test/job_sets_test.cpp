@@ -131,6 +131,13 @@ TEST(Transactions, LockedSectionsRefuseForeignChanges) {
   EXPECT_NE(removal.reason.find("locked"), std::string::npos) << removal.reason;
   s.commit(first.transaction);
   EXPECT_TRUE(s.schedule(JobSpec{"J2", square(-6, -1, -4, 1), 50, 100, 5}).ok);
+  // A job being removed by an open transaction cannot be removed again (§4.2.7).
+  for (auto id : s.open_transactions()) s.commit(id);
+  const auto removing = s.remove_job("J1");
+  ASSERT_TRUE(removing.ok);
+  const auto again = s.unschedule("J1");
+  EXPECT_FALSE(again.ok);
+  EXPECT_NE(again.reason.find("locked"), std::string::npos) << again.reason;
 }
 
 TEST(Transactions, CommitAndAbortPerNode) {

@@ -102,7 +102,31 @@ void run_world(unsigned seed, Stats& stats) {
     return j;
   };
   int next_id = 0;
-  for (int op = 0; op < 8; ++op) {
+  std::vector<TransactionId> open;
+  auto refresh = [&] {  // the ids of jobs scheduled now (working view)
+    std::erase_if(scheduled_ids, [&](const std::string& id) {
+      for (const auto& n : s.node_ids()) {
+        for (const auto& j : s.jobs(n, false)) {
+          if (j.id == id) return false;
+        }
+      }
+      return true;
+    });
+  };
+  auto finish_oldest = [&] {
+    const TransactionId tx = open.front();
+    open.erase(open.begin());
+    if (coin(0.7)) {
+      s.commit(tx);
+    } else {
+      s.abort(tx);
+    }
+  };
+  for (int op = 0; op < 10; ++op) {
+    if (!open.empty() && coin(0.4)) {
+      finish_oldest();
+      refresh();
+    }
     std::map<std::string, std::vector<Xyt>> before;
     for (const auto& id : s.node_ids()) before[id] = to_xyt(s.trajectory(id));
     const double t_frozen = s.frozen_horizon_time();
@@ -148,7 +172,11 @@ void run_world(unsigned seed, Stats& stats) {
     if (r.ok) {
       ++stats.scheduled;
       for (const auto& j : r.jobs) scheduled_ids.push_back(j.id);
-      if (coin(0.85)) {
+      // Some transactions stay open for a while (§4.2.7): later planning must treat both
+      // alternatives as obstacles and respect the locks.
+      if (coin(0.3)) {
+        open.push_back(r.transaction);
+      } else if (coin(0.85)) {
         s.commit(r.transaction);
       } else {
         s.abort(r.transaction);
@@ -156,19 +184,13 @@ void run_world(unsigned seed, Stats& stats) {
     } else {
       EXPECT_FALSE(r.reason.empty());
     }
-    std::erase_if(scheduled_ids, [&](const std::string& id) {
-      for (const auto& n : s.node_ids()) {
-        for (const auto& j : s.jobs(n)) {
-          if (j.id == id) return false;
-        }
-      }
-      return true;
-    });
+    refresh();
     check::Checker c;
     for (const auto& id : s.node_ids())
       c.unchanged_before(id, before[id], to_xyt(s.trajectory(id)), t_frozen);
     ASSERT_TRUE(c.violations.empty()) << "seed " << seed << ": " << c.violations.front();
   }
+  while (!open.empty()) finish_oldest();
   ASSERT_TRUE(s.open_transactions().empty());
 
   check::Checker c;
