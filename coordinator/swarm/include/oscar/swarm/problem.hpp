@@ -1,0 +1,53 @@
+#pragma once
+/// @file A planning problem as read by `oscar swarm plan` (format in docs/swarm.md).
+
+#include <string>
+#include <vector>
+
+#include "oscar/swarm/scheduler.hpp"
+
+namespace oscar::swarm {
+
+/// One operation of a problem file.
+struct Operation {
+  enum class Kind {
+    kSchedule,
+    kPeriodic,
+    kDependent,
+    kUnschedule,
+    kRemove,
+    kReschedule,
+    kCommit,
+    kAbort,
+    kSetPresent
+  };
+  Kind kind = Kind::kSchedule;
+  std::string name;               ///< the op as written
+  JobSpec job;                    ///< schedule, reschedule
+  PeriodicSpec periodic;          ///< schedule_periodic
+  DependentSpec dependent;        ///< schedule_dependent
+  std::string id;                 ///< unschedule, remove
+  TransactionId transaction = 0;  ///< commit/abort; 0 = the last open one
+  std::string node;               ///< commit/abort of one node
+  double t = 0;                   ///< set_present
+  int line = 0;                   ///< 1-based line in the file
+};
+
+/// A world, nodes, settings and operations.
+struct Problem {
+  std::string source;  ///< file name for messages
+  World world;
+  std::vector<NodeSpec> nodes;
+  SchedulerSettings settings;
+  std::vector<Operation> operations;
+};
+
+/// Parses a problem from YAML or JSON text and validates it completely before any planning.
+/// @throws std::invalid_argument with "source:line:column: what: rule" on bad input.
+Problem parse_problem(const std::string& text, const std::string& source);
+
+/// Reads and parses a problem file.
+/// @throws std::invalid_argument if the file cannot be read or is invalid.
+Problem load_problem(const std::string& path);
+
+}  // namespace oscar::swarm

@@ -1,0 +1,160 @@
+#pragma once
+/// @file The space-time scheduler (seed 002 ch. 4, Anhang A).
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "oscar/swarm/job.hpp"
+#include "oscar/swarm/load.hpp"
+#include "oscar/swarm/schedule_result.hpp"
+#include "oscar/swarm/spatial_path_finder.hpp"
+#include "oscar/swarm/trajectory.hpp"
+#include "oscar/swarm/trajectory_planner.hpp"
+#include "oscar/swarm/world.hpp"
+
+namespace oscar::swarm {
+
+class DubinsPathFinder;
+
+/// Scheduler settings (seed §4.2.1, §4.2.4, §4.3.4).
+struct SchedulerSettings {
+  double present = 0;            ///< present time (s)
+  double frozen_horizon = 0;     ///< t_FH = present + frozen_horizon (§4.2.1)
+  double dependency_margin = 0;  ///< d_m of eq. 4.10/4.11
+  int location_samples = 10;     ///< locations tried per job (§4.2.1, Ort)
+  double wait_threshold = 0;     ///< d_th of §4.3.4
+  unsigned seed = 1;             ///< seed of the location sampler
+};
+
+/// A periodic job set (seed §4.2.3): job i starts within [start + i·period, start + (i+1)·period -
+/// d].
+struct PeriodicSpec {
+  std::vector<std::string> ids;
+  Polygon area;
+  bool same_location = true;
+  double start = 0;
+  double period = 0;
+  double duration = 0;
+};
+
+/// Dependent jobs (seed §4.2.4): `depends[c]` lists the jobs c waits for.
+struct DependentSpec {
+  std::vector<JobSpec> jobs;
+  std::map<std::string, std::vector<std::string>> depends;
+};
+
+/// An idle slot (pause) of a node that meets conditions 4.2–4.4 for a location (seed §4.2.1).
+struct Slot {
+  std::string node;
+  std::size_t index = 0;  ///< position of the new job in the node's job list
+  double t1 = 0;          ///< pause start, moved to the frozen horizon if earlier
+  double t2 = 0;          ///< pause end (kForever after the last job)
+  Point from;             ///< where the node is at t1
+  Point at;               ///< the job location
+  double detour = 0;      ///< Δs of eq. 4.5 (s1 + s2 - s12)
+};
+
+/// Schedules jobs onto nodes and plans their trajectories (seed ch. 4): location sampling, idle
+/// slots by conditions 4.2–4.4, least detour first (4.5), path-velocity decomposition (§4.3),
+/// periodic (A.2) and dependent (A.3) sets atomically, and transactions (§4.2.7) whose alternative
+/// trajectories count as obstacles and which lock the trajectory sections they change.
+/// Bad input throws std::invalid_argument; infeasible jobs are ScheduleResult values.
+class Scheduler {
+ public:
+  /// @throws std::invalid_argument on non-finite or out-of-range settings.
+  Scheduler(World world, SchedulerSettings settings);
+  ~Scheduler();
+  Scheduler(Scheduler&&) noexcept;
+  Scheduler& operator=(Scheduler&&) noexcept;
+
+  /// Adds a node idle at its start (seed §5.2 addNode).
+  /// @throws std::invalid_argument on a duplicate id, bad numbers, or a start inside an obstacle
+  /// or too close to another node.
+  void add_node(const NodeSpec& spec);
+
+  /// Schedules one job in a new transaction (seed §4.2.1, A.4).
+  /// @throws std::invalid_argument on an invalid spec or an id already in use.
+  ScheduleResult schedule(const JobSpec& spec);
+  /// Schedules a periodic set, all or nothing (§4.2.3, A.2).
+  ScheduleResult schedule(const PeriodicSpec& spec);
+  /// Schedules dependent jobs, all or nothing, earliest implicit deadline first (§4.2.4, A.3).
+  /// @throws std::invalid_argument on unknown ids or a cycle.
+  ScheduleResult schedule(const DependentSpec& spec);
+  /// Removes a job and re-plans the trajectory around the gap (§4.2.5).
+  /// @throws std::invalid_argument on an unknown id.
+  ScheduleResult unschedule(const std::string& job_id);
+  /// Removes a job without re-planning (§4.2.5).
+  /// @throws std::invalid_argument on an unknown id.
+  ScheduleResult remove_job(const std::string& job_id);
+  /// Unschedules and schedules again atomically (§4.2.6).
+  ScheduleResult reschedule(const JobSpec& spec);
+
+  /// Commits a transaction, wholly or for one node (§4.2.7).
+  /// @throws std::invalid_argument on an unknown transaction or node.
+  void commit(TransactionId id, const std::string& node = "");
+  /// Aborts a transaction, wholly or for one node (§4.2.7).
+  /// @throws std::invalid_argument on an unknown transaction or node.
+  void abort(TransactionId id, const std::string& node = "");
+  /// The open transactions, oldest first.
+  std::vector<TransactionId> open_transactions() const;
+
+  /// The slots of all nodes meeting conditions 4.2–4.4 for `spec` at `at`, least detour first
+  /// (eq. 4.5), excluding slots locked by transactions other than `tx` (§4.2.7).
+  std::vector<Slot> qualifying_slots(const JobSpec& spec, const Point& at,
+                                     TransactionId tx = 0) const;
+
+  /// Moves the present forward (§4.2.1).
+  /// @throws std::invalid_argument if t is before the present or not finite.
+  void set_present(double t);
+  double present() const { return settings_.present; }
+  /// t_FH: nothing before it changes.
+  double frozen_horizon_time() const { return settings_.present + settings_.frozen_horizon; }
+
+  /// The node ids in the order added.
+  std::vector<std::string> node_ids() const;
+  const NodeSpec& node(const std::string& id) const;
+  /// The committed trajectory, or the working one with all open transactions applied.
+  const Trajectory& trajectory(const std::string& node, bool committed = true) const;
+  /// The committed (or working) jobs of a node, by start time.
+  const std::vector<Job>& jobs(const std::string& node, bool committed = true) const;
+  /// Load figures of a node's committed schedule over [t0, t1] (seed §4.4).
+  /// @throws std::invalid_argument on an unknown node or an empty interval.
+  Load load(const std::string& node, double t0, double t1) const;
+  const World& world() const { return world_; }
+  const SchedulerSettings& settings() const { return settings_; }
+
+ private:
+  struct NodeState;
+  struct Change;
+  NodeState& state(const std::string& id);
+  const NodeState& state(const std::string& id) const;
+  TransactionId open_transaction();
+  bool try_schedule(const JobSpec& spec, TransactionId tx, const std::optional<Point>& at,
+                    std::string& reason, Job& scheduled);
+  bool try_candidate(const Slot& c, const JobSpec& spec, TransactionId tx, Job& scheduled);
+  bool try_unschedule(const std::string& job_id, TransactionId tx, bool replan,
+                      std::string& reason);
+  bool locked_by_other(const NodeState& n, TransactionId tx, double lo, double hi) const;
+  void record(TransactionId tx, NodeState& n, double lo, double hi);
+  std::vector<Point> sample_locations(const Polygon& area);
+  const SpatialPathFinder& finder(const NodeState& n) const;
+  std::vector<MovingObstacle> obstacles_for(const NodeState& n) const;
+  TrajectoryPlanner::PathFunction path_function(const NodeState& n) const;
+  void validate(const JobSpec& spec, bool allow_existing) const;
+  bool job_exists(const std::string& id) const;
+  void finish(TransactionId tx, const std::string& node, bool commit);
+
+  World world_;
+  SchedulerSettings settings_;
+  std::vector<std::unique_ptr<NodeState>> nodes_;
+  mutable std::map<double, std::unique_ptr<SpatialPathFinder>> finders_;  // by node radius
+  mutable std::map<std::pair<double, double>, std::unique_ptr<DubinsPathFinder>> dubins_finders_;
+  std::map<TransactionId, std::map<std::string, Change>> transactions_;
+  TransactionId next_transaction_ = 1;
+  unsigned sample_counter_ = 0;
+};
+
+}  // namespace oscar::swarm

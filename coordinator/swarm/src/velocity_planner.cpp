@@ -1,0 +1,134 @@
+#include "oscar/swarm/velocity_planner.hpp"
+
+#include <algorithm>
+#include <boost/graph/adjacency_list.hpp>
+#include <boost/graph/dijkstra_shortest_paths.hpp>
+#include <limits>
+
+namespace oscar::swarm {
+
+VelocityPlanner::VelocityPlanner(double s_final, double t_start, std::vector<Polygon> regions,
+                                 Settings settings)
+    : s_final_(s_final), t_start_(t_start), regions_(std::move(regions)), settings_(settings) {
+  if (settings_.v_leave <= 0) settings_.v_leave = settings_.v_max;
+}
+
+bool VelocityPlanner::free(const Point& a, const Point& b) const {
+  for (const auto& r : regions_) {
+    if (segment_hits_interior(a, b, r)) return false;
+  }
+  return true;
+}
+
+bool VelocityPlanner::edge_ok(const Point& a, const Point& b) const {
+  const double ds = b.x() - a.x();
+  const double dt = b.y() - a.y();
+  if (dt <= 0 || ds < -kEpsilon) return false;                        // eq. 4.12, forward only
+  if (ds > settings_.v_max * dt * (1 + 1e-12) + 1e-12) return false;  // eq. 4.13
+  return free(a, b);
+}
+
+std::vector<Point> VelocityPlanner::corners(double t_max) const {
+  std::vector<Point> result;
+  for (const auto& r : regions_) {
+    for (const auto& c : vertices(r)) {
+      if (c.y() < t_start_ || c.y() > t_max || c.x() < -kEpsilon || c.x() > s_final_ + kEpsilon) {
+        continue;
+      }
+      bool inside = false;
+      for (const auto& other : regions_) inside = inside || strictly_inside(c, other);
+      if (!inside) result.push_back(c);
+    }
+  }
+  return result;
+}
+
+std::optional<std::vector<Point>> VelocityPlanner::fixed_arrival(double t_final) const {
+  const Point start(0, t_start_);
+  const Point goal(s_final_, t_final);
+  if (t_final < t_start_ ||
+      s_final_ > settings_.v_max * (t_final - t_start_) * (1 + 1e-12) + 1e-12) {
+    return std::nullopt;
+  }
+  std::vector<Point> nodes{start, goal};
+  for (const auto& c : corners(t_final)) nodes.push_back(c);
+  for (const auto& r : regions_) {
+    if (strictly_inside(start, r) || strictly_inside(goal, r)) return std::nullopt;
+  }
+  if (s_final_ <= kEpsilon) {
+    // Stationary: only a wait is possible.
+    if (t_final <= t_start_ || free(start, goal)) return std::vector<Point>{start, goal};
+    return std::nullopt;
+  }
+  using Graph =
+      boost::adjacency_list<boost::vecS, boost::vecS, boost::directedS, boost::no_property,
+                            boost::property<boost::edge_weight_t, double>>;
+  const std::size_t base = nodes.size();
+  Graph graph(base);
+  auto cost = [](const Point& a, const Point& b) {
+    return b.x() - a.x() > kEpsilon ? b.y() - a.y() : 0.0;  // driving time; waiting is free
+  };
+  for (std::size_t i = 0; i < base; ++i) {
+    for (std::size_t j = 0; j < base; ++j) {
+      if (i == j) continue;
+      const Point a = nodes[i];  // copies: nodes grows below
+      const Point b = nodes[j];
+      if (edge_ok(a, b)) boost::add_edge(i, j, cost(a, b) + 1e-9, graph);
+      // §4.3.4: wait at s_a, then leave with v_L to reach b exactly.
+      if (b.x() - a.x() > kEpsilon) {
+        const Point w(a.x(), b.y() - (b.x() - a.x()) / settings_.v_leave);
+        if (w.y() - a.y() >= std::max(settings_.wait_threshold_s, kEpsilon) && edge_ok(a, w) &&
+            edge_ok(w, b)) {
+          const auto k = boost::add_vertex(graph);
+          nodes.push_back(w);
+          boost::add_edge(i, k, 1e-9, graph);
+          boost::add_edge(k, j, cost(w, b) + 1e-9, graph);
+        }
+      }
+    }
+  }
+  const std::size_t n = boost::num_vertices(graph);
+  std::vector<std::size_t> predecessor(n);
+  std::vector<double> dist(n);
+  boost::dijkstra_shortest_paths(
+      graph, 0, boost::predecessor_map(predecessor.data()).distance_map(dist.data()));
+  if (predecessor[1] == 1) return std::nullopt;
+  std::vector<Point> path;
+  for (std::size_t v = 1; v != 0; v = predecessor[v]) path.push_back(nodes[v]);
+  path.push_back(start);
+  std::reverse(path.begin(), path.end());
+  return path;
+}
+
+std::optional<std::vector<Point>> VelocityPlanner::earliest_arrival(double t_latest) const {
+  const Point start(0, t_start_);
+  for (const auto& r : regions_) {
+    if (strictly_inside(start, r)) return std::nullopt;
+  }
+  std::vector<Point> nodes{start};
+  for (const auto& c : corners(t_latest)) nodes.push_back(c);
+  std::sort(nodes.begin() + 1, nodes.end(),
+            [](const Point& a, const Point& b) { return a.y() < b.y(); });
+  std::vector<char> reached(nodes.size(), 0);
+  reached[0] = 1;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    if (!reached[i]) continue;
+    const Point& a = nodes[i];
+    // Max-speed edge to the line s = s_final (Abb. 4.14b).
+    const double t_goal = a.y() + (s_final_ - a.x()) / settings_.v_max;
+    if (t_goal < best && t_goal <= t_latest + 1e-12) {
+      const Point g(s_final_, std::max(t_goal, a.y()));
+      bool inside = false;
+      for (const auto& r : regions_) inside = inside || strictly_inside(g, r);
+      if (!inside && (g.y() > a.y() ? free(a, g) : true)) best = g.y();
+    }
+    for (std::size_t j = i + 1; j < nodes.size(); ++j) {
+      if (!reached[j] && edge_ok(a, nodes[j])) reached[j] = 1;
+    }
+  }
+  if (!std::isfinite(best)) return std::nullopt;
+  return fixed_arrival(std::max(best, t_start_));
+}
+
+}  // namespace oscar::swarm

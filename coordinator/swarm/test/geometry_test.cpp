@@ -1,0 +1,74 @@
+#include "oscar/swarm/geometry.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "oscar/swarm/spatial_path_finder.hpp"
+
+namespace oscar::swarm {
+namespace {
+
+Polygon square(double x0, double y0, double x1, double y1) {
+  return make_polygon({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, "square");
+}
+
+TEST(Geometry, SegmentAlongAnEdgeDoesNotHitTheInterior) {
+  const auto sq = square(0, 0, 1, 1);
+  EXPECT_FALSE(segment_hits_interior({0, 0}, {1, 0}, sq));
+  EXPECT_FALSE(segment_hits_interior({-1, 1}, {2, 1}, sq));
+  EXPECT_TRUE(segment_hits_interior({0, 0}, {1, 1}, sq));  // the diagonal runs inside
+  EXPECT_TRUE(segment_hits_interior({-1, 0.5}, {2, 0.5}, sq));
+  EXPECT_FALSE(segment_hits_interior({2, 2}, {3, 3}, sq));
+}
+
+TEST(Geometry, BadPolygonsAreRejectedWithTheirName) {
+  try {
+    make_polygon({{0, 0}, {1, 1}, {1, 0}, {0, 1}}, "job J1 area");
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("job J1 area"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("self-intersecting"), std::string::npos);
+  }
+  EXPECT_THROW(make_polygon({{0, 0}, {1, 1}}, "a"), std::invalid_argument);
+  EXPECT_THROW(make_polygon({{0, 0}, {1, 1}, {2, 2}}, "a"), std::invalid_argument);
+  EXPECT_THROW(make_polygon({{0, 0}, {1, std::nan("")}, {2, 0}}, "a"), std::invalid_argument);
+}
+
+TEST(Geometry, InflatedPolygonKeepsTheDistance) {
+  const auto grown = inflate(square(0, 0, 1, 1), 0.5);
+  for (const auto& v : vertices(grown)) {
+    EXPECT_GE(std::max({-v.x(), v.x() - 1, -v.y(), v.y() - 1}), 0.5 - 1e-9);
+  }
+  EXPECT_TRUE(strictly_inside({-0.4, 0.5}, grown));
+  EXPECT_FALSE(strictly_inside({-0.6, 0.5}, grown));
+}
+
+TEST(SpatialPathFinder, StraightLineWhenNothingIsInTheWay) {
+  SpatialPathFinder finder({square(5, 5, 6, 6)});
+  const auto path = finder.find({0, 0}, {3, 0});
+  ASSERT_TRUE(path);
+  EXPECT_EQ(path->size(), 2u);
+  EXPECT_NEAR(path_length(*path), 3, 1e-12);
+}
+
+TEST(SpatialPathFinder, GoesAroundASquareByItsCorners) {
+  SpatialPathFinder finder({square(1, -1, 2, 1)});
+  const auto path = finder.find({0, 0}, {3, 0});
+  ASSERT_TRUE(path);
+  ASSERT_EQ(path->size(), 4u);
+  EXPECT_NEAR(path_length(*path), 2 * std::sqrt(2.0) + 1, 1e-12);
+}
+
+TEST(SpatialPathFinder, NoPathIntoOrOutOfAnObstacle) {
+  SpatialPathFinder finder({square(1, -1, 2, 1)});
+  EXPECT_FALSE(finder.find({1.5, 0}, {3, 0}));
+  // A closed ring of overlapping walls around the start.
+  SpatialPathFinder walls({square(-2, -2, 2, -1), square(-2, 1, 2, 2), square(-2, -1.5, -1, 1.5),
+                           square(1, -1.5, 2, 1.5)});
+  EXPECT_FALSE(walls.find({0, 0}, {5, 5}));
+}
+
+}  // namespace
+}  // namespace oscar::swarm

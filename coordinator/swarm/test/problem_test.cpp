@@ -1,0 +1,99 @@
+#include "oscar/swarm/problem.hpp"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+#include "oscar/swarm/problem_runner.hpp"
+
+namespace oscar::swarm {
+namespace {
+
+const std::string kNodes = R"(
+nodes:
+  - { id: n1, radius: 0.1, max_speed: 0.5, start: [0, 0, 0] }
+)";
+
+void expect_error(const std::string& text, const std::string& part) {
+  try {
+    parse_problem(text, "p.yaml");
+    FAIL() << "no exception; expected '" << part << "'";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+  }
+}
+
+TEST(Problem, RunsAndWritesTheDocumentedJson) {
+  const auto p = parse_problem(kNodes + R"(
+operations:
+  - { op: schedule, job: { id: J1, area: [[4,2],[6,2],[6,4],[4,4]], earliest_start: 10, latest_finish: 60, duration: 10 } }
+  - { op: commit }
+)",
+                               "p.yaml");
+  ProblemRunner runner(p);
+  runner.run();
+  const auto doc = nlohmann::json::parse(runner.to_json());
+  ASSERT_EQ(doc["operations"].size(), 2u);
+  EXPECT_TRUE(doc["operations"][0]["ok"]);
+  EXPECT_EQ(doc["operations"][0]["transaction"], 1);
+  ASSERT_EQ(doc["jobs"].size(), 1u);
+  EXPECT_EQ(doc["jobs"][0]["node"], "n1");
+  EXPECT_DOUBLE_EQ(doc["jobs"][0]["x"].get<double>(), 5);
+  EXPECT_GE(doc["nodes"][0]["trajectory"].size(), 3u);
+  EXPECT_TRUE(doc["world"]["static"].is_array());
+}
+
+TEST(Problem, JsonInputWorksToo) {
+  const auto p = parse_problem(
+      R"({"nodes": [{"id": "n1", "radius": 0.1, "max_speed": 1, "start": [0, 0, 0]}],
+          "operations": [{"op": "set_present", "t": 3}]})",
+      "p.json");
+  EXPECT_EQ(p.operations.size(), 1u);
+}
+
+TEST(Problem, BadInputNamesFileLineAndRule) {
+  expect_error(kNodes +
+                   "operations:\n  - { op: schedule, job: { id: J, area: [[0,0],[1,0],[1,1]], "
+                   "earliest_start: .nan, latest_finish: 60, duration: 10 } }\n",
+               "p.yaml:5:");
+  expect_error(kNodes +
+                   "operations:\n  - { op: schedule, job: { id: J, area: [[0,0],[1,0],[1,1]], "
+                   "earliest_start: .nan, latest_finish: 60, duration: 10 } }\n",
+               "must be finite");
+  expect_error(
+      kNodes +
+          "operations:\n  - { op: schedule, job: { id: J, area: [[0,0],[1,1],[1,0],[0,1]], "
+          "earliest_start: 0, latest_finish: 60, duration: 10 } }\n",
+      "self-intersecting");
+  expect_error(kNodes +
+                   "operations:\n  - { op: schedule, job: { id: J, area: [], "
+                   "earliest_start: 0, latest_finish: 60, duration: 10 } }\n",
+               "at least 3 vertices");
+  expect_error(kNodes +
+                   "operations:\n  - { op: schedule, job: { id: J, area: [[0,0],[1,0],[1,1]], "
+                   "earliest_start: 0, latest_finish: 5, duration: 10 } }\n",
+               "shorter than the duration");
+  expect_error(kNodes + "operations:\n  - { op: unschedule, id: Q }\n",
+               "p.yaml:5:5: unschedule: unknown job id 'Q'");
+  expect_error(kNodes + "operations:\n  - { op: commit, node: n9 }\n", "unknown node id 'n9'");
+  expect_error(
+      kNodes + "operations:\n  - { op: set_present, t: 5 }\n  - { op: set_present, t: 4 }\n",
+      "p.yaml:6:5: set_present: present time must not go backwards");
+  expect_error(kNodes + R"(operations:
+  - op: schedule_dependent
+    jobs:
+      - { id: A, area: [[0,0],[1,0],[1,1]], earliest_start: 0, latest_finish: 60, duration: 1 }
+      - { id: B, area: [[0,0],[1,0],[1,1]], earliest_start: 0, latest_finish: 60, duration: 1 }
+    depends: { A: [B], B: [A] }
+)",
+               "cycle");
+  expect_error(kNodes + "operations:\n  - { op: fly }\n", "unknown op 'fly'");
+  expect_error("nodes:\n  - { id: n1, radius: 0.1, max_speed: .inf, start: [0, 0, 0] }\n",
+               "node 'n1' max_speed: must be finite");
+  expect_error(kNodes + "world: { static: [[[0,0],[1,0]]] }\n", "world.static[0]");
+  expect_error("nodes: [ {id: a", "not valid YAML");
+}
+
+}  // namespace
+}  // namespace oscar::swarm
