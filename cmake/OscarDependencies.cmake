@@ -10,12 +10,15 @@ find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 find_package(Boost 1.74 REQUIRED COMPONENTS graph)
 find_package(tl-expected REQUIRED)
 
-# Debian's OMPL 1.5 exports only variables (OMPL_INCLUDE_DIRS, OMPL_LIBRARIES).
+# Debian's OMPL 1.5 exports only variables (OMPL_INCLUDE_DIRS, OMPL_LIBRARIES), and its
+# OMPL_LIBRARIES names libboost_filesystem.so, which only libboost-filesystem-dev provides.
+# libompl.so records its own Boost dependencies, so linking it alone is enough.
 find_package(ompl REQUIRED)
 if(NOT TARGET oscar_deps::ompl)
+  list(GET OMPL_LIBRARIES 0 OSCAR_OMPL_LIBRARY)
   add_library(oscar_deps::ompl INTERFACE IMPORTED)
   target_include_directories(oscar_deps::ompl SYSTEM INTERFACE ${OMPL_INCLUDE_DIRS})
-  target_link_libraries(oscar_deps::ompl INTERFACE ${OMPL_LIBRARIES} Boost::boost)
+  target_link_libraries(oscar_deps::ompl INTERFACE ${OSCAR_OMPL_LIBRARY} Boost::boost)
 endif()
 
 if(OSCAR_BUILD_TESTS)
