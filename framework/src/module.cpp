@@ -220,17 +220,18 @@ void Module::stop() {
   dds_.reset();
 }
 
-void Module::run_slot(Slot& slot, Trigger trigger) {
+// Runs on the processing thread without the lock; `stub` was read under it.
+void Module::run_slot(Slot& slot, Trigger trigger, bool stub) {
   try {
     if (!slot.active) {
       slot.instance->kernel().on_activate();
       slot.active = true;
     }
-    slot.instance->run(wall_now(), trigger, slot.stub);
+    slot.instance->run(wall_now(), trigger, stub);
   } catch (const std::exception& e) {
     slot.failure = e.what();
     log_->error("kernel '{}' failed in {}: {}", slot.instance->name(),
-                slot.stub ? "stub()" : "process()", e.what());
+                stub ? "stub()" : "process()", e.what());
   }
 }
 
@@ -262,18 +263,18 @@ void Module::processing_loop() {
       }
       continue;
     }
-    std::vector<std::pair<Slot*, Trigger>> run;
+    std::vector<std::tuple<Slot*, Trigger, bool>> run;
     if (due && due->next_due <= now) {
-      run.emplace_back(due, Trigger::kCycle);
+      run.emplace_back(due, Trigger::kCycle, due->stub);
       for (auto& s : slots_) {
         if (s.get() != due && s->single_step() && s->mode.trigger == "module") {
-          run.emplace_back(s.get(), Trigger::kModule);
+          run.emplace_back(s.get(), Trigger::kModule, s->stub);
         }
       }
       due->next_due += due->mode.cycle;
     }
     lock.unlock();
-    for (auto [slot, trigger] : run) run_slot(*slot, trigger);
+    for (auto [slot, trigger, stub] : run) run_slot(*slot, trigger, stub);
     lock.lock();
     if (due && !run.empty()) {
       const auto after = Clock::now();
@@ -294,8 +295,9 @@ void Module::processing_loop() {
         s->pending = false;
         again = true;
         const auto trigger = s->mode.trigger == "command" ? Trigger::kCommand : Trigger::kInput;
+        const bool stub = s->stub;
         lock.unlock();
-        run_slot(*s, trigger);
+        run_slot(*s, trigger, stub);
         lock.lock();
       }
     }

@@ -1,6 +1,7 @@
 #pragma once
 // The frame's bookkeeping for one kernel (internal to Module).
 
+#include <atomic>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -16,7 +17,7 @@ struct Module::Slot {
   std::unique_ptr<KernelInstance> instance;
   ModeSpec mode;
   bool stub = false;
-  bool active = false;   // on_activate() ran and on_deactivate() did not
+  std::atomic<bool> active{false};  // on_activate() ran and on_deactivate() did not
   bool pending = false;  // a trigger arrived and the kernel has not run since
   std::chrono::steady_clock::time_point next_due{};
   std::uint64_t overruns = 0;

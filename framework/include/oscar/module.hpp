@@ -57,7 +57,7 @@ class Module {
   void check_multicore_rules() const;
   void wire_in_process();
   void processing_loop();
-  void run_slot(Slot& slot, Trigger trigger);
+  void run_slot(Slot& slot, Trigger trigger, bool stub);
   void mark_pending(Slot& slot);
   void post_and_wait(const std::function<void()>& task);
   void report(const std::string& transition);
