@@ -86,14 +86,15 @@ void OutputPort::publish_erased(std::shared_ptr<void> cue) {
   header.source(address());
   if (header.stamps().empty()) header.stamps().push_back(static_cast<unsigned long long>(clock_()));
   std::shared_ptr<const void> frozen = std::move(cue);
-  buffer_.push(frozen, generation_stamp(header), wall_now());
+  // The cue evicted from the ring is freed at the end, after the cue is on its way.
+  const auto evicted = buffer_.push(frozen, generation_stamp(header), wall_now());
   for (auto* input : consumers_) input->deliver(frozen);
   if (remote_) remote_(frozen.get());
 }
 
 void OutputPort::forward_erased(std::shared_ptr<const void> cue) {
   std::lock_guard lock(mutex_);
-  buffer_.push(cue, generation_stamp(type_.header(cue.get())), wall_now());
+  const auto evicted = buffer_.push(cue, generation_stamp(type_.header(cue.get())), wall_now());
   for (auto* input : consumers_) input->deliver(cue);
   if (remote_) remote_(cue.get());
 }

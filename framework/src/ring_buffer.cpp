@@ -11,17 +11,18 @@ RingBuffer::RingBuffer(std::size_t depth) : slots_(depth) {
   if (depth == 0) throw std::invalid_argument("ring buffer depth must be at least 1, got 0");
 }
 
-std::uint64_t RingBuffer::push(std::shared_ptr<const void> cue, Stamp t, Stamp received) {
-  std::uint64_t index = 0;
+std::shared_ptr<const void> RingBuffer::push(std::shared_ptr<const void> cue, Stamp t,
+                                             Stamp received) {
+  std::shared_ptr<const void> evicted;
   {
     std::lock_guard lock(mutex_);
-    index = ++pushed_;
-    slots_[next_] = RingEntry{std::move(cue), t, received, index};
+    evicted = std::move(slots_[next_].cue);
+    slots_[next_] = RingEntry{std::move(cue), t, received, ++pushed_};
     next_ = (next_ + 1) % slots_.size();
     count_ = std::min(count_ + 1, slots_.size());
   }
   arrived_.notify_all();
-  return index;
+  return evicted;
 }
 
 std::size_t RingBuffer::size() const {

@@ -29,8 +29,10 @@ class RingBuffer {
   /// @throws std::invalid_argument if depth is 0.
   explicit RingBuffer(std::size_t depth);
 
-  /// Stores a cue, evicting the oldest when full; wakes waiters. Returns the entry's index.
-  std::uint64_t push(std::shared_ptr<const void> cue, Stamp t, Stamp received);
+  /// Stores a cue, evicting the oldest when full; wakes waiters. Returns the evicted cue, so
+  /// the caller chooses when it is freed (a large cue's free can cost a system call, which a
+  /// publisher should not pay between stamping a cue and sending it).
+  std::shared_ptr<const void> push(std::shared_ptr<const void> cue, Stamp t, Stamp received);
 
   std::size_t depth() const { return slots_.size(); }
   std::size_t size() const;
