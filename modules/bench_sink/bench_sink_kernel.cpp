@@ -24,7 +24,7 @@ struct BenchSink::Ports {
 namespace {
 template <class T>
 struct TypedPorts final : BenchSink::Ports {
-  explicit TypedPorts(KernelSetup& setup) : in(setup.input<T>("in", {.depth = 256})) {}
+  explicit TypedPorts(KernelSetup& setup) : in(setup.input<T>("in", {.depth = 16})) {}
   void consume(Cycle& cycle, BenchSink::Stats& s, std::int64_t warmup) override {
     for (const auto& r : in.take_new()) {
       const auto& h = r.cue->header();

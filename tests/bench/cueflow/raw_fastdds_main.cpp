@@ -62,7 +62,7 @@ fdds::DataReaderQos reader_qos() {
   fdds::DataReaderQos q = fdds::DATAREADER_QOS_DEFAULT;
   q.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
   q.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
-  q.history().depth = 256;  // as bench_sink's input
+  q.history().depth = 16;  // as bench_sink's input
   q.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
   return q;
 }
