@@ -216,12 +216,12 @@ const std::vector<ServiceId>& Scheduler::closure(ServiceId service) const {
   auto& slot = closure_cache_.at(service);
   if (!slot) {
     std::set<ServiceId> seen{service};
-    std::vector<ServiceId> todo{service};
-    while (!todo.empty()) {
-      const ServiceId s = todo.back();
-      todo.pop_back();
+    std::vector<ServiceId> to_visit{service};
+    while (!to_visit.empty()) {
+      const ServiceId s = to_visit.back();
+      to_visit.pop_back();
       for (const Use& u : model_.needs(s)) {
-        if (seen.insert(u.service).second) todo.push_back(u.service);
+        if (seen.insert(u.service).second) to_visit.push_back(u.service);
       }
     }
     slot.emplace(seen.begin(), seen.end());

@@ -32,19 +32,19 @@ std::uint64_t holder_key(const Use& u) {
 std::vector<ClosureUse> closure_of(const Model& m, BundleId bundle) {
   std::vector<ClosureUse> out;
   std::set<ServiceId> expanded;
-  std::vector<ServiceId> todo;
+  std::vector<ServiceId> to_visit;
   for (ResourceId r : m.bundle(bundle).resources) {
     const Use u{m.resource(r).service, m.resource(r).access, Use::By::kResource, r};
     out.push_back({u.service, u.access, holder_key(u)});
-    todo.push_back(u.service);
+    to_visit.push_back(u.service);
   }
-  while (!todo.empty()) {
-    const ServiceId s = todo.back();
-    todo.pop_back();
+  while (!to_visit.empty()) {
+    const ServiceId s = to_visit.back();
+    to_visit.pop_back();
     if (!expanded.insert(s).second) continue;
     for (const Use& u : m.needs(s)) {
       out.push_back({u.service, u.access, holder_key(u)});
-      todo.push_back(u.service);
+      to_visit.push_back(u.service);
     }
   }
   return out;
