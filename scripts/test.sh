@@ -3,6 +3,8 @@
 # with warnings as errors and runs every test; then builds the tests with AddressSanitizer +
 # UBSan and with ThreadSanitizer and runs the unit and integration tests under each.
 # SANITIZERS="address thread" (default) chooses the sanitizer passes; SANITIZERS= skips them.
+# Sanitizer builds warn without -Werror: GCC 12 with -fsanitize=thread reports false
+# maybe-uninitialized warnings inside Boost.Geometry; the Release build keeps -Werror.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root="$PWD"
@@ -21,6 +23,6 @@ export TSAN_OPTIONS="suppressions=$root/tests/sanitizers/tsan.supp:halt_on_error
 for sanitizer in ${SANITIZERS-address thread}; do
   echo "== $sanitizer sanitizer: unit and integration tests"
   BUILD_DIR="build-$sanitizer" BUILD_TYPE=RelWithDebInfo bash scripts/build.sh \
-    -DOSCAR_SANITIZE="$sanitizer" -DOSCAR_BUILD_TESTS=ON -DOSCAR_BUILD_BENCHMARKS=OFF
+    -DOSCAR_SANITIZE="$sanitizer" -DOSCAR_BUILD_TESTS=ON -DOSCAR_BUILD_BENCHMARKS=OFF -DOSCAR_WERROR=OFF
   ctest --test-dir "build-$sanitizer" --output-on-failure --timeout 300 -L "unit|integration|applets|swarm"
 done
