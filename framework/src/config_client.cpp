@@ -1,11 +1,15 @@
 #include "oscar/config_client.hpp"
 
+#include <algorithm>
+
 #include <unistd.h>
 
 #include <thread>
 
 #include <fmt/format.h>
 #include <oscar/configPubSubTypes.h>
+
+#include "oscar/topic_io.hpp"
 
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
@@ -43,11 +47,7 @@ ConfigClient::Channel& ConfigClient::channel(const std::string& module) {
   wq.history().kind = dds::KEEP_ALL_HISTORY_QOS;
   c->writer = participant_.publisher().create_datawriter(
       &participant_.topic("oscar/config/" + module, new ConfigCommandPubSubType()), wq);
-  dds::DataReaderQos rq = dds::DATAREADER_QOS_DEFAULT;
-  rq.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  rq.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
-  rq.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-  rq.history().depth = 64;
+  const auto rq = qos::state_reader(64);
   c->reader = participant_.subscriber().create_datareader(
       &participant_.topic("oscar/config_reply/" + module, new ConfigReplyPubSubType()), rq);
   return *c;
@@ -78,8 +78,15 @@ ConfigReply ConfigClient::send(const std::string& module, CommandKind kind,
   cmd.target(module);
   cmd.kind(kind);
   cmd.args(std::move(args));
-  c.writer->write(&cmd);
+  // At least once: a module that was just restarted may not read this writer yet while its dead
+  // predecessor still counts as matched, so the command is repeated (same id; the module
+  // answers a repeat from its memory) until the reply comes.
+  auto resend = std::chrono::steady_clock::now();
   while (std::chrono::steady_clock::now() < until) {
+    if (std::chrono::steady_clock::now() >= resend) {
+      c.writer->write(&cmd);
+      resend += std::chrono::milliseconds(100);
+    }
     ConfigReply reply;
     dds::SampleInfo info;
     while (c.reader->take_next_sample(&reply, &info) == ReturnCode_t::RETCODE_OK) {
@@ -97,9 +104,10 @@ CommandKind parse_command_kind(const std::string& text) {
       {"set_cycle", CMD_SET_CYCLE}, {"set_param", CMD_SET_PARAM},   {"rewire", CMD_REWIRE},
       {"suspend", CMD_SUSPEND},     {"resume", CMD_RESUME},         {"stub", CMD_STUB},
       {"shutdown", CMD_SHUTDOWN}};
-  std::string known;
+  std::string known, wanted = text;
+  std::replace(wanted.begin(), wanted.end(), '-', '_');  // `set-cycle` as well as `set_cycle`
   for (const auto& [name, kind] : kinds) {
-    if (text == name) return kind;
+    if (wanted == name) return kind;
     known += (known.empty() ? "" : ", ") + std::string(name);
   }
   throw std::invalid_argument(fmt::format("unknown command '{}' (commands: {})", text, known));

@@ -126,6 +126,23 @@ NetworkConfig NetworkConfig::from_yaml(const YAML::Node& node) {
   return net;
 }
 
+NetworkConfig NetworkConfig::for_host(const YAML::Node& system, const std::string& host) {
+  if (system["network"]) return from_yaml(system["network"]);
+  NetworkConfig net;
+  const auto hosts = system["hosts"];
+  if (!hosts || !hosts.IsMap() || host.empty() || !hosts[host] || !hosts[host]["address"]) {
+    return net;
+  }
+  net.interfaces = {hosts[host]["address"].as<std::string>()};
+  net.peers.clear();
+  for (const auto& kv : hosts) {
+    if (kv.second.IsMap() && kv.second["address"]) {
+      net.peers.push_back(kv.second["address"].as<std::string>());
+    }
+  }
+  return net;
+}
+
 int domain_from_env(int fallback) {
   const char* env = std::getenv("OSCAR_DOMAIN");
   if (!env || !*env) return fallback;

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <future>
 #include <map>
 #include <set>
@@ -16,6 +17,7 @@
 #include "module_dds.hpp"
 #include "module_slot.hpp"
 #include "ring_pull_source.hpp"
+#include "sequence_store.hpp"
 
 namespace oscar {
 
@@ -71,6 +73,9 @@ Module::Module(ModuleSpec spec, const std::vector<std::string>& plugin_path)
     }
     slot->mode = spec_.effective_mode(k);
     slot->stub = spec_.stub;
+    for (const auto& [input, wiring] : k.inputs) {
+      if (!wiring.source.empty()) slot->sources[input] = wiring.source;
+    }
     slots_.push_back(std::move(slot));
   }
   check_multicore_rules();
@@ -174,6 +179,15 @@ void Module::mark_pending(Slot& slot) {
 }
 
 void Module::start(int domain) {
+  // Under a monitor, outputs continue the numbering of the module's earlier incarnations.
+  if (const char* run_dir = std::getenv("OSCAR_RUN_DIR"); run_dir && *run_dir) {
+    sequences_ = std::make_unique<internal::SequenceStore>(run_dir, spec_.name);
+    for (auto& s : slots_) {
+      for (auto& out : s->instance->ports().outputs) {
+        out->persist_sequence(sequences_->counter(out->address()));
+      }
+    }
+  }
   if (domain >= 0) {
     dds_ = std::make_unique<Dds>(*this, domain);
     dds_->wire_outputs(slots_);
@@ -188,6 +202,7 @@ void Module::start(int domain) {
     std::lock_guard lock(mutex_);
     const auto now = Clock::now();
     for (auto& s : slots_) s->next_due = now;
+    suspended_ = spec_.start_suspended;
   }
   processing_ = std::thread([this] { processing_loop(); });
   if (dds_) dds_->start_config();
@@ -227,8 +242,11 @@ void Module::run_slot(Slot& slot, Trigger trigger, bool stub) {
       slot.instance->kernel().on_activate();
       slot.active = true;
     }
+    busy_since_ns_.store(Clock::now().time_since_epoch().count(), std::memory_order_relaxed);
     slot.instance->run(wall_now(), trigger, stub);
+    busy_since_ns_.store(0, std::memory_order_relaxed);
   } catch (const std::exception& e) {
+    busy_since_ns_.store(0, std::memory_order_relaxed);
     slot.failure = e.what();
     log_->error("kernel '{}' failed in {}: {}", slot.instance->name(),
                 stub ? "stub()" : "process()", e.what());
@@ -335,6 +353,12 @@ void Module::report(const std::string& transition) {
   if (dds_) dds_->publish_state(state());
 }
 
+bool Module::hung() const {
+  const auto since = busy_since_ns_.load(std::memory_order_relaxed);
+  return since != 0 && Clock::now().time_since_epoch().count() - since >
+                           std::chrono::nanoseconds(spec_.watchdog).count();
+}
+
 ModuleState Module::state() const {
   std::lock_guard lock(mutex_);
   return state_locked();
@@ -345,6 +369,7 @@ ModuleState Module::state_locked() const {
   st.module_name(spec_.name);
   st.host(spec_.host);
   st.pid(static_cast<std::int32_t>(getpid()));
+  st.incarnation(spec_.incarnation);
   st.suspended(suspended_);
   st.last_transition(last_transition_);
   for (const auto& s : slots_) {
@@ -357,6 +382,11 @@ ModuleState Module::state_locked() const {
     k.stub(s->stub);
     k.cycles(s->instance->cycles());
     k.overruns(s->overruns);
+    std::uint64_t published = 0;
+    for (const auto& out : s->instance->ports().outputs) published += out->published();
+    k.published(published);
+    k.params(s->instance->ports().params.to_yaml());
+    for (const auto& [input, source] : s->sources) k.inputs().push_back(input + "=" + source);
     st.kernels().push_back(std::move(k));
   }
   return st;

@@ -182,7 +182,10 @@ ConfigReply Module::apply(const ConfigCommand& c) {
                           c.args()[1], s.instance->name()));
         }
         post_and_wait([&] {
-          s.instance->ports().params.set_text(c.args()[1], c.args()[2]);
+          {
+            std::lock_guard lock(mutex_);  // state() reads the values from another thread
+            s.instance->ports().params.set_text(c.args()[1], c.args()[2]);
+          }
           s.instance->kernel().on_params_changed();
         });
         transition = fmt::format("{}: {} = {}", s.instance->name(), c.args()[1], c.args()[2]);
@@ -261,6 +264,8 @@ void Module::rewire(Slot& slot, const std::string& input_name, const std::string
     throw std::invalid_argument(fmt::format(
         "source '{}' is not in module '{}' and the module runs without DDS", source, spec_.name));
   }
+  std::lock_guard lock(mutex_);
+  slot.sources[input_name] = source;
 }
 
 }  // namespace oscar

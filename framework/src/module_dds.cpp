@@ -1,6 +1,7 @@
 #include "module_dds.hpp"
 
 #include "dds_log_sink.hpp"
+#include "oscar/topic_io.hpp"
 
 #include <unistd.h>
 
@@ -10,6 +11,7 @@
 
 #include <fmt/format.h>
 #include <oscar/configPubSubTypes.h>
+#include <oscar/registryPubSubTypes.h>
 
 namespace oscar {
 namespace dds = eprosima::fastdds::dds;
@@ -188,23 +190,15 @@ void Module::Dds::disconnect_input(InputPort& input) {
 
 void Module::Dds::start_config() {
   const auto& name = module_.spec_.name;
-  dds::DataWriterQos state_qos = dds::DATAWRITER_QOS_DEFAULT;
-  state_qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  state_qos.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
-  state_qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-  state_qos.history().depth = 1;
   state_writer_ = participant_.publisher().create_datawriter(
-      &participant_.topic("oscar/registry/module_state", new ModuleStatePubSubType()), state_qos);
+      &participant_.topic("oscar/registry/module_state", new ModuleStatePubSubType()),
+      qos::state_writer());
 
   // Transient-local: a client whose reader this writer has not matched yet still gets the
   // reply once it does (discovery is not symmetric in time).
-  dds::DataWriterQos reply_qos = dds::DATAWRITER_QOS_DEFAULT;
-  reply_qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  reply_qos.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
-  reply_qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-  reply_qos.history().depth = 64;
   reply_writer_ = participant_.publisher().create_datawriter(
-      &participant_.topic("oscar/config_reply/" + name, new ConfigReplyPubSubType()), reply_qos);
+      &participant_.topic("oscar/config_reply/" + name, new ConfigReplyPubSubType()),
+      qos::state_writer(64));
 
   dds::DataReaderQos config_qos = dds::DATAREADER_QOS_DEFAULT;
   config_qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
@@ -219,7 +213,12 @@ void Module::Dds::start_config() {
   log_qos.history().depth = 100;
   log_writer_ = participant_.publisher().create_datawriter(
       &participant_.topic("oscar/log", new LogRecordPubSubType()), log_qos);
-  if (!state_writer_ || !reply_writer_ || !config_reader_ || !log_writer_) {
+  // The heartbeat: manual-by-topic liveliness with the module's lease (DESIGN §4). It stops
+  // when the process stops (SIGSTOP, crash) or a kernel call outlives the watchdog.
+  beat_writer_ = participant_.publisher().create_datawriter(
+      &participant_.topic("oscar/registry/alive", new ModuleBeatPubSubType()),
+      qos::beat_writer(module_.spec_.lease));
+  if (!state_writer_ || !reply_writer_ || !config_reader_ || !log_writer_ || !beat_writer_) {
     throw std::runtime_error("cannot create the configuration endpoints of module " + name);
   }
   {
@@ -227,6 +226,7 @@ void Module::Dds::start_config() {
     serving_ = true;
   }
   config_thread_ = std::thread([this] { serve_config(); });
+  beat_thread_ = std::thread([this] { beat(); });
   module_.log_sink_->attach(log_writer_);
 }
 
@@ -240,9 +240,34 @@ void Module::Dds::serve_config() {
     auto command = std::move(queue_.front());
     queue_.pop_front();
     lock.unlock();
-    auto reply = module_.apply(command);
-    reply_writer_->write(&reply);
+    // A repeated command (same sender and id: the client did not see our reply) is answered
+    // again, not applied twice.
+    auto& last = last_reply_[command.sender()];
+    if (last.id() != command.id() || last.module_name().empty()) last = module_.apply(command);
+    reply_writer_->write(&last);
     lock.lock();
+  }
+}
+
+// Every lease/3 a heartbeat (unless a kernel hangs); every second the module state, whose
+// counters give `oscar ps` its rates.
+void Module::Dds::beat() {
+  const auto period = std::max(module_.spec_.lease / 3, std::chrono::milliseconds(1));
+  ModuleBeat b;
+  b.module_name(module_.spec_.name);
+  b.incarnation(module_.spec_.incarnation);
+  b.pid(static_cast<std::int32_t>(getpid()));
+  auto next_state = std::chrono::steady_clock::now();
+  std::unique_lock lock(queue_mutex_);
+  while (serving_) {
+    lock.unlock();
+    if (!module_.hung()) beat_writer_->write(&b);
+    if (std::chrono::steady_clock::now() >= next_state) {
+      publish_state(module_.state());
+      next_state += std::chrono::seconds(1);
+    }
+    lock.lock();
+    queue_cv_.wait_for(lock, period, [&] { return !serving_; });
   }
 }
 
@@ -254,6 +279,7 @@ void Module::Dds::stop_config() {
     queue_cv_.notify_all();
   }
   if (config_thread_.joinable()) config_thread_.join();
+  if (beat_thread_.joinable()) beat_thread_.join();
   if (config_reader_) participant_.subscriber().delete_datareader(config_reader_);
   config_reader_ = nullptr;
 }

@@ -44,6 +44,7 @@ class Module::Dds {
   class OutputWriter;
   class ConfigListener;
   void serve_config();
+  void beat();
 
   Module& module_;
   DdsParticipant participant_;
@@ -61,8 +62,11 @@ class Module::Dds {
   std::mutex queue_mutex_;
   std::condition_variable queue_cv_;
   std::deque<ConfigCommand> queue_;
+  std::map<std::string, ConfigReply> last_reply_;  // by sender: answers repeated commands
   bool serving_ = false;
   std::thread config_thread_;
+  eprosima::fastdds::dds::DataWriter* beat_writer_ = nullptr;
+  std::thread beat_thread_;
 };
 
 }  // namespace oscar

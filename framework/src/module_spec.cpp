@@ -16,17 +16,6 @@ namespace {
   throw std::invalid_argument(at + ": " + message);
 }
 
-void check_keys(const YAML::Node& map, const std::string& file, const std::string& what,
-                std::initializer_list<const char*> allowed) {
-  for (const auto& kv : map) {
-    const auto key = kv.first.as<std::string>();
-    if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
-      fail(yaml_where(file, kv.first),
-           fmt::format("{}: unknown key '{}' (allowed: {})", what, key, fmt::join(allowed, ", ")));
-    }
-  }
-}
-
 std::string scalar(const YAML::Node& node, const std::string& file, const std::string& what) {
   if (!node || !node.IsScalar() || node.Scalar().empty()) {
     fail(node ? yaml_where(file, node) : file, what + " must be a non-empty string");
@@ -46,7 +35,7 @@ InputWiring parse_wiring(const YAML::Node& node, const std::string& file, const 
   if (node.IsScalar()) {
     w.source = node.Scalar();
   } else if (node.IsMap()) {
-    check_keys(node, file, what, {"source", "transfer", "depth"});
+    check_yaml_keys(node, file, what, {"source", "transfer", "depth"});
     if (node["source"]) w.source = scalar(node["source"], file, what + ".source");
     try {
       if (node["transfer"]) w.transfer = parse_transfer(node["transfer"].as<std::string>());
@@ -71,7 +60,7 @@ InputWiring parse_wiring(const YAML::Node& node, const std::string& file, const 
 KernelSpec parse_kernel(const YAML::Node& node, const std::string& file, std::size_t index) {
   const auto what = fmt::format("kernels[{}]", index);
   if (!node.IsMap()) fail(yaml_where(file, node), what + ": expected a map with type and name");
-  check_keys(node, file, what, {"type", "name", "params", "inputs", "mode"});
+  check_yaml_keys(node, file, what, {"type", "name", "params", "inputs", "mode"});
   KernelSpec k;
   k.where = yaml_where(file, node);
   k.type = scalar(node["type"], file.empty() ? k.where : file, what + ".type");
@@ -117,6 +106,17 @@ KernelSpec parse_kernel(const YAML::Node& node, const std::string& file, std::si
 }
 
 }  // namespace
+
+void check_yaml_keys(const YAML::Node& map, const std::string& file, const std::string& what,
+                     std::initializer_list<const char*> allowed) {
+  for (const auto& kv : map) {
+    const auto key = kv.first.as<std::string>();
+    if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
+      fail(yaml_where(file, kv.first),
+           fmt::format("{}: unknown key '{}' (allowed: {})", what, key, fmt::join(allowed, ", ")));
+    }
+  }
+}
 
 std::string yaml_where(const std::string& file, const YAML::Node& node) {
   const auto mark = node.Mark();
@@ -206,8 +206,9 @@ ModeSpec ModeSpec::parse(const YAML::Node& node) {
 
 ModuleSpec ModuleSpec::from_yaml(const YAML::Node& node, const std::string& file) {
   if (!node || !node.IsMap()) fail(file, "a module must be a map with name and kernels");
-  check_keys(node, file, "module",
-             {"name", "host", "domain", "kernels", "mode", "stub", "network", "restart", "debug"});
+  check_yaml_keys(node, file, "module",
+                  {"name", "host", "domain", "kernels", "mode", "stub", "network", "restart",
+                   "debug", "watchdog", "standby"});
   ModuleSpec m;
   m.where = yaml_where(file, node);
   m.name = scalar(node["name"], m.where, "module name");
@@ -238,6 +239,15 @@ ModuleSpec ModuleSpec::from_yaml(const YAML::Node& node, const std::string& file
     }
   }
   if (node["stub"]) m.stub = node["stub"].as<bool>();
+  if (node["watchdog"]) {
+    try {
+      m.watchdog = std::chrono::duration_cast<std::chrono::milliseconds>(
+          parse_duration(node["watchdog"].as<std::string>()));
+    } catch (const std::exception& e) {
+      fail(yaml_where(file, node["watchdog"]), std::string("watchdog: ") + e.what());
+    }
+    if (m.watchdog.count() <= 0) fail(yaml_where(file, node["watchdog"]), "watchdog must be > 0");
+  }
   try {
     m.network = NetworkConfig::from_yaml(node["network"]);
   } catch (const std::invalid_argument& e) {
@@ -257,8 +267,11 @@ ModuleSpec ModuleSpec::load(const std::string& path, const std::string& module) 
         if (module.empty() && modules.size() > 1) break;
         auto spec = from_yaml(m, path);
         if (!spec.domain && root["domain"]) spec.domain = root["domain"].as<int>();
-        if (!m["network"] && root["network"])
-          spec.network = NetworkConfig::from_yaml(root["network"]);
+        if (!m["network"]) spec.network = NetworkConfig::for_host(root, spec.host);
+        if (root["lease"]) {
+          spec.lease = std::chrono::duration_cast<std::chrono::milliseconds>(
+              parse_duration(root["lease"].as<std::string>()));
+        }
         return spec;
       }
     }

@@ -83,6 +83,7 @@ void OutputPort::publish_erased(std::shared_ptr<void> cue) {
   auto& header = const_cast<CueHeader&>(type_.header(cue.get()));
   std::lock_guard lock(mutex_);
   header.seq(++seq_);
+  if (persisted_seq_) *persisted_seq_ = seq_;
   header.source(address());
   if (header.stamps().empty()) header.stamps().push_back(static_cast<unsigned long long>(clock_()));
   std::shared_ptr<const void> frozen = std::move(cue);
@@ -119,6 +120,12 @@ void OutputPort::disconnect(InputPort* input) {
 void OutputPort::set_remote(std::function<void(const void*)> remote) {
   std::lock_guard lock(mutex_);
   remote_ = std::move(remote);
+}
+
+void OutputPort::persist_sequence(std::uint64_t* counter) {
+  std::lock_guard lock(mutex_);
+  persisted_seq_ = counter;
+  seq_ = std::max(seq_, *counter);
 }
 
 void OutputPort::set_clock(std::function<Stamp()> clock) {

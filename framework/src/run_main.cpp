@@ -58,7 +58,8 @@ int run_main(int argc, char** argv) {
   std::string file, module_name, mode, name = "module";
   std::vector<std::string> kernels, params, inputs, plugins;
   int domain = -1;
-  bool stub = false, check = false, list = false, modules = false;
+  unsigned incarnation = 1;
+  bool stub = false, check = false, list = false, modules = false, suspended = false;
   app.add_option("file", file, "module YAML (one module map, or a system file with --module)");
   app.add_option("--module", module_name, "the module of a system file to run");
   app.add_option("--name", name, "module name when kernels are given on the command line");
@@ -70,6 +71,9 @@ int run_main(int argc, char** argv) {
   app.add_option("-d,--domain", domain, "DDS domain (default: the file's, $OSCAR_DOMAIN, or 0)");
   app.add_option("--plugin", plugins, "plugin file to load first (repeatable)");
   app.add_flag("--stub", stub, "start every kernel in stub mode");
+  app.add_option("--incarnation", incarnation, "which start of this module this is (registry)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--suspended", suspended, "start suspended (the registry resumes it)");
   app.add_flag("--check", check, "load and check the module, print it, and exit");
   app.add_flag("--list-types", list, "list the kernel types that can be loaded and exit");
   app.add_flag("--list-modules", modules, "list the modules of the system file and exit");
@@ -100,6 +104,8 @@ int run_main(int argc, char** argv) {
                              : ModuleSpec::load(file, module_name);
     if (!mode.empty()) spec.mode = ModeSpec::parse_text(mode);
     if (stub) spec.stub = true;
+    spec.incarnation = incarnation;
+    spec.start_suspended = suspended;
     Module module(std::move(spec), plugin_search_path());
     if (check) {
       const auto state = module.state();  // kept: a range-for would not extend its life

@@ -6,31 +6,32 @@
 #include <CLI/CLI.hpp>
 
 #include <oscar/config_client.hpp>
-#include <oscar/dds_participant.hpp>
+#include <oscar/registry/registry_client.hpp>
 
 int main(int argc, char** argv) {
   CLI::App app{
       "oscar config: send a configuration command to a module (DESIGN §6).\n"
       "Commands: activate KERNEL|* [MODE], deactivate KERNEL|*, trigger KERNEL|*,\n"
-      "set_cycle KERNEL CYCLE, set_param KERNEL NAME VALUE, rewire KERNEL INPUT SOURCE,\n"
+      "set-cycle KERNEL CYCLE, set-param KERNEL NAME VALUE, rewire KERNEL INPUT SOURCE,\n"
       "suspend, resume, stub KERNEL|* on|off, shutdown.\n"
       "Only the coordinator configures modules: an operator acts with its authority only with\n"
       "--as coordinator."};
-  std::string module, command, as = "operator";
+  std::string module, command, as = "operator", system_file, host;
   std::vector<std::string> args;
   int domain = -1, timeout_ms = 3000;
   app.add_option("module", module, "target module")->required();
   app.add_option("command", command, "command kind")->required();
   app.add_option("args", args, "command arguments");
   app.add_option("--as", as, "sender authority: coordinator, registry, boot (default: operator)");
-  app.add_option("-d,--domain", domain, "DDS domain (default: $OSCAR_DOMAIN or 0)");
+  app.add_option("--system", system_file, "system file (its domain and network)");
+  app.add_option("--host", host, "the host this runs on (with --system)");
+  app.add_option("-d,--domain", domain, "DDS domain (default: the system's, $OSCAR_DOMAIN or 0)");
   app.add_option("--timeout-ms", timeout_ms, "how long to wait for the module");
   CLI11_PARSE(app, argc, argv);
   try {
     const auto kind = oscar::parse_command_kind(command);
-    oscar::DdsParticipant participant(domain >= 0 ? domain : oscar::domain_from_env(0),
-                                      "oscar:config");
-    oscar::ConfigClient client(participant, as);
+    auto participant = oscar::tool_participant("oscar:config", system_file, host, domain);
+    oscar::ConfigClient client(*participant, as);
     const auto reply = client.send(module, kind, args, std::chrono::milliseconds(timeout_ms));
     if (!reply.ok()) {
       std::fprintf(stderr, "oscar config: %s: %s\n", module.c_str(), reply.error().c_str());

@@ -16,11 +16,16 @@ const char* const kUsage =
     "usage: oscar <command> [args...]\n"
     "\n"
     "commands (each is the program oscar-<command>):\n"
+    "  boot SYSTEM.yaml      boot a system across hosts; follow its log until Ctrl-C\n"
+    "  ps                    the running system's modules: host, pid, state, restarts, rates\n"
+    "  restart MODULE        restart a module (also one given up or on manual policy)\n"
+    "  shutdown              stop the running system in order\n"
+    "  log                   follow the merged log of the running system\n"
     "  run ...               host kernels in one module process (oscar-run)\n"
     "  config MODULE CMD ... send a configuration command to a module\n"
     "  applets run FILE      run an applet-scheduler scenario\n"
     "  swarm plan FILE       plan jobs and trajectories for a swarm\n"
-    "  bench <what> ...      benchmarks: cueflow, applets, swarm\n"
+    "  bench <what> ...      benchmarks: cueflow, restart, applets, swarm\n"
     "\n"
     "`oscar <command> --help` shows a command's options.\n";
 
@@ -41,7 +46,7 @@ int main(int argc, char** argv) {
   int first_arg = 2;
   if (program == "oscar-bench") {
     if (argc < 3) {
-      std::fputs("usage: oscar bench <cueflow|applets|swarm> [args...]\n", stderr);
+      std::fputs("usage: oscar bench <cueflow|restart|applets|swarm> [args...]\n", stderr);
       return 2;
     }
     program += std::string("-") + argv[2];

@@ -3,6 +3,7 @@
 /// kernels, does all communication (DDS and in-process handoff), runs the kernels in one
 /// processing thread according to their modes, and obeys configuration commands.
 
+#include <atomic>
 #include <condition_variable>
 #include <deque>
 #include <functional>
@@ -22,7 +23,8 @@ namespace oscar {
 class DdsParticipant;
 namespace internal {
 class DdsLogSink;
-}
+class SequenceStore;
+}  // namespace internal
 
 class Module {
  public:
@@ -46,6 +48,8 @@ class Module {
   /// Applies a configuration command (as one arriving on oscar/config/<module> would be).
   ConfigReply apply(const ConfigCommand& command);
   ModuleState state() const;
+  /// True while one kernel call has run longer than the watchdog limit (the heartbeat stops).
+  bool hung() const;
 
   const ModuleSpec& spec() const { return spec_; }
   KernelInstance& kernel(const std::string& name);
@@ -79,7 +83,9 @@ class Module {
   bool stop_requested_ = false;
   std::condition_variable stopped_;
   std::string last_transition_;
+  std::atomic<std::int64_t> busy_since_ns_{0};  // steady clock; 0 while no kernel runs
   std::thread processing_;
+  std::unique_ptr<internal::SequenceStore> sequences_;  // declared before dds_: outlives it
   std::unique_ptr<Dds> dds_;
 };
 

@@ -3,6 +3,7 @@
 /// an oscar-run fragment) and checked against the seed's multi-core rules (seed 004 §2.2).
 
 #include <chrono>
+#include <initializer_list>
 #include <map>
 #include <optional>
 #include <string>
@@ -55,6 +56,14 @@ struct ModuleSpec {
   bool stub = false;
   NetworkConfig network;
   std::string where;
+  /// Which start of this module this is (1 = first; the registry counts restarts).
+  std::uint32_t incarnation = 1;
+  /// Start with all kernels suspended (a restart waits for its configuration to be re-applied).
+  bool start_suspended = false;
+  /// Liveliness lease of the module's heartbeat (DESIGN §4: default 300 ms).
+  std::chrono::milliseconds lease{300};
+  /// A kernel call running longer than this stops the heartbeat: the registry sees a hang.
+  std::chrono::milliseconds watchdog{2000};
 
   /// Parses one module map. `file` names the source in messages ("file:line: ...").
   /// @throws std::invalid_argument for unknown keys, missing names, duplicate kernel names,
@@ -72,6 +81,10 @@ struct ModuleSpec {
 
 /// Loads a YAML file; syntax errors become std::invalid_argument "file:line:col: message".
 YAML::Node load_yaml_file(const std::string& path);
+
+/// @throws std::invalid_argument "file:line: <what>: unknown key 'k' (allowed: ...)".
+void check_yaml_keys(const YAML::Node& map, const std::string& file, const std::string& what,
+                     std::initializer_list<const char*> allowed);
 
 /// "file:line" of a node (1-based line), for error messages.
 std::string yaml_where(const std::string& file, const YAML::Node& node);

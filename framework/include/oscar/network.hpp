@@ -24,6 +24,10 @@ struct NetworkConfig {
   /// Reads a `network:` map (interfaces, peers, shared_memory, shm_segment_bytes).
   /// @throws std::invalid_argument on unknown keys or non-IPv4 addresses.
   static NetworkConfig from_yaml(const YAML::Node& node);
+  /// The profile of a process on `host` of a system file: the file's `network:` if given, else
+  /// the loopback default; a host with an `address:` (a test host in a network namespace) uses
+  /// that address and announces itself to the addresses of all the system's hosts.
+  static NetworkConfig for_host(const YAML::Node& system, const std::string& host);
 };
 
 /// The domain id from $OSCAR_DOMAIN, else `fallback`.

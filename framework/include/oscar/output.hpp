@@ -50,6 +50,9 @@ class OutputPort {
   void set_remote(std::function<void(const void*)> remote);
   /// The clock that stamps generation times (wall clock by default; harnesses set their own).
   void set_clock(std::function<Stamp()> clock);
+  /// Continues numbering after `*counter` and stores every new number there (the frame points
+  /// it into a file that outlives the process, so a restart never repeats a number).
+  void persist_sequence(std::uint64_t* counter);
 
  private:
   std::string kernel_, name_;
@@ -57,6 +60,7 @@ class OutputPort {
   OutputOptions options_;
   RingBuffer buffer_;
   std::uint64_t seq_ = 0;
+  std::uint64_t* persisted_seq_ = nullptr;
   std::mutex mutex_;  // guards consumers_, remote_, clock_ against rewiring
   std::vector<InputPort*> consumers_;
   std::function<void(const void*)> remote_;

@@ -1,0 +1,70 @@
+#include "oscar/topic_io.hpp"
+
+namespace oscar::qos {
+namespace dds = eprosima::fastdds::dds;
+
+namespace {
+// The system types nest sequences (SystemState > ModuleState > KernelState > strings): their
+// largest possible sample is hundreds of MB, and preallocated histories would reserve that many
+// times over. Samples are allocated as large as they really are instead.
+constexpr auto kDynamic = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+
+eprosima::fastrtps::Duration_t seconds(std::chrono::milliseconds d) {
+  return eprosima::fastrtps::Duration_t(static_cast<double>(d.count()) / 1000.0);
+}
+}  // namespace
+
+dds::DataWriterQos state_writer(int depth) {
+  dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
+  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  q.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
+  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = depth;
+  q.endpoint().history_memory_policy = kDynamic;
+  return q;
+}
+
+dds::DataReaderQos state_reader(int depth) {
+  dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
+  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  q.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
+  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = depth;
+  q.endpoint().history_memory_policy = kDynamic;
+  return q;
+}
+
+dds::DataReaderQos stream_reader(int depth) {
+  dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
+  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
+  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = depth;
+  q.endpoint().history_memory_policy = kDynamic;
+  return q;
+}
+
+dds::DataWriterQos beat_writer(std::chrono::milliseconds lease) {
+  dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
+  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = 1;
+  q.endpoint().history_memory_policy = kDynamic;
+  q.liveliness().kind = dds::MANUAL_BY_TOPIC_LIVELINESS_QOS;
+  q.liveliness().lease_duration = seconds(lease);
+  q.liveliness().announcement_period = seconds(lease / 3);
+  return q;
+}
+
+dds::DataReaderQos beat_reader(std::chrono::milliseconds lease) {
+  dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
+  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = 1;
+  q.endpoint().history_memory_policy = kDynamic;
+  q.liveliness().kind = dds::MANUAL_BY_TOPIC_LIVELINESS_QOS;
+  q.liveliness().lease_duration = seconds(lease);
+  return q;
+}
+
+}  // namespace oscar::qos

@@ -1,0 +1,90 @@
+#pragma once
+/// @file Registry: holds the system graph and keeps the system running (DESIGN §7, seed 004
+/// §2.4). Launches every module through its host's monitor, learns of failures three ways
+/// (process events from monitors, lapsed module heartbeats, lost monitors), suspends the
+/// system, restarts/replaces per policy, re-applies configuration and wiring, and resumes.
+
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <oscar/registry.h>
+
+#include "oscar/config_client.hpp"
+#include "oscar/dds_participant.hpp"
+#include "oscar/registry/system_spec.hpp"
+
+namespace oscar {
+
+class Registry {
+ public:
+  /// Joins the system's domain on `participant`; acquires no processes until run().
+  Registry(const SystemSpec& system, DdsParticipant& participant);
+  ~Registry();
+  Registry(const Registry&) = delete;
+  Registry& operator=(const Registry&) = delete;
+
+  /// Boots the system and keeps it running until a shutdown request (or stop()); then stops the
+  /// modules in reverse order and tells the monitors to exit.
+  void run();
+  /// Asks run() to shut the system down and return (thread-safe).
+  void stop();
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  struct Tracked;
+  struct Monitor {
+    long pid = 0;
+    bool alive = false;
+    std::string log_dir;
+  };
+  class Io;
+
+  // Everything below runs on the run() thread; DDS callbacks only post().
+  void post(std::function<void()> event);
+  void on_monitor_beat(const MonitorBeat& beat);
+  void on_monitor_lost(const std::string& host, long pid);
+  void on_process_event(const ProcessEvent& event);
+  void on_module_state(const ModuleState& state);
+  void on_module_lost(const std::string& module, unsigned incarnation);
+  void on_request(const RegistryRequest& request);
+  void tick();
+
+  void fail(Tracked& m, const std::string& reason, bool process_gone);
+  void launch(Tracked& m, unsigned incarnation, bool suspended);
+  void started(Tracked& m, const ModuleState& state);
+  void reapply(Tracked& m, const ModuleState& now);
+  void rewire_consumers(const Tracked& failed, const Tracked& replacement);
+  void suspend_all();
+  void resume_if_whole();
+  bool configure(const std::string& module, CommandKind kind, std::vector<std::string> args);
+  void shutdown();
+  void set_system(const std::string& state, const std::string& message);
+  void publish();
+  Tracked* find(const std::string& name);
+
+  const SystemSpec& system_;
+  DdsParticipant& participant_;
+  ConfigClient config_;
+  std::vector<std::unique_ptr<Tracked>> modules_;  // in system file order
+  std::map<std::string, Monitor> monitors_;        // by host
+  std::string state_ = "booting";
+  std::string message_;
+  unsigned long long next_request_id_ = 1;
+  bool shutting_down_ = false;
+  Clock::time_point last_publish_{};
+
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<std::function<void()>> events_;
+  bool stop_requested_ = false;
+  std::unique_ptr<Io> io_;  // last: its callbacks post() into the members above
+};
+
+}  // namespace oscar

@@ -1,0 +1,56 @@
+#pragma once
+/// @file RegistryClient: what boot and the `oscar` tools use to follow the system state and to
+/// ask the registry for a restart or a shutdown.
+
+#include <chrono>
+#include <condition_variable>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include <oscar/registry.h>
+
+#include "oscar/dds_participant.hpp"
+
+namespace oscar {
+
+class RegistryClient {
+ public:
+  /// `on_state` (optional) is called for every system state, on a DDS thread.
+  RegistryClient(DdsParticipant& participant, std::string sender,
+                 std::function<void(const SystemState&)> on_state = {});
+  ~RegistryClient();
+
+  /// The newest state that satisfies `pred`, once one arrives within `timeout`.
+  std::optional<SystemState> wait_for(const std::function<bool(const SystemState&)>& pred,
+                                      std::chrono::milliseconds timeout);
+  /// The newest state seen so far.
+  std::optional<SystemState> latest();
+  /// Sends a request and waits for the registry's answer.
+  /// @throws std::runtime_error if no registry answers within `timeout`, or with its refusal.
+  void request(RegistryRequestKind kind, const std::string& module,
+               std::chrono::milliseconds timeout = std::chrono::milliseconds(5000));
+
+ private:
+  struct Endpoints;
+  std::string sender_;
+  std::function<void(const SystemState&)> on_state_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::optional<SystemState> latest_;
+  std::map<unsigned long long, RegistryReply> replies_;
+  unsigned long long next_id_;
+  std::unique_ptr<Endpoints> io_;  // last: its callbacks use the members above
+};
+
+/// The participant of a command-line tool: with `system_file`, that system's domain and the
+/// network of its host `host` (default: its local host); otherwise loopback and $OSCAR_DOMAIN
+/// (default 0). `domain` >= 0 overrides either.
+std::unique_ptr<DdsParticipant> tool_participant(const std::string& name,
+                                                 const std::string& system_file,
+                                                 const std::string& host, int domain);
+
+}  // namespace oscar

@@ -1,0 +1,78 @@
+#pragma once
+/// @file SystemSpec: a system file (DESIGN §7) — hosts, modules with their restart policies and
+/// debug wrappers — parsed and checked whole before anything is started.
+
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "oscar/module_spec.hpp"
+
+namespace oscar {
+
+/// Where a host's processes run: here, in a network namespace (a test host), or over ssh.
+struct HostSpec {
+  enum class Kind { kLocal, kNetns, kSsh };
+  std::string name;
+  Kind kind = Kind::kLocal;
+  std::string netns;    ///< kNetns: the namespace's name
+  std::string ssh;      ///< kSsh: "user@host"
+  std::string address;  ///< optional IPv4 address DDS uses on that host
+  std::string where;    ///< "file:line"
+};
+
+/// What the registry does when the module fails (DESIGN §7).
+struct RestartPolicy {
+  enum class Kind { kAuto, kManual, kReplace };
+  Kind kind = Kind::kAuto;
+  int max = 3;                             ///< kAuto: restarts before the module is given up
+  std::chrono::milliseconds backoff{200};  ///< kAuto: wait before each restart
+  std::string replacement;                 ///< kReplace: the standby module started instead
+  bool continue_on_limit = false;          ///< the rest resumes once the module is given up
+};
+
+/// Start the module under a debugger or checker.
+struct DebugSpec {
+  int gdbserver_port = 0;  ///< >0: gdbserver listening on 127.0.0.1:<port>
+  bool valgrind = false;
+  std::vector<std::string> valgrind_args;
+};
+
+struct SystemModule {
+  ModuleSpec spec;
+  RestartPolicy restart;
+  DebugSpec debug;
+  bool standby = false;  ///< started only as another module's replacement
+};
+
+struct SystemSpec {
+  std::string file;
+  std::string name;
+  int domain = 0;
+  std::chrono::milliseconds lease{300};
+  std::vector<HostSpec> hosts;  ///< without a `hosts:` key, one local host "localhost"
+  std::vector<SystemModule> modules;
+  YAML::Node root;
+
+  /// Reads and checks a system file: unknown keys, unknown hosts, duplicate module or kernel
+  /// names, wiring to unknown kernels, replace chains (unknown, not standby, cyclic).
+  /// @throws std::invalid_argument "file:line: ..." naming the thing and the rule.
+  static SystemSpec load(const std::string& path);
+  static SystemSpec parse(const YAML::Node& root, const std::string& file);
+
+  /// Builds every module without DDS (loads the plugins, checks the multi-core rules and the
+  /// types of wires between modules). @throws std::invalid_argument naming module and rule.
+  void check_modules(const std::vector<std::string>& plugin_path) const;
+
+  /// Every module's domain becomes `domain` (boot --domain, tests).
+  void override_domain(int domain);
+  /// The host boot and the registry run on: the first `local: true` host.
+  /// @throws std::invalid_argument if the system declares none.
+  const HostSpec& local_host() const;
+  const HostSpec& host(const std::string& name) const;
+  const SystemModule* find_module(const std::string& name) const;
+};
+
+}  // namespace oscar

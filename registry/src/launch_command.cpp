@@ -1,0 +1,56 @@
+#include "oscar/registry/launch_command.hpp"
+
+#include <fmt/format.h>
+
+namespace oscar {
+
+std::string shell_quote(const std::string& word) {
+  if (!word.empty() && word.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                              "0123456789_-./:=@,+%") == std::string::npos) {
+    return word;
+  }
+  std::string out = "'";
+  for (char c : word) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::vector<std::string> on_host(const HostSpec& host, const std::vector<std::string>& argv) {
+  switch (host.kind) {
+    case HostSpec::Kind::kLocal:
+      return argv;
+    case HostSpec::Kind::kNetns: {
+      std::vector<std::string> out{"ip", "netns", "exec", host.netns};
+      out.insert(out.end(), argv.begin(), argv.end());
+      return out;
+    }
+    case HostSpec::Kind::kSsh: {
+      std::string remote;
+      for (const auto& a : argv) {
+        if (!remote.empty()) remote += ' ';
+        remote += shell_quote(a);
+      }
+      return {"ssh", "-o", "BatchMode=yes", "-T", host.ssh, "--", remote};
+    }
+  }
+  return argv;
+}
+
+std::vector<std::string> module_command(const SystemSpec& system, const SystemModule& module,
+                                        unsigned incarnation, bool suspended,
+                                        const std::string& oscar_run, const std::string& log_dir) {
+  std::vector<std::string> argv;
+  if (module.debug.gdbserver_port > 0) {
+    argv = {"gdbserver", fmt::format("127.0.0.1:{}", module.debug.gdbserver_port)};
+  } else if (module.debug.valgrind) {
+    argv = {"valgrind", fmt::format("--log-file={}/{}.{}.valgrind.log", log_dir, module.spec.name,
+                                    incarnation)};
+    argv.insert(argv.end(), module.debug.valgrind_args.begin(), module.debug.valgrind_args.end());
+  }
+  argv.insert(argv.end(), {oscar_run, system.file, "--module", module.spec.name, "--incarnation",
+                           std::to_string(incarnation), "--domain",
+                           std::to_string(module.spec.domain.value_or(system.domain))});
+  if (suspended) argv.push_back("--suspended");
+  return argv;
+}
+
+}  // namespace oscar

@@ -1,0 +1,78 @@
+#include "oscar/registry/log_printer.hpp"
+
+#include <ctime>
+
+#include <fmt/format.h>
+
+#include "oscar/time.hpp"
+
+namespace oscar {
+namespace {
+const char* level_name(LogLevel l) {
+  switch (l) {
+    case LOG_TRACE:
+      return "trace";
+    case LOG_DEBUG:
+      return "debug";
+    case LOG_INFO:
+      return "info ";
+    case LOG_WARN:
+      return "warn ";
+    case LOG_ERROR:
+      return "error";
+    case LOG_CRITICAL:
+      return "crit ";
+  }
+  return "?";
+}
+}  // namespace
+
+LogPrinter::LogPrinter(std::FILE* out, bool colour, unsigned long long delay_ns)
+    : out_(out), colour_(colour), delay_ns_(delay_ns) {}
+
+void LogPrinter::add(const LogRecord& record) {
+  std::lock_guard lock(mutex_);
+  pending_.emplace(record.stamp_ns(), record);
+}
+
+void LogPrinter::note(const std::string& who, const std::string& message, LogLevel level) {
+  LogRecord r;
+  r.stamp_ns(static_cast<unsigned long long>(wall_now()));
+  r.module_name(who);
+  r.level(level);
+  r.message(message);
+  add(r);
+}
+
+std::string LogPrinter::format(const LogRecord& r) {
+  const auto secs = static_cast<std::time_t>(r.stamp_ns() / 1'000'000'000ULL);
+  std::tm tm{};
+  localtime_r(&secs, &tm);
+  const auto ms = (r.stamp_ns() / 1'000'000ULL) % 1000;
+  const auto who = r.kernel().empty() || r.kernel() == r.module_name()
+                       ? r.module_name()
+                       : r.module_name() + "/" + r.kernel();
+  if (!colour_) {
+    return fmt::format("{:02}:{:02}:{:02}.{:03} {} [{}] {}\n", tm.tm_hour, tm.tm_min, tm.tm_sec, ms,
+                       level_name(r.level()), who, r.message());
+  }
+  static constexpr int kPalette[] = {36, 32, 33, 35, 34, 96, 92, 93, 95, 94};
+  const auto [it, added] = colours_.emplace(r.module_name(), 0);
+  if (added) it->second = kPalette[(colours_.size() - 1) % std::size(kPalette)];
+  const int level_colour = r.level() >= LOG_ERROR ? 31 : r.level() == LOG_WARN ? 33 : 0;
+  return fmt::format("{:02}:{:02}:{:02}.{:03} \x1b[{}m{}\x1b[0m \x1b[{}m[{}]\x1b[0m {}\n",
+                     tm.tm_hour, tm.tm_min, tm.tm_sec, ms, level_colour, level_name(r.level()),
+                     it->second, who, r.message());
+}
+
+void LogPrinter::flush(bool all) {
+  std::lock_guard lock(mutex_);
+  const auto horizon = static_cast<unsigned long long>(wall_now()) - delay_ns_;
+  while (!pending_.empty() && (all || pending_.begin()->first <= horizon)) {
+    std::fputs(format(pending_.begin()->second).c_str(), out_);
+    pending_.erase(pending_.begin());
+  }
+  std::fflush(out_);
+}
+
+}  // namespace oscar

@@ -1,0 +1,175 @@
+// oscar-monitor: one per host (DESIGN §7). Starts module processes when the registry asks,
+// captures their output, reports how they end, and shows it is alive with a heartbeat.
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdio>
+#include <deque>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include <oscar/registryPubSubTypes.h>
+#include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
+
+#include "oscar/registry/supervisor.hpp"
+#include "oscar/registry/system_spec.hpp"
+#include "oscar/topic_io.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::filesystem::path own_dir() {
+  std::error_code ec;
+  auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::filesystem::path() : exe.parent_path();
+}
+
+oscar::ProcessEvent event(const std::string& host, const std::string& module, unsigned incarnation,
+                          oscar::ProcessEventKind kind, long pid) {
+  oscar::ProcessEvent e;
+  e.host(host);
+  e.module_name(module);
+  e.incarnation(incarnation);
+  e.kind(kind);
+  e.pid(static_cast<std::int32_t>(pid));
+  e.exit_code(0);
+  e.signal(0);
+  return e;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"oscar-monitor: starts and watches the module processes of one host"};
+  std::string file, host, log_dir;
+  int domain = -1;
+  app.add_option("--system", file, "the system file")->required();
+  app.add_option("--host", host, "this host's name in the system file")->required();
+  app.add_option("-d,--domain", domain, "DDS domain (default: the file's)");
+  app.add_option("--log-dir", log_dir, "where module output goes (default /tmp/oscar/...)");
+  CLI11_PARSE(app, argc, argv);
+
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  spdlog::set_pattern("%H:%M:%S.%e %^%-5l%$ [monitor " + host + "] %v");
+
+  try {
+    auto system = oscar::SystemSpec::load(file);
+    system.host(host);  // throws for an unknown host
+    if (domain >= 0) system.override_domain(domain);
+    if (log_dir.empty()) {
+      log_dir = fmt::format("/tmp/oscar/{}-{}/{}", system.name, system.domain, host);
+    }
+    oscar::Supervisor supervisor(log_dir);
+    oscar::DdsParticipant participant(system.domain, "oscar-monitor:" + host,
+                                      oscar::NetworkConfig::for_host(system.root, host));
+    oscar::TopicWriter<oscar::ProcessEvent, oscar::ProcessEventPubSubType> events(
+        participant, "oscar/registry/process", oscar::qos::state_writer(256));
+    oscar::TopicWriter<oscar::MonitorBeat, oscar::MonitorBeatPubSubType> beats(
+        participant, "oscar/registry/monitor", oscar::qos::beat_writer(system.lease));
+
+    std::mutex mutex;
+    std::deque<oscar::LaunchRequest> requests;
+    std::set<unsigned long long> seen;
+    const long own_pid = getpid();
+    oscar::TopicReader<oscar::LaunchRequest, oscar::LaunchRequestPubSubType> launches(
+        participant, "oscar/registry/launch", oscar::qos::state_reader(64),
+        [&](const oscar::LaunchRequest& q, const auto&) {
+          if (q.host() != host || q.monitor_pid() != own_pid) return;
+          std::lock_guard lock(mutex);
+          if (seen.insert(q.id()).second) requests.push_back(q);
+        });
+
+    oscar::MonitorBeat beat;
+    beat.host(host);
+    beat.pid(static_cast<std::int32_t>(own_pid));
+    beat.log_dir(log_dir);
+    spdlog::info("watching host '{}' (domain {}), module output in {}", host, system.domain,
+                 log_dir);
+    std::map<std::string, Clock::time_point> stopping;  // SIGKILL if still there by then
+    const auto beat_period = system.lease / 3;
+    auto next_beat = Clock::now();
+    bool exit_requested = false;
+    while (!exit_requested) {
+      timespec poll{0, 5'000'000};
+      siginfo_t info;
+      if (sigtimedwait(&signals, &info, &poll) > 0) break;
+      if (Clock::now() >= next_beat) {
+        beats.write(beat);
+        next_beat += beat_period;
+      }
+      std::deque<oscar::LaunchRequest> todo;
+      {
+        std::lock_guard lock(mutex);
+        todo.swap(requests);
+      }
+      for (const auto& q : todo) {
+        switch (q.kind()) {
+          case oscar::LAUNCH_START: {
+            auto args = q.argv();
+            for (auto& a : args) {
+              if (a == "oscar-run") a = (own_dir() / "oscar-run").string();
+            }
+            try {
+              const auto pid = supervisor.start(q.module_name(), q.incarnation(), args, q.env());
+              spdlog::info("started {} (incarnation {}, pid {})", q.module_name(), q.incarnation(),
+                           pid);
+              events.write(event(host, q.module_name(), q.incarnation(), oscar::PROC_STARTED, pid));
+            } catch (const std::exception& e) {
+              spdlog::error("{}", e.what());
+              auto ev = event(host, q.module_name(), q.incarnation(), oscar::PROC_START_FAILED, 0);
+              ev.detail(e.what());
+              events.write(ev);
+            }
+            break;
+          }
+          case oscar::LAUNCH_KILL:
+            spdlog::warn("killing {} (the registry saw it hang)", q.module_name());
+            supervisor.signal(q.module_name(), SIGKILL);
+            break;
+          case oscar::LAUNCH_STOP:
+            supervisor.signal(q.module_name(), SIGTERM);
+            supervisor.signal(q.module_name(), SIGCONT);
+            stopping[q.module_name()] = Clock::now() + std::chrono::seconds(5);
+            break;
+          case oscar::LAUNCH_EXIT:
+            exit_requested = true;
+            break;
+        }
+      }
+      for (auto& [module, deadline] : stopping) {
+        if (Clock::now() > deadline) supervisor.signal(module, SIGKILL);
+      }
+      for (const auto& x : supervisor.reap()) {
+        stopping.erase(x.module);
+        spdlog::log(
+            x.signal == SIGTERM || x.exit_code == 0 ? spdlog::level::info : spdlog::level::warn,
+            "{} (pid {}) {}", x.module, x.pid, x.describe());
+        auto ev = event(host, x.module, x.incarnation, oscar::PROC_EXITED, x.pid);
+        ev.exit_code(x.exit_code);
+        ev.signal(x.signal);
+        ev.detail(x.last_output);
+        events.write(ev);
+      }
+    }
+    for (const auto& x : supervisor.stop_all(std::chrono::milliseconds(5000))) {
+      auto ev = event(host, x.module, x.incarnation, oscar::PROC_EXITED, x.pid);
+      ev.exit_code(x.exit_code);
+      ev.signal(x.signal);
+      events.write(ev);
+    }
+    spdlog::info("stopped");
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "oscar-monitor: %s\n", e.what());
+    return 2;
+  }
+}

@@ -1,0 +1,98 @@
+#include "oscar/registry/registry_client.hpp"
+
+#include <unistd.h>
+
+#include <stdexcept>
+#include <thread>
+
+#include <fmt/format.h>
+#include <oscar/registryPubSubTypes.h>
+
+#include "oscar/registry/system_spec.hpp"
+#include "oscar/topic_io.hpp"
+
+namespace oscar {
+
+struct RegistryClient::Endpoints {
+  TopicReader<SystemState, SystemStatePubSubType> states;
+  TopicReader<RegistryReply, RegistryReplyPubSubType> replies;
+  TopicWriter<RegistryRequest, RegistryRequestPubSubType> requests;
+};
+
+RegistryClient::RegistryClient(DdsParticipant& participant, std::string sender,
+                               std::function<void(const SystemState&)> on_state)
+    : sender_(std::move(sender)),
+      on_state_(std::move(on_state)),
+      next_id_(static_cast<unsigned long long>(getpid()) << 24) {
+  io_.reset(new Endpoints{{participant, "oscar/system/state", qos::state_reader(1),
+                           [this](const SystemState& s, const auto&) {
+                             if (on_state_) on_state_(s);
+                             std::lock_guard lock(mutex_);
+                             latest_ = s;
+                             changed_.notify_all();
+                           }},
+                          {participant, "oscar/registry/reply", qos::state_reader(16),
+                           [this](const RegistryReply& r, const auto&) {
+                             std::lock_guard lock(mutex_);
+                             replies_[r.id()] = r;
+                             changed_.notify_all();
+                           }},
+                          {participant, "oscar/registry/request", qos::state_writer(16)}});
+}
+
+RegistryClient::~RegistryClient() { io_.reset(); }
+
+std::optional<SystemState> RegistryClient::wait_for(
+    const std::function<bool(const SystemState&)>& pred, std::chrono::milliseconds timeout) {
+  std::unique_lock lock(mutex_);
+  if (changed_.wait_for(lock, timeout, [&] { return latest_ && pred(*latest_); })) return latest_;
+  return std::nullopt;
+}
+
+std::optional<SystemState> RegistryClient::latest() {
+  std::lock_guard lock(mutex_);
+  return latest_;
+}
+
+void RegistryClient::request(RegistryRequestKind kind, const std::string& module,
+                             std::chrono::milliseconds timeout) {
+  RegistryRequest q;
+  unsigned long long id = 0;
+  {
+    std::lock_guard lock(mutex_);
+    id = ++next_id_;
+  }
+  q.id(id);
+  q.sender(sender_);
+  q.kind(kind);
+  q.module_name(module);
+  // Wait for the registry's reader first: a request nobody matched would be lost in silence.
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  while (io_->requests.matched() == 0) {
+    if (std::chrono::steady_clock::now() > until) {
+      throw std::runtime_error("no registry is running on this domain (is the system booted?)");
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  io_->requests.write(q);
+  std::unique_lock lock(mutex_);
+  if (!changed_.wait_until(lock, until, [&] { return replies_.contains(id); })) {
+    throw std::runtime_error("the registry did not answer in time");
+  }
+  const auto reply = replies_[id];
+  if (!reply.ok()) throw std::runtime_error(reply.error());
+}
+
+std::unique_ptr<DdsParticipant> tool_participant(const std::string& name,
+                                                 const std::string& system_file,
+                                                 const std::string& host, int domain) {
+  if (system_file.empty()) {
+    return std::make_unique<DdsParticipant>(domain >= 0 ? domain : domain_from_env(0), name);
+  }
+  const auto system = SystemSpec::load(system_file);
+  const auto& h = host.empty() ? system.local_host() : system.host(host);
+  return std::make_unique<DdsParticipant>(domain >= 0 ? domain : system.domain, name,
+                                          NetworkConfig::for_host(system.root, h.name));
+}
+
+}  // namespace oscar

@@ -1,0 +1,85 @@
+#include "registry_io.hpp"
+
+#include <oscar/configPubSubTypes.h>
+
+namespace oscar {
+
+Registry::Io::Io(Registry& r)
+    : r_(r),
+      launch_(r.participant_, "oscar/registry/launch", qos::state_writer(64)),
+      reply_(r.participant_, "oscar/registry/reply", qos::state_writer(16)),
+      system_(r.participant_, "oscar/system/state", qos::state_writer(1)),
+      monitors_(
+          r.participant_, "oscar/registry/monitor", qos::beat_reader(r.system_.lease),
+          [this](const MonitorBeat& b, const auto& info) {
+            {
+              std::lock_guard lock(handles_mutex_);
+              monitor_handles_[info.publication_handle] = {b.host(), b.pid()};
+            }
+            r_.post([this, b] { r_.on_monitor_beat(b); });
+          },
+          [this](const Handle& h) {
+            std::lock_guard lock(handles_mutex_);
+            const auto it = monitor_handles_.find(h);
+            if (it == monitor_handles_.end()) return;
+            const auto [host, pid] = it->second;
+            r_.post([this, host, pid] { r_.on_monitor_lost(host, pid); });
+          }),
+      events_(r.participant_, "oscar/registry/process", qos::state_reader(256),
+              [this](const ProcessEvent& e, const auto&) {
+                r_.post([this, e] { r_.on_process_event(e); });
+              }),
+      states_(r.participant_, "oscar/registry/module_state", qos::state_reader(64),
+              [this](const ModuleState& s, const auto&) {
+                r_.post([this, s] { r_.on_module_state(s); });
+              }),
+      beats_(
+          r.participant_, "oscar/registry/alive", qos::beat_reader(r.system_.lease),
+          [this](const ModuleBeat& b, const auto& info) {
+            std::lock_guard lock(handles_mutex_);
+            module_handles_[info.publication_handle] = {b.module_name(), b.incarnation()};
+            beats_at_[{b.module_name(), b.incarnation()}] = Clock::now();
+          },
+          [this](const Handle& h) {
+            std::lock_guard lock(handles_mutex_);
+            const auto it = module_handles_.find(h);
+            if (it == module_handles_.end()) return;
+            const auto [module, incarnation] = it->second;
+            r_.post([this, module, incarnation] { r_.on_module_lost(module, incarnation); });
+          }),
+      requests_(r.participant_, "oscar/registry/request", qos::state_reader(16),
+                [this](const RegistryRequest& q, const auto&) {
+                  r_.post([this, q] { r_.on_request(q); });
+                }) {}
+
+void Registry::Io::send(LaunchKind kind, const std::string& host, long monitor_pid,
+                        const std::string& module, unsigned incarnation,
+                        const std::vector<std::string>& argv, const std::vector<std::string>& env) {
+  LaunchRequest q;
+  q.id(next_id_++);
+  q.host(host);
+  q.monitor_pid(static_cast<std::int32_t>(monitor_pid));
+  q.kind(kind);
+  q.module_name(module);
+  q.incarnation(incarnation);
+  q.argv(argv);
+  q.env(env);
+  launch_.write(q);
+}
+
+Registry::Clock::time_point Registry::Io::last_beat(const std::string& module,
+                                                    unsigned incarnation) {
+  std::lock_guard lock(handles_mutex_);
+  const auto it = beats_at_.find({module, incarnation});
+  return it == beats_at_.end() ? Clock::time_point{} : it->second;
+}
+
+void Registry::Io::reply(unsigned long long id, const std::string& error) {
+  RegistryReply rep;
+  rep.id(id);
+  rep.ok(error.empty());
+  rep.error(error);
+  reply_.write(rep);
+}
+
+}  // namespace oscar

@@ -1,0 +1,47 @@
+#pragma once
+// The registry's DDS endpoints (internal): every callback posts an event to the run() thread.
+
+#include <map>
+#include <mutex>
+#include <utility>
+
+#include <oscar/configPubSubTypes.h>
+#include <oscar/registryPubSubTypes.h>
+
+#include "oscar/registry/registry.hpp"
+#include "oscar/topic_io.hpp"
+
+namespace oscar {
+
+class Registry::Io {
+ public:
+  explicit Io(Registry& r);
+
+  void send(LaunchKind kind, const std::string& host, long monitor_pid, const std::string& module,
+            unsigned incarnation, const std::vector<std::string>& argv,
+            const std::vector<std::string>& env);
+  void reply(unsigned long long id, const std::string& error);
+  void publish(const SystemState& state) { system_.write(state); }
+  /// When the last heartbeat of that incarnation arrived (epoch if none did).
+  Clock::time_point last_beat(const std::string& module, unsigned incarnation);
+
+ private:
+  using Handle = eprosima::fastdds::dds::InstanceHandle_t;
+  Registry& r_;
+  std::mutex handles_mutex_;
+  std::map<Handle, std::pair<std::string, long>> monitor_handles_;     // -> host, pid
+  std::map<Handle, std::pair<std::string, unsigned>> module_handles_;  // -> module, incarnation
+  std::map<std::pair<std::string, unsigned>, Clock::time_point> beats_at_;
+  unsigned long long next_id_ = 1;
+
+  TopicWriter<LaunchRequest, LaunchRequestPubSubType> launch_;
+  TopicWriter<RegistryReply, RegistryReplyPubSubType> reply_;
+  TopicWriter<SystemState, SystemStatePubSubType> system_;
+  TopicReader<MonitorBeat, MonitorBeatPubSubType> monitors_;
+  TopicReader<ProcessEvent, ProcessEventPubSubType> events_;
+  TopicReader<ModuleState, ModuleStatePubSubType> states_;
+  TopicReader<ModuleBeat, ModuleBeatPubSubType> beats_;
+  TopicReader<RegistryRequest, RegistryRequestPubSubType> requests_;
+};
+
+}  // namespace oscar

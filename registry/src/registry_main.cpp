@@ -1,0 +1,46 @@
+// oscar-registry: holds the system graph and keeps the system running (DESIGN §7).
+#include <csignal>
+#include <cstdio>
+#include <thread>
+
+#include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
+
+#include "oscar/registry/registry.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"oscar-registry: boots a system through its monitors and restarts failed modules"};
+  std::string file, host;
+  int domain = -1;
+  app.add_option("--system", file, "the system file")->required();
+  app.add_option("--host", host, "the host it runs on (default: the system's first local host)");
+  app.add_option("-d,--domain", domain, "DDS domain (default: the file's)");
+  CLI11_PARSE(app, argc, argv);
+
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  spdlog::set_pattern("%H:%M:%S.%e %^%-5l%$ %v");
+  try {
+    auto system = oscar::SystemSpec::load(file);
+    if (domain >= 0) system.override_domain(domain);
+    if (host.empty()) host = system.local_host().name;
+    oscar::DdsParticipant participant(system.domain, "oscar-registry",
+                                      oscar::NetworkConfig::for_host(system.root, host));
+    oscar::Registry registry(system, participant);
+    std::thread signal_waiter([&] {
+      int sig = 0;
+      sigwait(&signals, &sig);
+      registry.stop();
+    });
+    registry.run();
+    pthread_kill(signal_waiter.native_handle(), SIGTERM);
+    signal_waiter.join();
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "oscar-registry: %s\n", e.what());
+    return 2;
+  }
+}

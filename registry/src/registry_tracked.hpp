@@ -1,0 +1,30 @@
+#pragma once
+// The registry's record of one module (internal to Registry).
+
+#include <optional>
+
+#include "oscar/registry/registry.hpp"
+
+namespace oscar {
+
+struct Registry::Tracked {
+  const SystemModule* spec = nullptr;
+  // waiting | starting | running | failed | restarting | replaced | standby | stopped
+  std::string status;
+  unsigned incarnation = 0;  // 0: never started
+  long pid = 0;
+  unsigned restarts = 0;
+  std::string last_failure;
+  bool process_gone = true;  // the current incarnation's process is known to have ended
+  Clock::time_point restart_at{};
+  Clock::time_point running_since{};
+  std::string replaced_by;  // set when a replacement takes over
+  ModuleState state;        // the last announcement of the current incarnation
+  bool has_state = false;
+  std::optional<ModuleState> config;  // what to re-apply to the next incarnation
+  double cues_per_s = 0;
+  Clock::time_point rate_since{};
+  std::uint64_t rate_published = 0;
+};
+
+}  // namespace oscar

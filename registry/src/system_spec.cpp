@@ -1,0 +1,295 @@
+#include "oscar/registry/system_spec.hpp"
+
+#include <arpa/inet.h>
+
+#include <map>
+#include <set>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "oscar/module.hpp"
+#include "oscar/time.hpp"
+
+namespace oscar {
+namespace {
+
+[[noreturn]] void fail(const std::string& at, const std::string& message) {
+  throw std::invalid_argument(at + ": " + message);
+}
+
+std::chrono::milliseconds millis(const YAML::Node& node, const std::string& file,
+                                 const std::string& what) {
+  try {
+    const auto d = std::chrono::duration_cast<std::chrono::milliseconds>(
+        parse_duration(node.as<std::string>()));
+    if (d.count() <= 0) throw std::invalid_argument("must be positive");
+    return d;
+  } catch (const std::exception& e) {
+    fail(yaml_where(file, node), fmt::format("{}: {}", what, e.what()));
+  }
+}
+
+HostSpec parse_host(const std::string& name, const YAML::Node& node, const std::string& file) {
+  HostSpec h;
+  h.name = name;
+  h.where = yaml_where(file, node);
+  const auto what = "hosts." + name;
+  if (!node.IsMap()) fail(h.where, what + ": expected {local: true} | {netns: NAME} | {ssh: U@H}");
+  check_yaml_keys(node, file, what, {"local", "netns", "ssh", "address"});
+  const int kinds = (node["local"] ? 1 : 0) + (node["netns"] ? 1 : 0) + (node["ssh"] ? 1 : 0);
+  if (kinds != 1) fail(h.where, what + ": give exactly one of local, netns, ssh");
+  if (node["netns"]) {
+    h.kind = HostSpec::Kind::kNetns;
+    h.netns = node["netns"].as<std::string>();
+  } else if (node["ssh"]) {
+    h.kind = HostSpec::Kind::kSsh;
+    h.ssh = node["ssh"].as<std::string>();
+    if (h.ssh.find_first_of(" ;&|'\"$`") != std::string::npos) {
+      fail(h.where,
+           fmt::format("{}.ssh '{}': expected user@host without shell characters", what, h.ssh));
+    }
+  } else if (!node["local"].as<bool>()) {
+    fail(h.where, what + ": local must be true (or use netns/ssh)");
+  }
+  if (node["address"]) {
+    h.address = node["address"].as<std::string>();
+    in_addr a{};
+    if (inet_pton(AF_INET, h.address.c_str(), &a) != 1) {
+      fail(yaml_where(file, node["address"]),
+           fmt::format("{}.address '{}' is not an IPv4 address", what, h.address));
+    }
+  }
+  return h;
+}
+
+RestartPolicy parse_restart(const YAML::Node& node, const std::string& file,
+                            const std::string& what) {
+  RestartPolicy r;
+  if (!node) return r;
+  if (!node.IsMap()) fail(yaml_where(file, node), what + ": expected a map with policy");
+  check_yaml_keys(node, file, what, {"policy", "max", "backoff", "replace", "on_limit"});
+  const auto policy =
+      node["policy"] ? node["policy"].as<std::string>() : (node["replace"] ? "replace" : "auto");
+  if (policy == "auto") {
+    r.kind = RestartPolicy::Kind::kAuto;
+  } else if (policy == "manual") {
+    r.kind = RestartPolicy::Kind::kManual;
+  } else if (policy == "replace") {
+    r.kind = RestartPolicy::Kind::kReplace;
+    if (!node["replace"]) fail(yaml_where(file, node), what + ": policy replace needs replace: M");
+    r.replacement = node["replace"].as<std::string>();
+  } else {
+    fail(yaml_where(file, node["policy"]),
+         fmt::format("{}.policy '{}': expected auto, manual or replace", what, policy));
+  }
+  if (node["replace"] && r.kind != RestartPolicy::Kind::kReplace) {
+    fail(yaml_where(file, node["replace"]), what + ": replace goes with policy replace");
+  }
+  if (node["max"]) {
+    r.max = node["max"].as<int>();
+    if (r.max < 0) fail(yaml_where(file, node["max"]), what + ".max must be >= 0");
+  }
+  if (node["backoff"]) r.backoff = millis(node["backoff"], file, what + ".backoff");
+  if (node["on_limit"]) {
+    const auto on_limit = node["on_limit"].as<std::string>();
+    if (on_limit != "suspend" && on_limit != "continue") {
+      fail(yaml_where(file, node["on_limit"]),
+           fmt::format("{}.on_limit '{}': expected suspend or continue", what, on_limit));
+    }
+    r.continue_on_limit = on_limit == "continue";
+  }
+  return r;
+}
+
+DebugSpec parse_debug(const YAML::Node& node, const std::string& file, const std::string& what) {
+  DebugSpec d;
+  if (!node) return d;
+  if (!node.IsMap())
+    fail(yaml_where(file, node), what +
+                                     ": expected {gdbserver: PORT} or "
+                                     "{valgrind: [ARGS...]}");
+  check_yaml_keys(node, file, what, {"gdbserver", "valgrind"});
+  if (node["gdbserver"]) {
+    d.gdbserver_port = node["gdbserver"].as<int>();
+    if (d.gdbserver_port <= 0 || d.gdbserver_port > 65535) {
+      fail(yaml_where(file, node["gdbserver"]), what + ".gdbserver: a TCP port 1..65535");
+    }
+  }
+  if (const auto v = node["valgrind"]) {
+    d.valgrind = !(v.IsScalar() && v.Scalar() == "false");
+    if (v.IsSequence()) {
+      for (const auto& a : v) d.valgrind_args.push_back(a.as<std::string>());
+    }
+  }
+  if (d.valgrind && d.gdbserver_port) fail(yaml_where(file, node), what + ": one debugger only");
+  return d;
+}
+
+// A replace chain must end at a standby module and never come back to where it started.
+void check_replace_chains(const SystemSpec& s) {
+  for (const auto& m : s.modules) {
+    std::vector<std::string> chain{m.spec.name};
+    const SystemModule* at = &m;
+    while (at->restart.kind == RestartPolicy::Kind::kReplace) {
+      const auto& next = at->restart.replacement;
+      const auto* target = s.find_module(next);
+      if (!target) {
+        fail(at->spec.where,
+             fmt::format("module '{}': replace names no module '{}'", at->spec.name, next));
+      }
+      if (!target->standby) {
+        fail(at->spec.where,
+             fmt::format("module '{}': its replacement '{}' must be declared standby: true",
+                         at->spec.name, next));
+      }
+      if (std::find(chain.begin(), chain.end(), next) != chain.end()) {
+        chain.push_back(next);
+        fail(m.spec.where, fmt::format("cyclic replace chain: {}", fmt::join(chain, " -> ")));
+      }
+      chain.push_back(next);
+      at = target;
+    }
+  }
+}
+
+}  // namespace
+
+SystemSpec SystemSpec::load(const std::string& path) { return parse(load_yaml_file(path), path); }
+
+SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
+  SystemSpec s;
+  s.file = file;
+  s.root = root;
+  if (!root.IsMap()) fail(file, "a system file is a map with system, hosts and modules");
+  check_yaml_keys(root, file, "system file",
+                  {"system", "domain", "hosts", "modules", "network", "lease"});
+  s.name = root["system"] ? root["system"].as<std::string>() : "system";
+  if (root["domain"]) {
+    s.domain = root["domain"].as<int>();
+    if (s.domain < 0 || s.domain > 232) fail(yaml_where(file, root["domain"]), "domain: 0..232");
+  }
+  if (root["lease"]) s.lease = millis(root["lease"], file, "lease");
+  if (const auto hosts = root["hosts"]) {
+    if (!hosts.IsMap() || hosts.size() == 0) fail(yaml_where(file, hosts), "hosts: a map");
+    for (const auto& kv : hosts) {
+      s.hosts.push_back(parse_host(kv.first.as<std::string>(), kv.second, file));
+    }
+  } else {
+    s.hosts.push_back(HostSpec{"localhost", HostSpec::Kind::kLocal, "", "", "", file});
+  }
+  const auto modules = root["modules"];
+  if (!modules || !modules.IsSequence() || modules.size() == 0) {
+    fail(file, "modules: a non-empty list");
+  }
+  std::map<std::string, std::string> kernels;  // kernel -> module
+  for (const auto& node : modules) {
+    SystemModule m;
+    m.spec = ModuleSpec::from_yaml(node, file);
+    const auto what = "module '" + m.spec.name + "'";
+    if (s.find_module(m.spec.name)) {
+      fail(m.spec.where, fmt::format("duplicate module name '{}'", m.spec.name));
+    }
+    if (m.spec.host.empty()) {
+      if (s.hosts.size() != 1) fail(m.spec.where, what + ": name its host (several are declared)");
+      m.spec.host = s.hosts.front().name;
+    }
+    const bool known = std::any_of(s.hosts.begin(), s.hosts.end(),
+                                   [&](const HostSpec& h) { return h.name == m.spec.host; });
+    if (!known) {
+      std::vector<std::string> names;
+      for (const auto& h : s.hosts) names.push_back(h.name);
+      fail(yaml_where(file, node["host"]), fmt::format("{}: unknown host '{}' (hosts: {})", what,
+                                                       m.spec.host, fmt::join(names, ", ")));
+    }
+    if (!m.spec.domain) m.spec.domain = s.domain;
+    if (!node["network"]) m.spec.network = NetworkConfig::for_host(root, m.spec.host);
+    m.spec.lease = s.lease;
+    m.restart = parse_restart(node["restart"], file, what + ".restart");
+    m.debug = parse_debug(node["debug"], file, what + ".debug");
+    m.standby = node["standby"] && node["standby"].as<bool>();
+    for (const auto& k : m.spec.kernels) {
+      const auto [it, added] = kernels.emplace(k.name, m.spec.name);
+      if (!added) {
+        fail(k.where, fmt::format("duplicate kernel name '{}' (also in module '{}'); kernel "
+                                  "names are unique within a system",
+                                  k.name, it->second));
+      }
+    }
+    s.modules.push_back(std::move(m));
+  }
+  for (const auto& m : s.modules) {
+    for (const auto& k : m.spec.kernels) {
+      for (const auto& [input, wiring] : k.inputs) {
+        const auto producer = wiring.source.substr(0, wiring.source.find('/'));
+        if (!wiring.source.empty() && !kernels.contains(producer)) {
+          fail(k.where, fmt::format("kernel '{}' input '{}': no kernel '{}' in the system", k.name,
+                                    input, producer));
+        }
+      }
+    }
+  }
+  check_replace_chains(s);
+  return s;
+}
+
+void SystemSpec::check_modules(const std::vector<std::string>& plugin_path) const {
+  std::vector<std::unique_ptr<Module>> built;
+  std::map<std::string, std::string> output_types;  // "<kernel>/<channel>" -> type
+  for (const auto& m : modules) {
+    built.push_back(std::make_unique<Module>(m.spec, plugin_path));
+    for (const auto& k : m.spec.kernels) {
+      for (const auto& out : built.back()->kernel(k.name).ports().outputs) {
+        output_types[out->address()] = out->type().name;
+      }
+    }
+  }
+  for (std::size_t i = 0; i < modules.size(); ++i) {
+    for (const auto& k : modules[i].spec.kernels) {
+      for (const auto& [input, wiring] : k.inputs) {
+        if (wiring.source.empty()) continue;
+        const auto* port = built[i]->kernel(k.name).ports().find_input(input);
+        const auto it = output_types.find(wiring.source);
+        if (it == output_types.end()) {
+          fail(k.where, fmt::format("kernel '{}' input '{}': kernel '{}' has no output '{}'",
+                                    k.name, input, wiring.source.substr(0, wiring.source.find('/')),
+                                    wiring.source.substr(wiring.source.find('/') + 1)));
+        }
+        if (port && it->second != port->type().name) {
+          fail(k.where, fmt::format("cannot wire {} ({}) to input {}/{} ({}): the types differ",
+                                    wiring.source, it->second, k.name, input, port->type().name));
+        }
+      }
+    }
+  }
+}
+
+void SystemSpec::override_domain(int d) {
+  domain = d;
+  for (auto& m : modules) m.spec.domain = d;
+}
+
+const HostSpec& SystemSpec::local_host() const {
+  for (const auto& h : hosts) {
+    if (h.kind == HostSpec::Kind::kLocal) return h;
+  }
+  throw std::invalid_argument(
+      fmt::format("{}: no host is local: true (boot and the registry run there)", file));
+}
+
+const HostSpec& SystemSpec::host(const std::string& host_name) const {
+  for (const auto& h : hosts) {
+    if (h.name == host_name) return h;
+  }
+  throw std::invalid_argument(fmt::format("{}: no host '{}'", file, host_name));
+}
+
+const SystemModule* SystemSpec::find_module(const std::string& module_name) const {
+  for (const auto& m : modules) {
+    if (m.spec.name == module_name) return &m;
+  }
+  return nullptr;
+}
+
+}  // namespace oscar

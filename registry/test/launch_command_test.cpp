@@ -1,0 +1,64 @@
+#include "oscar/registry/launch_command.hpp"
+
+#include <gtest/gtest.h>
+
+namespace oscar {
+namespace {
+
+using Argv = std::vector<std::string>;
+
+TEST(LaunchCommand, LocalHostsRunTheCommandAsItIs) {
+  HostSpec h;
+  EXPECT_EQ(on_host(h, {"oscar-monitor", "--host", "a"}), (Argv{"oscar-monitor", "--host", "a"}));
+}
+
+TEST(LaunchCommand, NetnsHostsRunItInTheirNamespace) {
+  HostSpec h;
+  h.kind = HostSpec::Kind::kNetns;
+  h.netns = "scooter";
+  EXPECT_EQ(on_host(h, {"oscar-monitor", "--host", "scooter"}),
+            (Argv{"ip", "netns", "exec", "scooter", "oscar-monitor", "--host", "scooter"}));
+}
+
+TEST(LaunchCommand, SshHostsGetOneQuotedRemoteCommand) {
+  HostSpec h;
+  h.kind = HostSpec::Kind::kSsh;
+  h.ssh = "robot@marvin";
+  EXPECT_EQ(on_host(h, {"/opt/oscar/bin/oscar-monitor", "--system", "my system.yaml", "it's"}),
+            (Argv{"ssh", "-o", "BatchMode=yes", "-T", "robot@marvin", "--",
+                  "/opt/oscar/bin/oscar-monitor --system 'my system.yaml' 'it'\\''s'"}));
+}
+
+SystemSpec one_module(const std::string& debug) {
+  return SystemSpec::parse(
+      YAML::Load("system: s\ndomain: 9\nmodules: [ { name: cam, kernels: [ { type: relay } ]" +
+                 debug + " } ]"),
+      "sys.yaml");
+}
+
+TEST(LaunchCommand, ModuleCommandNamesFileModuleIncarnationAndDomain) {
+  const auto s = one_module("");
+  EXPECT_EQ(module_command(s, s.modules[0], 3, true, "oscar-run", "/logs"),
+            (Argv{"oscar-run", "sys.yaml", "--module", "cam", "--incarnation", "3", "--domain", "9",
+                  "--suspended"}));
+}
+
+TEST(LaunchCommand, GdbserverListensOnLoopbackOnly) {
+  const auto s = one_module(", debug: { gdbserver: 2345 }");
+  const auto argv = module_command(s, s.modules[0], 1, false, "oscar-run", "/logs");
+  ASSERT_GE(argv.size(), 3u);
+  EXPECT_EQ(argv[0], "gdbserver");
+  EXPECT_EQ(argv[1], "127.0.0.1:2345");
+  EXPECT_EQ(argv[2], "oscar-run");
+}
+
+TEST(LaunchCommand, ValgrindWritesItsLogBesideTheModules) {
+  const auto s = one_module(", debug: { valgrind: [--leak-check=full] }");
+  const auto argv = module_command(s, s.modules[0], 2, false, "oscar-run", "/logs");
+  EXPECT_EQ(
+      Argv(argv.begin(), argv.begin() + 4),
+      (Argv{"valgrind", "--log-file=/logs/cam.2.valgrind.log", "--leak-check=full", "oscar-run"}));
+}
+
+}  // namespace
+}  // namespace oscar

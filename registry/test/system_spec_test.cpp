@@ -1,0 +1,165 @@
+#include "oscar/registry/system_spec.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "oscar/cue_types.hpp"
+#include "oscar/kernel_registry.hpp"
+
+namespace oscar {
+namespace {
+
+using ::testing::HasSubstr;
+
+SystemSpec parse(const std::string& yaml) { return SystemSpec::parse(YAML::Load(yaml), "s.yaml"); }
+
+std::string error_of(const std::string& yaml) {
+  try {
+    parse(yaml);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+constexpr const char* kTwoHosts = R"(
+system: t
+domain: 7
+hosts: { a: { local: true, address: 10.77.0.1 }, b: { netns: hb, address: 10.77.0.2 } }
+modules:
+  - name: src
+    host: a
+    kernels: [ { type: bench_source, name: src } ]
+    mode: { continuous: 50ms }
+    restart: { policy: auto, max: 2, backoff: 100ms, on_limit: continue }
+  - name: sink
+    host: b
+    kernels: [ { type: bench_sink, name: sink, inputs: { in: src/out } } ]
+    restart: { replace: spare }
+  - name: spare
+    host: b
+    standby: true
+    kernels: [ { type: bench_sink, name: spare_sink, inputs: { in: src/out } } ]
+)";
+
+TEST(SystemSpec, ReadsHostsPoliciesAndPerHostNetworks) {
+  const auto s = parse(kTwoHosts);
+  EXPECT_EQ(s.name, "t");
+  EXPECT_EQ(s.domain, 7);
+  ASSERT_EQ(s.hosts.size(), 2u);
+  EXPECT_EQ(s.host("b").kind, HostSpec::Kind::kNetns);
+  EXPECT_EQ(s.local_host().name, "a");
+  const auto* src = s.find_module("src");
+  ASSERT_NE(src, nullptr);
+  EXPECT_EQ(src->restart.max, 2);
+  EXPECT_EQ(src->restart.backoff, std::chrono::milliseconds(100));
+  EXPECT_TRUE(src->restart.continue_on_limit);
+  EXPECT_EQ(src->spec.domain, 7);
+  EXPECT_EQ(src->spec.network.interfaces, std::vector<std::string>{"10.77.0.1"});
+  EXPECT_EQ(src->spec.network.peers, (std::vector<std::string>{"10.77.0.1", "10.77.0.2"}));
+  EXPECT_EQ(s.find_module("sink")->restart.kind, RestartPolicy::Kind::kReplace);
+  EXPECT_TRUE(s.find_module("spare")->standby);
+}
+
+TEST(SystemSpec, WithoutHostsEverythingRunsOnOneLocalHostOnLoopback) {
+  const auto s = parse("modules: [ { name: m, kernels: [ { type: relay } ] } ]");
+  ASSERT_EQ(s.hosts.size(), 1u);
+  EXPECT_EQ(s.modules[0].spec.host, "localhost");
+  EXPECT_EQ(s.modules[0].spec.network.interfaces, std::vector<std::string>{"127.0.0.1"});
+}
+
+TEST(SystemSpec, MalformedYamlNamesFileLineAndColumn) {
+  const auto path = ::testing::TempDir() + "/malformed.yaml";
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  std::fputs("system: x\nmodules:\n  - name: [unclosed\n", f);
+  std::fclose(f);
+  try {
+    SystemSpec::load(path);
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr(path + ":4:"));
+    EXPECT_THAT(e.what(), HasSubstr("malformed YAML"));
+  }
+}
+
+TEST(SystemSpec, UnknownKeysAreErrorsWithTheirLine) {
+  EXPECT_THAT(error_of("system: x\nmodulez: []\n"),
+              HasSubstr("s.yaml:2: system file: unknown key 'modulez'"));
+  EXPECT_THAT(
+      error_of("modules: [ { name: m, kernels: [ {type: relay} ], restart: { polcy: auto } } ]"),
+      HasSubstr("unknown key 'polcy'"));
+}
+
+TEST(SystemSpec, UnknownHostIsAnErrorListingTheHosts) {
+  EXPECT_THAT(error_of(R"(
+hosts: { a: { local: true } }
+modules: [ { name: m, host: z, kernels: [ { type: relay } ] } ])"),
+              HasSubstr("module 'm': unknown host 'z' (hosts: a)"));
+}
+
+TEST(SystemSpec, DuplicateModuleAndKernelNamesAreErrors) {
+  EXPECT_THAT(error_of(R"(modules:
+  - { name: m, kernels: [ { type: relay, name: a } ] }
+  - { name: m, kernels: [ { type: relay, name: b } ] })"),
+              HasSubstr("duplicate module name 'm'"));
+  EXPECT_THAT(error_of(R"(modules:
+  - { name: m, kernels: [ { type: relay, name: a } ] }
+  - { name: n, kernels: [ { type: relay, name: a } ] })"),
+              HasSubstr("duplicate kernel name 'a' (also in module 'm')"));
+}
+
+TEST(SystemSpec, WiringToAnUnknownKernelIsAnError) {
+  EXPECT_THAT(
+      error_of("modules: [ { name: m, kernels: [ { type: relay, inputs: { in: ghost/out } } ] } ]"),
+      HasSubstr("kernel 'relay' input 'in': no kernel 'ghost' in the system"));
+}
+
+TEST(SystemSpec, CyclicReplaceChainsAreErrorsShowingTheChain) {
+  EXPECT_THAT(error_of(R"(modules:
+  - { name: a, kernels: [ { type: relay, name: ka } ], restart: { replace: b } }
+  - { name: b, standby: true, kernels: [ { type: relay, name: kb } ], restart: { replace: c } }
+  - { name: c, standby: true, kernels: [ { type: relay, name: kc } ], restart: { replace: b } })"),
+              HasSubstr("cyclic replace chain: a -> b -> c -> b"));
+}
+
+TEST(SystemSpec, AReplacementMustExistAndBeStandby) {
+  EXPECT_THAT(
+      error_of("modules: [ { name: a, kernels: [ { type: relay } ], restart: { replace: z } } ]"),
+      HasSubstr("module 'a': replace names no module 'z'"));
+  EXPECT_THAT(error_of(R"(modules:
+  - { name: a, kernels: [ { type: relay, name: ka } ], restart: { replace: b } }
+  - { name: b, kernels: [ { type: relay, name: kb } ] })"),
+              HasSubstr("its replacement 'b' must be declared standby: true"));
+}
+
+TEST(SystemSpec, BadPolicyValuesAreErrors) {
+  EXPECT_THAT(
+      error_of(
+          "modules: [ { name: a, kernels: [ { type: relay } ], restart: { policy: often } } ]"),
+      HasSubstr("restart.policy 'often': expected auto, manual or replace"));
+  EXPECT_THAT(
+      error_of(
+          "modules: [ { name: a, kernels: [ { type: relay } ], restart: { backoff: soon } } ]"),
+      HasSubstr("restart.backoff"));
+  EXPECT_THAT(
+      error_of("modules: [ { name: a, kernels: [ { type: relay } ], debug: { gdbserver: 0 } } ]"),
+      HasSubstr("gdbserver: a TCP port"));
+  EXPECT_THAT(error_of("hosts: { a: { local: true, netns: x } }\nmodules: []"),
+              HasSubstr("give exactly one of local, netns, ssh"));
+  EXPECT_THAT(error_of("hosts: { a: { ssh: 'u@h; rm -rf /' } }\nmodules: []"),
+              HasSubstr("without shell characters"));
+}
+
+TEST(SystemSpec, CheckModulesRejectsAnUnknownKernelType) {
+  register_standard_cue_types();
+  const auto s = parse("modules: [ { name: m, kernels: [ { type: no_such_kernel, name: k } ] } ]");
+  try {
+    s.check_modules(plugin_search_path());
+    FAIL() << "no error";
+  } catch (const std::exception& e) {
+    EXPECT_THAT(e.what(), HasSubstr("no_such_kernel"));
+  }
+}
+
+}  // namespace
+}  // namespace oscar

@@ -1,0 +1,155 @@
+// Three test hosts in network namespaces (issue 3, test f): modules spread across them, cues
+// crossing hosts over UDP between the test addresses; a killed monitor is a lost host whose
+// modules are failed; a monitor started again brings them back. Root only; skipped otherwise.
+#include <signal.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "process.hpp"  // tests/common
+#include "test_hosts.hpp"
+
+namespace oscar {
+namespace {
+using namespace std::chrono_literals;
+using nlohmann::json;
+
+std::string temp(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / (name + "_" + std::to_string(getpid())))
+      .string();
+}
+
+class ThreeHosts : public testing::Test {
+ protected:
+  void SetUp() override {
+    if (const auto why = test::TestHosts::unavailable(); !why.empty()) GTEST_SKIP() << why;
+    hosts_ = std::make_unique<test::TestHosts>(3);
+    file_ = temp("netns_system") + ".yaml";
+    std::ofstream(file_) << fmt::format(R"(
+system: three
+lease: 300ms
+hosts:
+  h1: {{ local: true, address: {} }}
+  h2: {{ netns: {}, address: {} }}
+  h3: {{ netns: {}, address: {} }}
+modules:
+  - name: src
+    host: h1
+    kernels: [ {{ type: bench_source, name: src, params: {{ type: LineSeg3DSeq, lines: 100 }} }} ]
+    mode: {{ continuous: 20ms }}
+  - name: relay
+    host: h2
+    kernels: [ {{ type: relay, name: relay, params: {{ type: LineSeg3DSeq }}, inputs: {{ in: src/out }} }} ]
+    mode: single_step
+    restart: {{ policy: auto, max: 5, backoff: 100ms }}
+  - name: sink
+    host: h3
+    kernels: [ {{ type: bench_sink, name: sink, params: {{ type: LineSeg3DSeq }}, inputs: {{ in: relay/out }} }} ]
+    mode: single_step
+)",
+                                        hosts_->address(1), hosts_->netns(2), hosts_->address(2),
+                                        hosts_->netns(3), hosts_->address(3));
+    log_dir_ = temp("netns_logs");
+    std::filesystem::remove_all(log_dir_);
+    auto argv = hosts_->on(1);  // boot and the registry run on h1
+    argv.insert(argv.end(), {test::bin("oscar-boot"), file_, "--domain", domain(), "--log-dir",
+                             log_dir_, "--timeout", "40"});
+    boot_ = std::make_unique<test::Process>(argv, temp("netns_boot.log"));
+  }
+  void TearDown() override {
+    if (boot_) {
+      kill(boot_->pid(), SIGINT);
+      boot_->wait(40s);
+    }
+    boot_.reset();
+    hosts_.reset();
+  }
+
+  static std::string domain() { return std::to_string(test::test_domain()); }
+
+  // `oscar ps --json`, run on h1 (the test process itself is on no test host).
+  json ps() {
+    auto argv = hosts_->on(1);
+    argv.insert(argv.end(),
+                {test::bin("oscar-ps"), "--system", file_, "--domain", domain(), "--json"});
+    test::Process p(argv, temp("netns_ps.log"));
+    if (p.wait(20s) != 0) return json();
+    const auto out = p.output();
+    return json::parse(out.substr(out.find('{')), nullptr, false);
+  }
+
+  json module(const json& s, const std::string& name) {
+    for (const auto& m : s["modules"]) {
+      if (m["name"] == name) return m;
+    }
+    return json();
+  }
+
+  // Polls `oscar ps` until `pred` holds.
+  json until(const std::function<bool(const json&)>& pred, std::chrono::seconds limit = 40s) {
+    const auto end = std::chrono::steady_clock::now() + limit;
+    json s;
+    while (std::chrono::steady_clock::now() < end) {
+      s = ps();
+      if (s.is_object() && s.contains("modules") && pred(s)) return s;
+      std::this_thread::sleep_for(200ms);
+    }
+    ADD_FAILURE() << "condition not reached; last state: " << s.dump() << "\nboot:\n"
+                  << boot_->output();
+    return s;
+  }
+
+  std::unique_ptr<test::TestHosts> hosts_;
+  std::string file_, log_dir_;
+  std::unique_ptr<test::Process> boot_;
+};
+
+TEST_F(ThreeHosts, CuesCrossHostsALostHostFailsItsModulesAndComesBack) {
+  auto s = until([&](const json& st) { return st["state"] == "running"; });
+  EXPECT_EQ(module(s, "relay")["host"], "h2");
+  // Cues cross from h1 to h2 and on to h3: the relay republishes them.
+  s = until([&](const json& st) {
+    return module(st, "relay")["kernels"][0]["published"].get<std::uint64_t>() > 20;
+  });
+
+  // Kill h2's monitor: the host is lost, its module dies with it and is marked failed.
+  std::vector<long> monitors;
+  for (const auto& e : std::filesystem::directory_iterator("/proc")) {
+    std::ifstream in(e.path() / "cmdline");
+    std::string cmd((std::istreambuf_iterator<char>(in)), {});
+    if (cmd.find("oscar-monitor") != std::string::npos && cmd.find(file_) != std::string::npos &&
+        cmd.find(std::string("h2") + '\0') != std::string::npos &&
+        cmd.find("ip\0netns", 0, 8) == std::string::npos) {
+      monitors.push_back(std::stol(e.path().filename()));
+    }
+  }
+  ASSERT_EQ(monitors.size(), 1u);
+  ASSERT_EQ(kill(static_cast<pid_t>(monitors[0]), SIGKILL), 0);
+  s = until([&](const json& st) {
+    return !st["hosts_lost"].empty() && st["hosts_lost"][0] == "h2" &&
+           module(st, "relay")["last_failure"].get<std::string>().find("host 'h2' lost") !=
+               std::string::npos;
+  });
+  EXPECT_EQ(s["state"], "suspended");
+
+  // A new monitor on h2: the registry starts the relay there again and the system resumes.
+  auto argv = hosts_->on(2);
+  argv.insert(argv.end(), {test::bin("oscar-monitor"), "--system", file_, "--host", "h2",
+                           "--domain", domain(), "--log-dir", log_dir_ + "/h2"});
+  test::Process monitor(argv, temp("netns_monitor2.log"));
+  s = until([&](const json& st) {
+    return st["state"] == "running" && st["hosts_lost"].empty() &&
+           module(st, "relay")["incarnation"] == 2 && module(st, "relay")["status"] == "running";
+  });
+  const auto published = module(s, "relay")["kernels"][0]["published"].get<std::uint64_t>();
+  until([&](const json& st) {
+    return module(st, "relay")["kernels"][0]["published"].get<std::uint64_t>() > published + 10;
+  });
+}
+
+}  // namespace
+}  // namespace oscar

@@ -1,0 +1,52 @@
+// oscar log: the merged log of the running system, time-ordered, one colour per module.
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdio>
+
+#include <oscar/configPubSubTypes.h>
+#include <CLI/CLI.hpp>
+
+#include "oscar/registry/log_printer.hpp"
+#include "oscar/registry/registry_client.hpp"
+#include "oscar/topic_io.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"oscar log: follows the merged log of the running system until Ctrl-C"};
+  std::string system_file, host;
+  int domain = -1;
+  double duration_s = 0;
+  bool no_colour = false;
+  app.add_option("--system", system_file, "system file (its domain and network)");
+  app.add_option("--host", host, "the host this runs on (with --system)");
+  app.add_option("-d,--domain", domain, "DDS domain (default: the system's, $OSCAR_DOMAIN or 0)");
+  app.add_option("--duration", duration_s, "stop after this many seconds");
+  app.add_flag("--no-colour", no_colour, "plain text even on a terminal");
+  CLI11_PARSE(app, argc, argv);
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  try {
+    auto participant = oscar::tool_participant("oscar-log", system_file, host, domain);
+    oscar::LogPrinter printer(stdout, !no_colour && isatty(1) != 0);
+    oscar::TopicReader<oscar::LogRecord, oscar::LogRecordPubSubType> logs(
+        *participant, "oscar/log", oscar::qos::stream_reader(100),
+        [&](const oscar::LogRecord& r, const auto&) { printer.add(r); });
+    const auto until = duration_s > 0 ? std::chrono::steady_clock::now() +
+                                            std::chrono::milliseconds(long(duration_s * 1000))
+                                      : std::chrono::steady_clock::time_point::max();
+    while (std::chrono::steady_clock::now() < until) {
+      timespec poll{0, 50'000'000};
+      siginfo_t info;
+      if (sigtimedwait(&signals, &info, &poll) > 0) break;
+      printer.flush();
+    }
+    printer.flush(true);
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "oscar log: %s\n", e.what());
+    return 2;
+  }
+}

@@ -1,0 +1,101 @@
+// oscar ps: the modules of the running system — host, pid, mode, state, restarts, cue rates.
+#include <cstdio>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "oscar/registry/registry_client.hpp"
+
+namespace {
+
+std::string modes(const oscar::ModuleState& s) {
+  std::string out;
+  for (const auto& k : s.kernels()) {
+    if (!out.empty()) out += ",";
+    out +=
+        k.mode() == "continuous" ? fmt::format("cont({}ms)", k.cycle_ns() / 1'000'000) : k.mode();
+    if (k.stub()) out += "+stub";
+  }
+  return out.empty() ? "-" : out;
+}
+
+nlohmann::json to_json(const oscar::SystemState& s) {
+  auto j = nlohmann::json{{"system", s.system()},
+                          {"state", s.state()},
+                          {"message", s.message()},
+                          {"hosts_lost", s.hosts_lost()},
+                          {"modules", nlohmann::json::array()}};
+  for (const auto& m : s.modules()) {
+    nlohmann::json kernels = nlohmann::json::array();
+    for (const auto& k : m.state().kernels()) {
+      kernels.push_back({{"name", k.name()},
+                         {"type", k.type()},
+                         {"mode", k.mode()},
+                         {"cycle_ns", k.cycle_ns()},
+                         {"stub", k.stub()},
+                         {"params", k.params()},
+                         {"inputs", k.inputs()},
+                         {"published", k.published()},
+                         {"cycles", k.cycles()}});
+    }
+    j["modules"].push_back({{"name", m.name()},
+                            {"host", m.host()},
+                            {"pid", m.pid()},
+                            {"incarnation", m.incarnation()},
+                            {"status", m.status()},
+                            {"restarts", m.restarts()},
+                            {"last_failure", m.last_failure()},
+                            {"cues_per_s", m.cues_per_s()},
+                            {"suspended", m.state().suspended()},
+                            {"kernels", kernels}});
+  }
+  return j;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"oscar ps: the modules of the running system"};
+  std::string system_file, host;
+  int domain = -1;
+  double timeout_s = 3;
+  bool json = false;
+  app.add_option("--system", system_file, "system file (its domain and network)");
+  app.add_option("--host", host, "the host this runs on (with --system)");
+  app.add_option("-d,--domain", domain, "DDS domain (default: the system's, $OSCAR_DOMAIN or 0)");
+  app.add_option("--timeout", timeout_s, "seconds to wait for the registry");
+  app.add_flag("--json", json, "print the system state as JSON");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    auto participant = oscar::tool_participant("oscar-ps", system_file, host, domain);
+    oscar::RegistryClient client(*participant, "ps");
+    const auto s = client.wait_for([](const oscar::SystemState&) { return true; },
+                                   std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));
+    if (!s) {
+      std::fprintf(stderr, "oscar ps: no registry answered on domain %d within %.1f s\n",
+                   participant->domain(), timeout_s);
+      return 1;
+    }
+    if (json) {
+      std::printf("%s\n", to_json(*s).dump().c_str());
+      return 0;
+    }
+    std::printf("system %s: %s (%s)\n", s->system().c_str(), s->state().c_str(),
+                s->message().c_str());
+    std::printf("%-16s %-10s %-8s %-4s %-11s %-8s %9s  %s\n", "MODULE", "HOST", "PID", "INC",
+                "STATE", "RESTARTS", "CUES/S", "MODES");
+    for (const auto& m : s->modules()) {
+      std::printf(
+          "%-16s %-10s %-8d %-4u %-11s %-8u %9.1f  %s%s\n", m.name().c_str(), m.host().c_str(),
+          m.pid(), m.incarnation(),
+          (m.state().suspended() && m.status() == "running" ? "suspended" : m.status().c_str()),
+          m.restarts(), m.cues_per_s(), modes(m.state()).c_str(),
+          m.last_failure().empty() ? "" : ("  last failure: " + m.last_failure()).c_str());
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "oscar ps: %s\n", e.what());
+    return 2;
+  }
+}

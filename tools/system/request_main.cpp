@@ -1,0 +1,31 @@
+// oscar restart MODULE / oscar shutdown: ask the registry (one program, two names).
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+#include <CLI/CLI.hpp>
+
+#include "oscar/registry/registry_client.hpp"
+
+int main(int argc, char** argv) {
+  const bool restart = std::filesystem::path(argv[0]).filename() == "oscar-restart";
+  CLI::App app{restart ? "oscar restart: restarts a module (also one given up or on manual policy)"
+                       : "oscar shutdown: stops the system in order"};
+  std::string module, system_file, host;
+  int domain = -1;
+  if (restart) app.add_option("module", module, "the module to restart")->required();
+  app.add_option("--system", system_file, "system file (its domain and network)");
+  app.add_option("--host", host, "the host this runs on (with --system)");
+  app.add_option("-d,--domain", domain, "DDS domain (default: the system's, $OSCAR_DOMAIN or 0)");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    auto participant = oscar::tool_participant(argv[0], system_file, host, domain);
+    oscar::RegistryClient client(*participant, "operator");
+    client.request(restart ? oscar::REG_RESTART : oscar::REG_SHUTDOWN, module);
+    std::printf(restart ? "restarting %s\n" : "shutting down%s\n", module.c_str());
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "oscar %s: %s\n", restart ? "restart" : "shutdown", e.what());
+    return 2;
+  }
+}
