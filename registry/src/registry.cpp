@@ -74,10 +74,20 @@ Registry::Tracked* Registry::find(const std::string& name) {
 void Registry::on_monitor_beat(const MonitorBeat& beat) {
   auto& mon = monitors_[beat.host()];
   if (mon.alive && mon.pid == beat.pid()) return;
+  const bool lapsed = !mon.alive && mon.pid == beat.pid();  // it was slow, not gone
   const bool back = !mon.alive && mon.pid != 0;
   mon = Monitor{beat.pid(), true, beat.log_dir()};
   spdlog::info("registry: monitor of host '{}' is {} (pid {})", beat.host(), back ? "back" : "up",
                beat.pid());
+  for (auto& m : modules_) {
+    if (m->spec->spec.host != beat.host() || m->process_gone || m->incarnation == 0) continue;
+    if (lapsed) {
+      // Its modules may still run: have them killed and restart once their exits are reported.
+      io_->send(LAUNCH_KILL, beat.host(), beat.pid(), m->spec->spec.name, m->incarnation, {}, {});
+    } else if (back) {
+      m->process_gone = true;  // they died with the previous monitor (PR_SET_PDEATHSIG)
+    }
+  }
   publish();
 }
 
@@ -88,7 +98,7 @@ void Registry::on_monitor_lost(const std::string& host, long pid) {
   spdlog::error("registry: host '{}' lost (its monitor, pid {}, stopped answering)", host, pid);
   for (auto& m : modules_) {
     if (m->spec->spec.host == host && (m->status == "running" || m->status == "starting")) {
-      fail(*m, fmt::format("host '{}' lost", host), true);
+      fail(*m, fmt::format("host '{}' lost", host), false);
     }
   }
   publish();
@@ -168,8 +178,8 @@ void Registry::fail(Tracked& m, const std::string& reason, bool process_gone) {
   m.process_gone = process_gone;
   if (m.has_state) m.config = m.state;  // what the next incarnation gets back
   spdlog::error("registry: module '{}' failed: {}", name, reason);
-  if (!process_gone) {
-    const auto& mon = monitors_[m.spec->spec.host];
+  const auto& mon = monitors_[m.spec->spec.host];
+  if (!process_gone && mon.alive) {
     io_->send(LAUNCH_KILL, m.spec->spec.host, mon.pid, name, m.incarnation, {}, {});
   }
   suspend_all();

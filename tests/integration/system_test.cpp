@@ -18,6 +18,7 @@ using testing::HasSubstr;
 // Five modules, one of them multi-core (three kernels in one process).
 constexpr const char* kFiveModules = R"(
 system: five
+lease: 1s
 modules:
   - name: lines
     kernels: [ { type: bench_source, name: lines, params: { type: LineSeg3DSeq, lines: 10 } } ]
@@ -71,7 +72,7 @@ TEST(Boot, BootsFiveModulesLetsCuesFlowAndShutsDownLeavingNoProcess) {
 // One source watched by this test process; a sink in another module; a spare source.
 constexpr const char* kRestartable = R"(
 system: restart
-lease: 300ms
+lease: 1s
 modules:
   - name: src
     kernels: [ { type: bench_source, name: src, params: { type: Bool } } ]
@@ -185,6 +186,7 @@ TEST(Registry, AHungModuleIsDetectedByItsHeartbeatAndRestarted) {
 
 constexpr const char* kLimited = R"(
 system: limited
+lease: 1s
 modules:
   - name: flaky
     kernels: [ { type: bench_source, name: flaky, params: { type: Bool } } ]
@@ -238,6 +240,7 @@ TEST(Registry, AtTheRestartLimitTheSystemStaysSuspendedByDefault) {
 TEST(Registry, ReplacePolicyStartsTheStandbyModuleAndRewiresItsConsumers) {
   BootedSystem sys("replace", R"(
 system: replace
+lease: 1s
 modules:
   - name: cam
     kernels: [ { type: bench_source, name: cam, params: { type: Bool } } ]
