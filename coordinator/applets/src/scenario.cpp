@@ -108,7 +108,9 @@ Action parse_action(const Model& model, const YAML::Node& a, const std::string& 
 }
 
 std::string note(const Model& m, const Notification& n) {
-  const std::string who = m.applet(n.applet).name + "/" + m.bundle(n.bundle).name;
+  // A reassigner speaks for one service (seed Abb. 4.13): name it.
+  const std::string who = m.applet(n.applet).name + "/" + m.bundle(n.bundle).name +
+                          (n.service ? "[" + m.service(*n.service).name + "]" : "");
   switch (n.kind) {
     case Notification::Kind::kGranted:
       return who + ": granted";
