@@ -1,16 +1,35 @@
 #include "oscar/applets/config.hpp"
 
+#include "yaml_helpers.hpp"
+
 #include <fstream>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 
 namespace oscar::applets {
-namespace {
 
-[[noreturn]] void fail_at(const YAML::Node& node, const std::string& file, const std::string& m) {
+namespace internal {
+
+void fail_at(const YAML::Node& node, const std::string& file, const std::string& m) {
   throw std::invalid_argument(where(node, file) + ": " + m);
 }
+
+long long number(const YAML::Node& node, const std::string& file, const std::string& what) {
+  if (!node || !node.IsScalar()) fail_at(node, file, what + " must be a number");
+  try {
+    return node.as<long long>();
+  } catch (const YAML::Exception&) {
+    fail_at(node, file, what + " must be a whole number, not '" + node.as<std::string>() + "'");
+  }
+}
+
+}  // namespace internal
+
+namespace {
+
+using internal::fail_at;
+using internal::number;
 
 void allow_keys(const YAML::Node& node, const std::string& file, const std::string& what,
                 const std::set<std::string>& keys) {
@@ -28,15 +47,6 @@ void allow_keys(const YAML::Node& node, const std::string& file, const std::stri
 std::string text(const YAML::Node& node, const std::string& file, const std::string& what) {
   if (!node || !node.IsScalar()) fail_at(node, file, what + " must be a text value");
   return node.as<std::string>();
-}
-
-long long number(const YAML::Node& node, const std::string& file, const std::string& what) {
-  if (!node || !node.IsScalar()) fail_at(node, file, what + " must be a number");
-  try {
-    return node.as<long long>();
-  } catch (const YAML::Exception&) {
-    fail_at(node, file, what + " must be a whole number, not '" + node.as<std::string>() + "'");
-  }
 }
 
 Access access_of(const YAML::Node& node, const std::string& file) {

@@ -6,21 +6,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "yaml_helpers.hpp"
+
 namespace oscar::applets {
 namespace {
 
-[[noreturn]] void fail_at(const YAML::Node& node, const std::string& file, const std::string& m) {
-  throw std::invalid_argument(where(node, file) + ": " + m);
-}
-
-long long number(const YAML::Node& node, const std::string& file, const std::string& what) {
-  if (!node || !node.IsScalar()) fail_at(node, file, what + " must be a number");
-  try {
-    return node.as<long long>();
-  } catch (const YAML::Exception&) {
-    fail_at(node, file, what + " must be a whole number, not '" + node.as<std::string>() + "'");
-  }
-}
+using internal::fail_at;
+using internal::number;
 
 BundleId bundle_at(const Model& model, const YAML::Node& node, const std::string& file) {
   const std::string ref = node.IsScalar() ? node.as<std::string>() : "";

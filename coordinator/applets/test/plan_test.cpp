@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
+
 #include "oscar/applets/scheduler.hpp"
 
 namespace oscar::applets {
@@ -121,9 +123,6 @@ TEST(Plan, CycleIsGrantedAllOrNothingWithItsHighestPriority) {
   EXPECT_TRUE(s.plan().bundle_granted[ab]);
   EXPECT_TRUE(s.plan().bundle_granted[bb]);
   EXPECT_EQ(s.holder(disp), "A");
-  // An exclusive user of S1 above the cycle: the cycle needs S1 shared, so all of it loses.
-  const Model& mm = s.model();
-  (void)mm;
 }
 
 TEST(Plan, CycleThatCannotBeCompletedGrantsNothing) {
@@ -171,6 +170,45 @@ TEST(Plan, TriggeringSwitchesOnceWithoutOscillation) {
   EXPECT_EQ(s.plans_computed(), plans + 1);
   EXPECT_EQ(s.holder(s2), "App3");
   EXPECT_FALSE(s.plan().bundle_granted[a2s2]);
+}
+
+// Seed §4.5.2: priorities are levels with room in between; 250 lies between normal and high.
+TEST(Plan, IntermediatePriorityLevelsSortBetweenTheNamedOnes) {
+  Model m;
+  const ServiceId svc = m.add_service("S");
+  const BundleId normal = m.add_bundle(m.add_applet("Normal"), "s", {{svc, kX}}, kPriorityNormal);
+  const BundleId between = m.add_bundle(m.add_applet("Between"), "s", {{svc, kX}}, 250);
+  const BundleId high = m.add_bundle(m.add_applet("High"), "s", {{svc, kX}}, kPriorityHigh);
+  Scheduler s(m);
+  s.request(normal);
+  s.request(between);
+  EXPECT_EQ(s.holder(svc), "Between");
+  s.request(high);
+  EXPECT_EQ(s.holder(svc), "High");
+  s.set_priority(between, kPriorityHigh + 1);
+  EXPECT_EQ(s.holder(svc), "Between");
+}
+
+// Abb. 4.19: every request, release, priority and deadline change computes a new plan.
+TEST(Plan, IsRecomputedOnEveryRequestReleasePriorityAndDeadlineChange) {
+  Model m;
+  const ServiceId svc = m.add_service("S");
+  const BundleId a = m.add_bundle(m.add_applet("A"), "s", {{svc, kX}});
+  const BundleId b = m.add_bundle(m.add_applet("B"), "s", {{svc, kX}});
+  Scheduler s(m);
+  using std::chrono::milliseconds;
+  const std::vector<std::function<void()>> changes = {
+      [&] { s.request(a); }, [&] { s.request(b); }, [&] { s.set_priority(b, kPriorityHigh); },
+      [&] {
+        s.set_deadline(a, Deadline{milliseconds{0}, milliseconds{10}, milliseconds{100}});
+      },
+      [&] { s.release(b); }};
+  for (std::size_t i = 0; i < changes.size(); ++i) {
+    const auto before = s.plans_computed();
+    changes[i]();
+    EXPECT_EQ(s.plans_computed(), before + 1) << "change " << i;
+  }
+  EXPECT_EQ(s.holder(svc), "A");
 }
 
 TEST(Plan, HeldBundleKeepsItsPlaceAgainstANewEqualRequest) {
