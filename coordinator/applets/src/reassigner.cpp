@@ -122,6 +122,16 @@ std::optional<milliseconds> Scheduler::revoke_deadline(BundleId bundle) const {
   return until;
 }
 
+std::optional<milliseconds> Scheduler::next_forced_revocation() const {
+  std::optional<milliseconds> next;
+  for (const Reassignment& r : reassigners_) {
+    for (const auto& g : r.giving) {
+      if (!next || g.until < *next) next = g.until;
+    }
+  }
+  return next;
+}
+
 void Scheduler::advance_to(milliseconds t) {
   if (t < now_) {
     throw std::invalid_argument("time " + std::to_string(t.count()) + " ms lies before now (" +

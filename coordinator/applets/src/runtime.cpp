@@ -71,13 +71,23 @@ bool Runtime::crashed(const std::string& applet) const {
 void Runtime::with_scheduler(const std::function<void(Scheduler&)>& f) {
   std::unique_lock lock(mutex_);
   locked_call(f);
+  wake(lock);
 }
 
 void Runtime::locked_call(const std::function<void(Scheduler&)>& f) {
   scheduler_.advance_to(std::max(scheduler_.now(), clock()));
   f(scheduler_);
   deliver();
-  changed_.notify_all();
+  // Wake the force thread only for an earlier wait limit than it waits for (not on every call).
+  const auto next = scheduler_.next_forced_revocation();
+  if (next && *next < forcing_at_) changed_.notify_all();
+}
+
+void Runtime::wake(std::unique_lock<std::mutex>& lock) {
+  std::vector<Slot*> slots;
+  slots.swap(to_wake_);
+  lock.unlock();
+  for (Slot* slot : slots) slot->cv.notify_all();
 }
 
 void Runtime::deliver() {
@@ -89,7 +99,9 @@ void Runtime::deliver() {
     if (n.kind == Notification::Kind::kRevokedByForce) waiting_since_[n.bundle] = Clock::now();
     Slot& slot = *slots_[n.applet];
     slot.interrupts.push_back(std::move(n));
-    slot.cv.notify_all();
+    if (std::find(to_wake_.begin(), to_wake_.end(), &slot) == to_wake_.end()) {
+      to_wake_.push_back(&slot);
+    }
   }
 }
 
@@ -134,10 +146,11 @@ void Runtime::applet_main(AppletId id) {
       if (stopping_) return;
     }
   } catch (const std::exception&) {
-    std::lock_guard lock(mutex_);
+    std::unique_lock lock(mutex_);
     slot.crashed = true;
     stats_.crashed.push_back(scheduler_.model().applet(id).name);
     locked_call([id](Scheduler& s) { s.crash(id); });
+    wake(lock);
   }
 }
 
@@ -199,18 +212,17 @@ void Runtime::run_negotiations(AppletContext& ctx) {
 void Runtime::reassigner_main() {
   std::unique_lock lock(mutex_);
   while (!stopping_) {
-    milliseconds next = milliseconds::max();
-    for (BundleId b = 0; b < scheduler_.model().bundles().size(); ++b) {
-      if (auto until = scheduler_.revoke_deadline(b)) next = std::min(next, *until);
-    }
-    if (next == milliseconds::max()) {
+    forcing_at_ = scheduler_.next_forced_revocation().value_or(milliseconds::max());
+    if (forcing_at_ == milliseconds::max()) {
       changed_.wait(lock);
     } else {
-      changed_.wait_until(lock, start_ + next);
+      changed_.wait_until(lock, start_ + forcing_at_);
     }
     if (stopping_) break;
     scheduler_.advance_to(std::max(scheduler_.now(), clock()));
     deliver();
+    wake(lock);
+    lock.lock();
   }
 }
 

@@ -87,6 +87,9 @@ class Runtime {
   milliseconds clock() const;
   void locked_call(const std::function<void(Scheduler&)>& f);  // lock held by caller
   void deliver();                                              // lock held
+  // Unlocks, then wakes the applets deliver() queued notifications for: a woken applet does
+  // not block on the mutex its waker still holds.
+  void wake(std::unique_lock<std::mutex>& lock);
   void applet_main(AppletId id);
   // Runs one negotiation round for `bundle` and keeps or ends its chain (applet thread).
   std::optional<Notification> run_round(AppletContext& ctx, BundleId bundle,
@@ -96,7 +99,9 @@ class Runtime {
   void reassigner_main();
 
   mutable std::mutex mutex_;
-  std::condition_variable changed_;  // wakes the reassigner
+  std::condition_variable changed_;                // wakes the force thread
+  milliseconds forcing_at_ = milliseconds::max();  // the wait limit the force thread waits for
+  std::vector<Slot*> to_wake_;
   Scheduler scheduler_;
   std::vector<std::unique_ptr<Slot>> slots_;
   std::vector<Clock::time_point> waiting_since_;  // per bundle: asked, not yet granted

@@ -110,6 +110,8 @@ class Scheduler {
   /// Whether the bundle is being revoked and by when it must be yielded (the earliest wait
   /// limit among the reassigners of its services).
   std::optional<milliseconds> revoke_deadline(BundleId bundle) const;
+  /// The earliest wait limit of any running reassigner (when advance_to next revokes by force).
+  std::optional<milliseconds> next_forced_revocation() const;
   /// The reassigner of a service; `giving` is empty when none runs.
   const Reassignment& reassignment(ServiceId service) const { return reassigners_.at(service); }
   bool requested(BundleId bundle) const { return state_.at(bundle).requested; }
