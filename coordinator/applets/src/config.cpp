@@ -182,6 +182,7 @@ SystemConfig load_system(const YAML::Node& root, const std::string& file) {
   }
   const YAML::Node applets = root["applets"];
   if (applets && !applets.IsSequence()) fail_at(applets, file, "'applets' must be a list");
+  std::vector<YAML::Node> requested_at;  // per requested_at_start entry, for messages
   for (const auto& a : applets) {
     allow_keys(a, file, "applet", {"name", "provides", "bundles", "params", "fail_stop"});
     const std::string name = text(a["name"], file, "applet name");
@@ -216,10 +217,23 @@ SystemConfig load_system(const YAML::Node& root, const std::string& file) {
       const int prio = b["priority"] ? parse_priority(b["priority"], file) : kPriorityNormal;
       try {
         const BundleId bid = c.model.add_bundle(id, bname, resources, prio);
-        if (b["requested"] && b["requested"].as<bool>()) c.requested_at_start.push_back(bid);
+        if (b["requested"] && b["requested"].as<bool>()) {
+          c.requested_at_start.push_back(bid);
+          requested_at.push_back(b);
+        }
       } catch (const std::invalid_argument& e) {
         fail_at(b, file, e.what());
       }
+    }
+  }
+  // Requests at start are checked now, with their line, not when a run makes them (e.g. two
+  // bundles of one applet that both want an exclusive-only service).
+  Scheduler probe(c.model, c.options);
+  for (std::size_t i = 0; i < c.requested_at_start.size(); ++i) {
+    try {
+      probe.request(c.requested_at_start[i]);
+    } catch (const std::invalid_argument& e) {
+      fail_at(requested_at[i], file, e.what());
     }
   }
   return c;
