@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "oscar/applets/scheduler.hpp"
+#include "test_support.hpp"
 
 namespace oscar::applets {
 namespace {
@@ -102,14 +103,11 @@ TEST(Plan, InheritancePreventsPriorityInversion) {
 
 // Abb. 4.9: a cycle is granted all or nothing, sorted with its highest priority.
 TEST(Plan, CycleIsGrantedAllOrNothingWithItsHighestPriority) {
-  Model m;
-  const ServiceId s1 = m.add_service("S1");
-  const ServiceId s2 = m.add_service("S2");
+  testing::TwoServiceApplets t;
+  Model& m = t.m;
+  const ServiceId s1 = t.s1, s2 = t.s2;
+  const AppletId a = t.a, b = t.b;
   const ServiceId disp = m.add_service("Display");
-  const AppletId a = m.add_applet("A");
-  const AppletId b = m.add_applet("B");
-  m.provide(a, s1);
-  m.provide(b, s2);
   const BundleId ab = m.add_bundle(a, "x", {{s2, kS}, {disp, kX}}, kPriorityLow);
   const BundleId bb = m.add_bundle(b, "x", {{s1, kS}}, kPriorityHigh);
   const BundleId other = m.add_bundle(m.add_applet("Other"), "d", {{disp, kX}}, kPriorityNormal);
@@ -126,13 +124,10 @@ TEST(Plan, CycleIsGrantedAllOrNothingWithItsHighestPriority) {
 }
 
 TEST(Plan, CycleThatCannotBeCompletedGrantsNothing) {
-  Model m;
-  const ServiceId s1 = m.add_service("S1");
-  const ServiceId s2 = m.add_service("S2");
-  const AppletId a = m.add_applet("A");
-  const AppletId b = m.add_applet("B");
-  m.provide(a, s1);
-  m.provide(b, s2);
+  testing::TwoServiceApplets t;
+  Model& m = t.m;
+  const ServiceId s1 = t.s1, s2 = t.s2;
+  const AppletId a = t.a, b = t.b;
   const BundleId ab = m.add_bundle(a, "x", {{s2, kS}});
   const BundleId bb = m.add_bundle(b, "x", {{s1, kS}});
   const BundleId x = m.add_bundle(m.add_applet("X"), "s1", {{s1, kX}}, kPrioritySystem);

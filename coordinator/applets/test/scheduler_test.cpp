@@ -3,7 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "error_of.hpp"
+#include "test_support.hpp"
 
 namespace oscar::applets {
 namespace {
