@@ -1,8 +1,10 @@
 #pragma once
 // Shared by the applet tests: error messages, and the smallest dependency cycle (Abb. 4.9).
 
+#include <chrono>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "oscar/applets/model.hpp"
 
@@ -17,6 +19,18 @@ std::string error_of(F&& f) {
     return e.what();
   }
   return "no exception";
+}
+
+/// Whether `pred` becomes true within `limit` (polled every 2 ms): threaded tests wait for an
+/// outcome, never a fixed time.
+template <typename P>
+bool eventually(P pred, std::chrono::milliseconds limit = std::chrono::seconds{10}) {
+  const auto end = std::chrono::steady_clock::now() + limit;
+  while (std::chrono::steady_clock::now() < end) {
+    if (pred()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds{2});
+  }
+  return pred();
 }
 
 /// Service applets A (provides S1) and B (provides S2): a bundle of A using S2 and one of B
