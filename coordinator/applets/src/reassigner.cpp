@@ -65,6 +65,29 @@ const std::vector<ServiceId>& Scheduler::services_of(BundleId bundle) const {
   return *slot;
 }
 
+bool Scheduler::uses_itself(BundleId bundle, ServiceId service) const {
+  auto& slot = own_cache_.at(bundle);
+  if (!slot) {
+    std::vector<ServiceId> own;
+    std::vector<ServiceId> to_visit;
+    for (ResourceId r : model_.bundle(bundle).resources) {
+      to_visit.push_back(model_.resource(r).service);
+    }
+    while (!to_visit.empty()) {
+      const ServiceId s = to_visit.back();
+      to_visit.pop_back();
+      if (std::find(own.begin(), own.end(), s) != own.end()) continue;
+      own.push_back(s);
+      for (const Use& u : model_.needs(s)) {
+        if (u.by == Use::By::kService) to_visit.push_back(u.service);
+      }
+    }
+    std::sort(own.begin(), own.end());
+    slot = std::move(own);
+  }
+  return std::binary_search(slot->begin(), slot->end(), service);
+}
+
 bool Scheduler::conflicts(BundleId a, BundleId b) const {
   const auto& fa = footprint(a);
   const auto& fb = footprint(b);
@@ -150,7 +173,10 @@ void Scheduler::advance_to(milliseconds t) {
     if (!revoking_[b]) continue;  // already forced by an earlier reassigner
     stop_giving(b);
     active_[b] = 0;
-    notifications_.push_back(notice(Notification::Kind::kRevokedByForce, b, s));
+    // Named after the service whose wait limit passed, if the holder heard from its reassigner.
+    notifications_.push_back(
+        notice(Notification::Kind::kRevokedByForce, b,
+               uses_itself(b, s) ? std::optional<ServiceId>{s} : std::nullopt));
   }
   if (!overdue.empty()) update_handover();
 }
@@ -188,7 +214,7 @@ Notification Scheduler::negotiate_with(ServiceId service, Reassignment::Giving& 
       n.until = giving.until;
     }
   }
-  notifications_.push_back(n);
+  if (uses_itself(bundle, service)) notifications_.push_back(n);
   return n;
 }
 
@@ -251,7 +277,7 @@ void Scheduler::update_handover() {
     r.to = std::move(to[s]);
     for (const auto& g : r.giving) {
       const bool is_fresh = std::find(fresh.begin(), fresh.end(), g.bundle) != fresh.end();
-      if (!is_fresh && !changed) continue;
+      if ((!is_fresh && !changed) || !uses_itself(g.bundle, s)) continue;
       Notification told = notice(Notification::Kind::kRevokeRequested, g.bundle, s);
       told.new_holders = r.to;
       told.until = g.until;

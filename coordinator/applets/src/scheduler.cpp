@@ -29,6 +29,7 @@ Scheduler::Scheduler(Model model, SchedulerOptions options)
   reassigners_.resize(model_.services().size());
   footprint_cache_.assign(n, std::nullopt);
   services_cache_.assign(n, std::nullopt);
+  own_cache_.assign(n, std::nullopt);
   if (options_.revoke_wait.count() < 0 || options_.negotiation_round_max.count() < 0 ||
       options_.negotiation_rounds_max < 0 || options_.context_switch.count() < 0) {
     fail("scheduler options: times and round counts must not be negative");

@@ -144,5 +144,35 @@ TEST(Reassigner, DependencyDownTheHierarchyHasItsOwnReassigner) {
   }
 }
 
+// The UI service applet holds the monitor itself: a UI user being revoked hears from the UI's
+// reassigner only, while the monitor's reassigner tracks it silently until it yields (the UI it
+// uses needs the monitor until then).
+TEST(Reassigner, UserOfAServiceAppletHearsOnlyAboutWhatItUsesItself) {
+  Model m;
+  const ServiceId ui = m.add_service("UI", true);
+  const ServiceId monitor = m.add_service("Monitor");
+  const AppletId provider = m.add_applet("UIService");
+  m.provide(provider, ui);
+  m.add_bundle(provider, "io", {{monitor, kX}});
+  const BundleId menu = m.add_bundle(m.add_applet("Menu"), "ui", {{ui, kX}});
+  const BundleId drive = m.add_bundle(m.add_applet("DriveTo"), "ui", {{ui, kX}}, kPriorityHigh);
+  Scheduler s(m);
+  s.request(menu);
+  s.take_notifications();
+  s.request(drive);
+  const auto told = of_kind(s.take_notifications(), Notification::Kind::kRevokeRequested);
+  ASSERT_EQ(told.size(), 1u);
+  EXPECT_EQ(told[0].service, ui);
+  ASSERT_EQ(s.reassignment(monitor).giving.size(), 1u);
+  EXPECT_EQ(s.reassignment(monitor).giving[0].bundle, menu);
+  s.negotiate(menu, Negotiation{milliseconds{100}, milliseconds{100}, true});
+  const auto replies = of_kind(s.take_notifications(), Notification::Kind::kNegotiationAccepted);
+  ASSERT_EQ(replies.size(), 1u);
+  EXPECT_EQ(replies[0].service, ui);
+  s.yield(menu);
+  EXPECT_TRUE(s.reassignment(monitor).giving.empty());
+  EXPECT_TRUE(s.active(drive));
+}
+
 }  // namespace
 }  // namespace oscar::applets

@@ -147,6 +147,10 @@ class Scheduler {
   void update_handover();
   const std::vector<FootUse>& footprint(BundleId bundle) const;
   const std::vector<ServiceId>& services_of(BundleId bundle) const;
+  /// Whether the bundle uses `service` itself: one of its resources or, down the hierarchy, a
+  /// configured dependency of those. Not a service applet's resource, which that applet holds.
+  /// Its holder hears only from these reassigners (the others track it silently).
+  bool uses_itself(BundleId bundle, ServiceId service) const;
   bool conflicts(BundleId a, BundleId b) const;
   void check_bundle(BundleId bundle) const;
   void start_giving(BundleId bundle);
@@ -166,6 +170,7 @@ class Scheduler {
   std::uint64_t plans_ = 0;
   mutable std::vector<std::optional<std::vector<FootUse>>> footprint_cache_;  // sorted by service
   mutable std::vector<std::optional<std::vector<ServiceId>>> services_cache_;
+  mutable std::vector<std::optional<std::vector<ServiceId>>> own_cache_;  // sorted
 };
 
 }  // namespace oscar::applets
