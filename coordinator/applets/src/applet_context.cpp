@@ -53,18 +53,15 @@ Notification AppletContext::negotiate(const std::string& bundle, const Negotiati
   return n;
 }
 
-Notification AppletContext::negotiate(const std::string& bundle, const NegotiationRound& round) {
-  Notification reply;
-  const NegotiationRound* r = &round;
-  while (r != nullptr) {
-    if (r->first) r->first();
-    if (!being_revoked(bundle)) break;  // forced meanwhile, or the plan gave it back
-    reply = negotiate(bundle, r->answer);
-    r = (reply.kind == Notification::Kind::kNegotiationAccepted ? r->on_accept : r->on_reject)
-            .get();
-  }
-  yield(bundle);
-  return reply;
+std::optional<Notification> AppletContext::negotiate(const std::string& bundle,
+                                                     const NegotiationRound& round) {
+  const BundleId b = bundle_id(bundle);
+  if (runtime_.slots_[applet_]->negotiations.count(b) != 0) return std::nullopt;
+  return runtime_.run_round(*this, b, round);
+}
+
+bool AppletContext::negotiating(const std::string& bundle) const {
+  return runtime_.slots_[applet_]->negotiations.count(bundle_id(bundle)) != 0;
 }
 
 bool AppletContext::being_revoked(const std::string& bundle) const {

@@ -1,16 +1,35 @@
 #include "oscar/applets/config.hpp"
 
+#include "yaml_helpers.hpp"
+
 #include <fstream>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 
 namespace oscar::applets {
-namespace {
 
-[[noreturn]] void fail_at(const YAML::Node& node, const std::string& file, const std::string& m) {
+namespace internal {
+
+void fail_at(const YAML::Node& node, const std::string& file, const std::string& m) {
   throw std::invalid_argument(where(node, file) + ": " + m);
 }
+
+long long number(const YAML::Node& node, const std::string& file, const std::string& what) {
+  if (!node || !node.IsScalar()) fail_at(node, file, what + " must be a number");
+  try {
+    return node.as<long long>();
+  } catch (const YAML::Exception&) {
+    fail_at(node, file, what + " must be a whole number, not '" + node.as<std::string>() + "'");
+  }
+}
+
+}  // namespace internal
+
+namespace {
+
+using internal::fail_at;
+using internal::number;
 
 void allow_keys(const YAML::Node& node, const std::string& file, const std::string& what,
                 const std::set<std::string>& keys) {
@@ -28,15 +47,6 @@ void allow_keys(const YAML::Node& node, const std::string& file, const std::stri
 std::string text(const YAML::Node& node, const std::string& file, const std::string& what) {
   if (!node || !node.IsScalar()) fail_at(node, file, what + " must be a text value");
   return node.as<std::string>();
-}
-
-long long number(const YAML::Node& node, const std::string& file, const std::string& what) {
-  if (!node || !node.IsScalar()) fail_at(node, file, what + " must be a number");
-  try {
-    return node.as<long long>();
-  } catch (const YAML::Exception&) {
-    fail_at(node, file, what + " must be a whole number, not '" + node.as<std::string>() + "'");
-  }
 }
 
 Access access_of(const YAML::Node& node, const std::string& file) {
@@ -172,6 +182,7 @@ SystemConfig load_system(const YAML::Node& root, const std::string& file) {
   }
   const YAML::Node applets = root["applets"];
   if (applets && !applets.IsSequence()) fail_at(applets, file, "'applets' must be a list");
+  std::vector<YAML::Node> requested_at;  // per requested_at_start entry, for messages
   for (const auto& a : applets) {
     allow_keys(a, file, "applet", {"name", "provides", "bundles", "params", "fail_stop"});
     const std::string name = text(a["name"], file, "applet name");
@@ -206,10 +217,23 @@ SystemConfig load_system(const YAML::Node& root, const std::string& file) {
       const int prio = b["priority"] ? parse_priority(b["priority"], file) : kPriorityNormal;
       try {
         const BundleId bid = c.model.add_bundle(id, bname, resources, prio);
-        if (b["requested"] && b["requested"].as<bool>()) c.requested_at_start.push_back(bid);
+        if (b["requested"] && b["requested"].as<bool>()) {
+          c.requested_at_start.push_back(bid);
+          requested_at.push_back(b);
+        }
       } catch (const std::invalid_argument& e) {
         fail_at(b, file, e.what());
       }
+    }
+  }
+  // Requests at start are checked now, with their line, not when a run makes them (e.g. two
+  // bundles of one applet that both want an exclusive-only service).
+  Scheduler probe(c.model, c.options);
+  for (std::size_t i = 0; i < c.requested_at_start.size(); ++i) {
+    try {
+      probe.request(c.requested_at_start[i]);
+    } catch (const std::invalid_argument& e) {
+      fail_at(requested_at[i], file, e.what());
     }
   }
   return c;

@@ -60,11 +60,17 @@ std::string to_dot(const Scheduler& s) {
            ";\n";
     for (BundleId b : ap.bundles) {
       const Bundle& bundle = m.bundle(b);
-      const std::string state = !s.requested(b)          ? "idle"
-                                : s.active(b)            ? "active"
-                                : plan.bundle_granted[b] ? "granted, waiting for hand-over"
-                                                         : "blocked";
-      const std::string colour = state == "idle"      ? "white"
+      // A bundle given back is still in use until its reassigners' first wait limit (Abb. 4.13);
+      // a service applet's bundle may be active through inheritance without a request.
+      const auto revoke_by = s.revoke_deadline(b);
+      const std::string state =
+          revoke_by         ? "being revoked, until " + std::to_string(revoke_by->count()) + " ms"
+          : s.active(b)     ? "active"
+          : !s.requested(b) ? "idle"
+          : plan.bundle_granted[b] ? "granted, waiting for hand-over"
+                                   : "blocked";
+      const std::string colour = revoke_by            ? "orange"
+                                 : state == "idle"    ? "white"
                                  : state == "active"  ? "palegreen"
                                  : state == "blocked" ? "lightgrey"
                                                       : "khaki";

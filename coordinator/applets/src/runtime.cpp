@@ -71,13 +71,23 @@ bool Runtime::crashed(const std::string& applet) const {
 void Runtime::with_scheduler(const std::function<void(Scheduler&)>& f) {
   std::unique_lock lock(mutex_);
   locked_call(f);
+  wake(lock);
 }
 
 void Runtime::locked_call(const std::function<void(Scheduler&)>& f) {
   scheduler_.advance_to(std::max(scheduler_.now(), clock()));
   f(scheduler_);
   deliver();
-  changed_.notify_all();
+  // Wake the force thread only for an earlier wait limit than it waits for (not on every call).
+  const auto next = scheduler_.next_forced_revocation();
+  if (next && *next < forcing_at_) changed_.notify_all();
+}
+
+void Runtime::wake(std::unique_lock<std::mutex>& lock) {
+  std::vector<Slot*> slots;
+  slots.swap(to_wake_);
+  lock.unlock();
+  for (Slot* slot : slots) slot->cv.notify_all();
 }
 
 void Runtime::deliver() {
@@ -89,7 +99,9 @@ void Runtime::deliver() {
     if (n.kind == Notification::Kind::kRevokedByForce) waiting_since_[n.bundle] = Clock::now();
     Slot& slot = *slots_[n.applet];
     slot.interrupts.push_back(std::move(n));
-    slot.cv.notify_all();
+    if (std::find(to_wake_.begin(), to_wake_.end(), &slot) == to_wake_.end()) {
+      to_wake_.push_back(&slot);
+    }
   }
 }
 
@@ -120,41 +132,97 @@ void Runtime::applet_main(AppletId id) {
           ctx.yield(scheduler_.model().bundle(n.bundle).name);
         }
       }
+      run_negotiations(ctx);  // follow-up rounds run like interrupt handlers (§4.5.3)
       bool paused;
       {
         std::lock_guard lock(mutex_);
         paused = slot.paused;
       }
       if (!paused) slot.code.step(ctx);  // line 5
-      next += slot.code.period;          // lines 6–7
+      ++slot.steps;
+      next += slot.code.period;  // lines 6–7
       std::unique_lock lock(mutex_);
       slot.cv.wait_until(lock, next, [&] { return stopping_; });
       if (stopping_) return;
     }
   } catch (const std::exception&) {
-    std::lock_guard lock(mutex_);
+    std::unique_lock lock(mutex_);
     slot.crashed = true;
     stats_.crashed.push_back(scheduler_.model().applet(id).name);
     locked_call([id](Scheduler& s) { s.crash(id); });
+    wake(lock);
   }
 }
 
-// Revokes by force when a wait limit passes (seed §4.6.1).
+std::optional<Notification> Runtime::run_round(AppletContext& ctx, BundleId bundle,
+                                               const NegotiationRound& round) {
+  Slot& slot = *slots_[ctx.id()];
+  const std::string& name = scheduler_.model().bundle(bundle).name;  // the model never changes
+  const SchedulerOptions& options = scheduler_.options();
+  const auto started = Clock::now();
+  if (round.first) round.first();
+  std::optional<Notification> reply;
+  // A round whose code overran the round limit is not answered: the chain ends (seed §4.5.3).
+  if (Clock::now() - started <= options.negotiation_round_max) {
+    // Checked and answered under one lock: a forced revocation cannot slip in between.
+    with_scheduler([&](Scheduler& s) {
+      if (s.revoke_deadline(bundle)) reply = s.negotiate(bundle, round.answer);
+    });
+  }
+  Slot::Chain& chain = slot.negotiations[bundle];
+  ++chain.rounds;
+  chain.step = slot.steps;
+  chain.round_started = started;
+  chain.next.reset();
+  if (reply) {
+    chain.next =
+        reply->kind == Notification::Kind::kNegotiationAccepted ? round.on_accept : round.on_reject;
+  }
+  if (!chain.next || chain.rounds >= options.negotiation_rounds_max) {
+    slot.negotiations.erase(bundle);
+    ctx.yield(name);  // the defined behaviour has run (or may not go on): hand the bundle over
+  }
+  return reply;
+}
+
+void Runtime::run_negotiations(AppletContext& ctx) {
+  Slot& slot = *slots_[ctx.id()];
+  const auto round_max = scheduler_.options().negotiation_round_max;
+  for (auto it = slot.negotiations.begin(); it != slot.negotiations.end();) {
+    const auto current = it++;  // run_round may erase `current`, never another entry
+    const BundleId bundle = current->first;
+    Slot::Chain& chain = current->second;
+    if (chain.step >= slot.steps) continue;  // one round per main-loop step
+    const std::string& name = scheduler_.model().bundle(bundle).name;
+    if (!ctx.being_revoked(name)) {  // forced meanwhile, or the plan gave the bundle back
+      slot.negotiations.erase(current);
+      continue;
+    }
+    if (Clock::now() - chain.round_started > round_max) {  // the round took too long
+      slot.negotiations.erase(current);
+      ctx.yield(name);
+      continue;
+    }
+    const auto next = chain.next;  // keeps the round alive while it runs
+    run_round(ctx, bundle, *next);
+  }
+}
+
+// Lets the reassigners revoke by force when a wait limit passes (seed §4.6.1).
 void Runtime::reassigner_main() {
   std::unique_lock lock(mutex_);
   while (!stopping_) {
-    milliseconds next = milliseconds::max();
-    for (BundleId b = 0; b < scheduler_.model().bundles().size(); ++b) {
-      if (auto until = scheduler_.revoke_deadline(b)) next = std::min(next, *until);
-    }
-    if (next == milliseconds::max()) {
+    forcing_at_ = scheduler_.next_forced_revocation().value_or(milliseconds::max());
+    if (forcing_at_ == milliseconds::max()) {
       changed_.wait(lock);
     } else {
-      changed_.wait_until(lock, start_ + next);
+      changed_.wait_until(lock, start_ + forcing_at_);
     }
     if (stopping_) break;
     scheduler_.advance_to(std::max(scheduler_.now(), clock()));
     deliver();
+    wake(lock);
+    lock.lock();
   }
 }
 

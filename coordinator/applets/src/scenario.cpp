@@ -6,21 +6,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "yaml_helpers.hpp"
+
 namespace oscar::applets {
 namespace {
 
-[[noreturn]] void fail_at(const YAML::Node& node, const std::string& file, const std::string& m) {
-  throw std::invalid_argument(where(node, file) + ": " + m);
-}
-
-long long number(const YAML::Node& node, const std::string& file, const std::string& what) {
-  if (!node || !node.IsScalar()) fail_at(node, file, what + " must be a number");
-  try {
-    return node.as<long long>();
-  } catch (const YAML::Exception&) {
-    fail_at(node, file, what + " must be a whole number, not '" + node.as<std::string>() + "'");
-  }
-}
+using internal::fail_at;
+using internal::number;
 
 BundleId bundle_at(const Model& model, const YAML::Node& node, const std::string& file) {
   const std::string ref = node.IsScalar() ? node.as<std::string>() : "";
@@ -108,7 +100,9 @@ Action parse_action(const Model& model, const YAML::Node& a, const std::string& 
 }
 
 std::string note(const Model& m, const Notification& n) {
-  const std::string who = m.applet(n.applet).name + "/" + m.bundle(n.bundle).name;
+  // A reassigner speaks for one service (seed Abb. 4.13): name it.
+  const std::string who = m.applet(n.applet).name + "/" + m.bundle(n.bundle).name +
+                          (n.service ? "[" + m.service(*n.service).name + "]" : "");
   switch (n.kind) {
     case Notification::Kind::kGranted:
       return who + ": granted";

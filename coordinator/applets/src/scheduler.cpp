@@ -25,30 +25,16 @@ Scheduler::Scheduler(Model model, SchedulerOptions options)
     state_[b].priority = model_.bundle(b).priority;
   }
   active_.assign(n, 0);
-  revoking_.assign(n, std::nullopt);
-  closure_cache_.assign(model_.services().size(), std::nullopt);
+  revoking_.assign(n, 0);
+  reassigners_.resize(model_.services().size());
+  footprint_cache_.assign(n, std::nullopt);
+  services_cache_.assign(n, std::nullopt);
+  own_cache_.assign(n, std::nullopt);
   if (options_.revoke_wait.count() < 0 || options_.negotiation_round_max.count() < 0 ||
       options_.negotiation_rounds_max < 0 || options_.context_switch.count() < 0) {
     fail("scheduler options: times and round counts must not be negative");
   }
   replan();
-}
-
-void Scheduler::advance_to(milliseconds t) {
-  if (t < now_) fail("time " + ms(t) + " lies before now (" + ms(now_) + "); time only advances");
-  now_ = t;
-  bool changed = false;
-  for (BundleId b = 0; b < revoking_.size(); ++b) {
-    if (revoking_[b] && revoking_[b]->until <= now_) {
-      // Seed §4.6.1: the wait limit passed, the resource is revoked by force.
-      revoking_[b].reset();
-      active_[b] = 0;
-      changed = true;
-      notifications_.push_back(Notification{
-          Notification::Kind::kRevokedByForce, model_.bundle(b).applet, b, {}, {}, now_});
-    }
-  }
-  if (changed) update_handover();
 }
 
 void Scheduler::check_bundle(BundleId bundle) const {
@@ -86,13 +72,13 @@ void Scheduler::release(BundleId bundle) {
   s.requested = false;
   s.boosted = false;
   active_[bundle] = 0;
-  revoking_[bundle].reset();
+  stop_giving(bundle);
   replan();
 }
 
 void Scheduler::yield(BundleId bundle) {
   if (!revoking_.at(bundle)) return;  // nothing to hand back: the bundle stays where it is
-  revoking_[bundle].reset();
+  stop_giving(bundle);
   active_[bundle] = 0;
   update_handover();
 }
@@ -144,55 +130,9 @@ void Scheduler::crash(AppletId applet) {
     state_[b].requested = false;
     state_[b].boosted = false;
     active_[b] = 0;
-    revoking_[b].reset();
+    stop_giving(b);
   }
   replan();
-}
-
-Notification Scheduler::negotiate(BundleId bundle, const Negotiation& answer) {
-  auto& rev = revoking_.at(bundle);
-  const Bundle& b = model_.bundle(bundle);
-  if (!rev) {
-    fail("applet '" + model_.applet(b.applet).name + "' negotiates over bundle '" + b.name +
-         "' which is not being revoked");
-  }
-  if (answer.min_needed.count() < 0 || answer.max_needed < answer.min_needed) {
-    fail("applet '" + model_.applet(b.applet).name + "' bundle '" + b.name +
-         "': a negotiation needs 0 <= min_needed <= max_needed");
-  }
-  ++rev->rounds;
-  // Latest time the new holders can wait: the earliest relative deadline among the granted
-  // bundles that need what this one holds (their deadlines bound the extra time, seed §4.6.1).
-  milliseconds latest = milliseconds::max();
-  for (BundleId g = 0; g < state_.size(); ++g) {
-    if (g == bundle || !plan_.bundle_granted[g] || active_[g] || !state_[g].deadline) continue;
-    if (conflicts(g, bundle)) latest = std::min(latest, state_[g].deadline->relative());
-  }
-  auto fits = [&](milliseconds t) {
-    return t <= options_.negotiation_round_max &&
-           (latest == milliseconds::max() || now_ + t + options_.context_switch <= latest);
-  };
-  Notification n{Notification::Kind::kNegotiationRejected, b.applet, bundle, {}, {}, rev->until};
-  if (answer.accept && rev->rounds <= options_.negotiation_rounds_max) {
-    std::optional<milliseconds> granted;
-    if (fits(answer.max_needed)) {
-      granted = answer.max_needed;
-    } else if (fits(answer.min_needed)) {
-      granted = answer.min_needed;
-    }
-    if (granted) {
-      rev->until = std::max(rev->until, now_ + *granted);
-      n.kind = Notification::Kind::kNegotiationAccepted;
-      n.until = rev->until;
-    }
-  }
-  notifications_.push_back(n);
-  return n;
-}
-
-std::optional<milliseconds> Scheduler::revoke_deadline(BundleId bundle) const {
-  if (!revoking_.at(bundle)) return std::nullopt;
-  return revoking_[bundle]->until;
 }
 
 void Scheduler::replan() {
@@ -204,97 +144,13 @@ void Scheduler::replan() {
       continue;
     }
     for (auto [a, b] : {pair, std::pair{pair.second, pair.first}}) {
-      notifications_.push_back(Notification{
-          Notification::Kind::kDeadlineOverlap, model_.bundle(a).applet, a, {}, b, now_});
+      Notification n = notice(Notification::Kind::kDeadlineOverlap, a);
+      n.other = b;
+      notifications_.push_back(std::move(n));
     }
   }
   plan_ = std::move(next);
   update_handover();
-}
-
-const std::vector<ServiceId>& Scheduler::closure(ServiceId service) const {
-  auto& slot = closure_cache_.at(service);
-  if (!slot) {
-    std::set<ServiceId> seen{service};
-    std::vector<ServiceId> to_visit{service};
-    while (!to_visit.empty()) {
-      const ServiceId s = to_visit.back();
-      to_visit.pop_back();
-      for (const Use& u : model_.needs(s)) {
-        if (seen.insert(u.service).second) to_visit.push_back(u.service);
-      }
-    }
-    slot.emplace(seen.begin(), seen.end());
-  }
-  return *slot;
-}
-
-bool Scheduler::conflicts(BundleId a, BundleId b) const {
-  for (ResourceId ra : model_.bundle(a).resources) {
-    for (ResourceId rb : model_.bundle(b).resources) {
-      const auto& ca = closure(model_.resource(ra).service);
-      const auto& cb = closure(model_.resource(rb).service);
-      auto i = ca.begin();
-      auto j = cb.begin();
-      while (i != ca.end() && j != cb.end()) {
-        if (*i == *j) return true;
-        if (*i < *j) {
-          ++i;
-        } else {
-          ++j;
-        }
-      }
-    }
-  }
-  return false;
-}
-
-// The per-service reassigners (seed §4.4.1, Abb. 4.13): inform holders the plan no longer
-// grants, cancel revocations the plan undid, and hand a granted bundle over once nothing it
-// conflicts with is still being given back.
-void Scheduler::update_handover() {
-  const std::size_t n = state_.size();
-  for (BundleId b = 0; b < n; ++b) {
-    if (!active_[b]) continue;
-    if (plan_.bundle_granted[b]) {
-      if (revoking_[b]) {
-        revoking_[b].reset();
-        notifications_.push_back(
-            Notification{Notification::Kind::kGranted, model_.bundle(b).applet, b, {}, {}, now_});
-      }
-      continue;
-    }
-    if (revoking_[b]) continue;
-    revoking_[b] = Revocation{now_ + options_.revoke_wait, 0};
-    std::set<AppletId> to;
-    for (BundleId g = 0; g < n; ++g) {
-      if (g != b && plan_.bundle_granted[g] && !active_[g] &&
-          model_.bundle(g).applet != model_.bundle(b).applet && conflicts(g, b)) {
-        to.insert(model_.bundle(g).applet);
-      }
-    }
-    notifications_.push_back(Notification{Notification::Kind::kRevokeRequested,
-                                          model_.bundle(b).applet,
-                                          b,
-                                          std::vector<AppletId>(to.begin(), to.end()),
-                                          {},
-                                          revoking_[b]->until});
-  }
-  std::vector<BundleId> giving_back;
-  for (BundleId b = 0; b < n; ++b) {
-    if (revoking_[b]) giving_back.push_back(b);
-  }
-  for (BundleId b = 0; b < n; ++b) {
-    if (active_[b] || !plan_.bundle_granted[b]) continue;
-    // Bundles granted only through inheritance (a service applet's resources that a user of its
-    // service needs) are handed over too: the service applet must be able to use them.
-    bool free = true;
-    for (BundleId x : giving_back) free = free && !conflicts(b, x);
-    if (!free) continue;
-    active_[b] = 1;
-    notifications_.push_back(
-        Notification{Notification::Kind::kGranted, model_.bundle(b).applet, b, {}, {}, now_});
-  }
 }
 
 std::string Scheduler::holder(ServiceId service) const {

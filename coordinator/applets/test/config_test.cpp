@@ -91,6 +91,20 @@ timeline: []
                         "exclusive-only service 'UI'"));
 }
 
+// Two bundles of one applet requested at start that both want an exclusive-only service.
+TEST(Config, TwoRequestedBundlesOnOneExclusiveOnlyServiceAreRejectedWithTheLine) {
+  EXPECT_THAT(error_of(R"(services: [{name: UI, exclusive_only: true}]
+applets:
+  - name: Battery
+    bundles:
+      - {name: warn, requested: true, resources: [{service: UI}]}
+      - {name: dock, requested: true, resources: [{service: UI}]}
+timeline: []
+)"),
+              HasSubstr("sys.yaml:6: applet 'Battery' requests bundle 'dock' with service 'UI' "
+                        "which its requested bundle 'warn' already uses"));
+}
+
 TEST(Config, TimelineErrorsNameTheLine) {
   const std::string sys = R"(services: [{name: P}]
 applets: [{name: A, bundles: [{name: b, resources: [{service: P}]}]}]

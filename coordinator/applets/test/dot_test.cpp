@@ -35,5 +35,26 @@ timeline:
   EXPECT_THAT(dot, HasSubstr(R"("b:Battery/d" -> "s:Dock" [color=red)"));
 }
 
+TEST(Dot, ShowsABundleBeingRevokedAndAnInheritedActiveOne) {
+  const auto s = Scenario::parse(
+      R"(services: [{name: UI, exclusive_only: true}, {name: Monitor}]
+applets:
+  - {name: UIService, provides: [UI], bundles: [{name: io, resources: [{service: Monitor}]}]}
+  - {name: Menu, bundles: [{name: ui, resources: [{service: UI}]}]}
+  - {name: Battery, bundles: [{name: warn, priority: high, resources: [{service: UI}]}]}
+runner: {auto_yield: false}
+timeline:
+  - {request: Menu/ui}
+  - {t_ms: 1000, request: Battery/warn}
+)",
+      "d.yaml");
+  Scheduler final_state(s.system().model, s.system().options);
+  s.run(&final_state);
+  const std::string dot = to_dot(final_state);
+  EXPECT_THAT(
+      dot, HasSubstr(R"(fillcolor=orange, label="ui\nprio normal\nbeing revoked, until 6000 ms")"));
+  EXPECT_THAT(dot, HasSubstr(R"(label="io\nprio normal\nactive")"));  // inherited, not requested
+}
+
 }  // namespace
 }  // namespace oscar::applets

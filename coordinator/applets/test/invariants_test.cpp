@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <optional>
 #include <random>
 #include <set>
 #include <tuple>
@@ -157,6 +158,36 @@ void check_plan(const Scheduler& s, const std::string& where) {
   }
 }
 
+// A lower-priority holder never keeps a service a higher-priority request could get, outside the
+// bounded reassignment window: a planned bundle waits only for holders being revoked (never for
+// one the plan still grants), and never longer than `bound`.
+void check_no_lower_holder_keeps(const Scheduler& s,
+                                 std::vector<std::optional<milliseconds>>& waiting_since,
+                                 milliseconds bound, const std::string& where) {
+  const Model& m = s.model();
+  const Plan& p = s.plan();
+  for (BundleId h = 0; h < m.bundles().size(); ++h) {
+    if (!p.bundle_granted[h] || s.active(h)) {
+      waiting_since[h].reset();
+      continue;
+    }
+    if (!waiting_since[h]) waiting_since[h] = s.now();
+    ASSERT_LE(s.now() - *waiting_since[h], bound) << where << " bundle " << h << " kept waiting";
+    const auto mine = closure_of(m, h);
+    for (BundleId l = 0; l < m.bundles().size(); ++l) {
+      if (l == h || !s.active(l)) continue;
+      bool clashes = false;
+      for (const auto& u : mine) {
+        for (const auto& v : closure_of(m, l)) clashes = clashes || clash(u, v);
+      }
+      if (!clashes) continue;
+      ASSERT_FALSE(p.bundle_granted[l]) << where << " planned bundles " << h << ", " << l;
+      ASSERT_TRUE(s.revoke_deadline(l).has_value())
+          << where << " holder " << l << " keeps what " << h << " could get, unrevoked";
+    }
+  }
+}
+
 TEST(Invariants, HoldAfterEveryPlanInRandomRuns) {
   int plans = 0;
   for (unsigned seed = 1; seed <= 400; ++seed) {
@@ -166,6 +197,11 @@ TEST(Invariants, HoldAfterEveryPlanInRandomRuns) {
     const auto n = static_cast<unsigned>(s.model().bundles().size());
     const milliseconds window =
         std::max(s.options().revoke_wait, s.options().negotiation_round_max);
+    // The longest a holder may keep what the plan gave away: the wait limit, extended by at
+    // most negotiation_rounds_max rounds of at most negotiation_round_max each.
+    const milliseconds bound = s.options().revoke_wait + s.options().negotiation_rounds_max *
+                                                             s.options().negotiation_round_max;
+    std::vector<std::optional<milliseconds>> waiting_since(n);
     for (int step = 0; step < 200; ++step) {
       const BundleId b = rng() % n;
       std::string where = name_of("seed ", seed);
@@ -217,6 +253,8 @@ TEST(Invariants, HoldAfterEveryPlanInRandomRuns) {
           ASSERT_LE(*until - s.now(), window) << where << " reassignment window unbounded";
         }
       }
+      check_no_lower_holder_keeps(s, waiting_since, bound, where);
+      if (HasFatalFailure()) return;
       if (step % 25 == 24) {
         // After the reassignment window, everything planned is handed over.
         s.advance_to(s.now() + window);

@@ -3,6 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "test_support.hpp"
+
 #include <stdexcept>
 
 namespace oscar::applets {
@@ -10,15 +12,7 @@ namespace {
 
 using ::testing::HasSubstr;
 
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "no exception";
-}
+using testing::error_of;
 
 TEST(Model, UnknownServiceIsNamed) {
   Model m;
@@ -81,14 +75,12 @@ TEST(Model, NeedsListsDependenciesAndProviderResources) {
 }
 
 TEST(Model, CycleOfTwoServiceAppletsIsFound) {
-  Model m;
-  const ServiceId s1 = m.add_service("S1");
-  const ServiceId s2 = m.add_service("S2");
-  const AppletId a = m.add_applet("A");
-  const AppletId b = m.add_applet("B");
-  m.provide(a, s1);
-  m.provide(b, s2);
-  const BundleId ba = m.add_bundle(a, "x", {{s2, Access::kShared}});
+  testing::TwoServiceApplets t;
+  Model& m = t.m;
+  const ServiceId s1 = t.s1;
+  const AppletId a = t.a;
+  const AppletId b = t.b;
+  const BundleId ba = m.add_bundle(a, "x", {{t.s2, Access::kShared}});
   const BundleId bb = m.add_bundle(b, "x", {{s1, Access::kShared}});
   const AppletId c = m.add_applet("C");
   const BundleId bc = m.add_bundle(c, "x", {{s1, Access::kShared}});

@@ -3,7 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
+
 #include "oscar/applets/scheduler.hpp"
+#include "test_support.hpp"
 
 namespace oscar::applets {
 namespace {
@@ -100,14 +103,11 @@ TEST(Plan, InheritancePreventsPriorityInversion) {
 
 // Abb. 4.9: a cycle is granted all or nothing, sorted with its highest priority.
 TEST(Plan, CycleIsGrantedAllOrNothingWithItsHighestPriority) {
-  Model m;
-  const ServiceId s1 = m.add_service("S1");
-  const ServiceId s2 = m.add_service("S2");
+  testing::TwoServiceApplets t;
+  Model& m = t.m;
+  const ServiceId s1 = t.s1, s2 = t.s2;
+  const AppletId a = t.a, b = t.b;
   const ServiceId disp = m.add_service("Display");
-  const AppletId a = m.add_applet("A");
-  const AppletId b = m.add_applet("B");
-  m.provide(a, s1);
-  m.provide(b, s2);
   const BundleId ab = m.add_bundle(a, "x", {{s2, kS}, {disp, kX}}, kPriorityLow);
   const BundleId bb = m.add_bundle(b, "x", {{s1, kS}}, kPriorityHigh);
   const BundleId other = m.add_bundle(m.add_applet("Other"), "d", {{disp, kX}}, kPriorityNormal);
@@ -121,19 +121,13 @@ TEST(Plan, CycleIsGrantedAllOrNothingWithItsHighestPriority) {
   EXPECT_TRUE(s.plan().bundle_granted[ab]);
   EXPECT_TRUE(s.plan().bundle_granted[bb]);
   EXPECT_EQ(s.holder(disp), "A");
-  // An exclusive user of S1 above the cycle: the cycle needs S1 shared, so all of it loses.
-  const Model& mm = s.model();
-  (void)mm;
 }
 
 TEST(Plan, CycleThatCannotBeCompletedGrantsNothing) {
-  Model m;
-  const ServiceId s1 = m.add_service("S1");
-  const ServiceId s2 = m.add_service("S2");
-  const AppletId a = m.add_applet("A");
-  const AppletId b = m.add_applet("B");
-  m.provide(a, s1);
-  m.provide(b, s2);
+  testing::TwoServiceApplets t;
+  Model& m = t.m;
+  const ServiceId s1 = t.s1, s2 = t.s2;
+  const AppletId a = t.a, b = t.b;
   const BundleId ab = m.add_bundle(a, "x", {{s2, kS}});
   const BundleId bb = m.add_bundle(b, "x", {{s1, kS}});
   const BundleId x = m.add_bundle(m.add_applet("X"), "s1", {{s1, kX}}, kPrioritySystem);
@@ -171,6 +165,45 @@ TEST(Plan, TriggeringSwitchesOnceWithoutOscillation) {
   EXPECT_EQ(s.plans_computed(), plans + 1);
   EXPECT_EQ(s.holder(s2), "App3");
   EXPECT_FALSE(s.plan().bundle_granted[a2s2]);
+}
+
+// Seed §4.5.2: priorities are levels with room in between; 250 lies between normal and high.
+TEST(Plan, IntermediatePriorityLevelsSortBetweenTheNamedOnes) {
+  Model m;
+  const ServiceId svc = m.add_service("S");
+  const BundleId normal = m.add_bundle(m.add_applet("Normal"), "s", {{svc, kX}}, kPriorityNormal);
+  const BundleId between = m.add_bundle(m.add_applet("Between"), "s", {{svc, kX}}, 250);
+  const BundleId high = m.add_bundle(m.add_applet("High"), "s", {{svc, kX}}, kPriorityHigh);
+  Scheduler s(m);
+  s.request(normal);
+  s.request(between);
+  EXPECT_EQ(s.holder(svc), "Between");
+  s.request(high);
+  EXPECT_EQ(s.holder(svc), "High");
+  s.set_priority(between, kPriorityHigh + 1);
+  EXPECT_EQ(s.holder(svc), "Between");
+}
+
+// Abb. 4.19: every request, release, priority and deadline change computes a new plan.
+TEST(Plan, IsRecomputedOnEveryRequestReleasePriorityAndDeadlineChange) {
+  Model m;
+  const ServiceId svc = m.add_service("S");
+  const BundleId a = m.add_bundle(m.add_applet("A"), "s", {{svc, kX}});
+  const BundleId b = m.add_bundle(m.add_applet("B"), "s", {{svc, kX}});
+  Scheduler s(m);
+  using std::chrono::milliseconds;
+  const std::vector<std::function<void()>> changes = {
+      [&] { s.request(a); }, [&] { s.request(b); }, [&] { s.set_priority(b, kPriorityHigh); },
+      [&] {
+        s.set_deadline(a, Deadline{milliseconds{0}, milliseconds{10}, milliseconds{100}});
+      },
+      [&] { s.release(b); }};
+  for (std::size_t i = 0; i < changes.size(); ++i) {
+    const auto before = s.plans_computed();
+    changes[i]();
+    EXPECT_EQ(s.plans_computed(), before + 1) << "change " << i;
+  }
+  EXPECT_EQ(s.holder(svc), "A");
 }
 
 TEST(Plan, HeldBundleKeepsItsPlaceAgainstANewEqualRequest) {

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include "test_support.hpp"
+
 #include <atomic>
 #include <mutex>
 #include <thread>
@@ -14,15 +16,7 @@ using namespace std::chrono_literals;
 constexpr auto kX = Access::kExclusive;
 constexpr auto kS = Access::kShared;
 
-template <typename P>
-bool eventually(P pred, std::chrono::milliseconds limit = 10s) {
-  const auto end = std::chrono::steady_clock::now() + limit;
-  while (std::chrono::steady_clock::now() < end) {
-    if (pred()) return true;
-    std::this_thread::sleep_for(2ms);
-  }
-  return pred();
-}
+using testing::eventually;
 
 // The service of the appendix test case: increment and read, synchronised by a mutex.
 class CounterService {
@@ -125,6 +119,52 @@ TEST(Runtime, AppendixCountersAddUpAcrossSharedAndExclusiveAccess) {
   EXPECT_GT(rt.stats().grants, 4u);
 }
 
+// Abb. 4.12/4.14: the scheduler only queues handlers; the applet's own thread runs them between
+// two steps, never during one, and never the thread that changed the plan.
+TEST(Runtime, InterruptHandlersRunOnTheAppletThreadBetweenSteps) {
+  Model m;
+  const ServiceId s = m.add_service("S");
+  m.add_bundle(m.add_applet("Holder"), "s", {{s, kX}});
+  const BundleId high = m.add_bundle(m.add_applet("Urgent"), "s", {{s, kX}}, kPriorityHigh);
+  Runtime rt(m);
+  std::mutex mu;
+  std::thread::id step_thread, handler_thread;
+  std::atomic<bool> in_step{false}, handled{false}, during_step{false};
+  std::atomic<int> steps{0};
+  rt.set_code("Holder", {[](AppletContext& c) { c.request("s"); },
+                         [&](AppletContext& c) {
+                           in_step = true;
+                           {
+                             std::lock_guard lock(mu);
+                             step_thread = std::this_thread::get_id();
+                           }
+                           if (c.granted("s")) c.use("s", [] {});
+                           ++steps;
+                           in_step = false;
+                         },
+                         [&](AppletContext& c, const Notification& n) {
+                           during_step = during_step || in_step;
+                           {
+                             std::lock_guard lock(mu);
+                             handler_thread = std::this_thread::get_id();
+                           }
+                           if (n.kind == Notification::Kind::kRevokeRequested) {
+                             c.yield("s");
+                             handled = true;
+                           }
+                         },
+                         2ms});
+  rt.start();
+  ASSERT_TRUE(eventually([&] { return steps > 2; }));
+  rt.with_scheduler([&](Scheduler& sch) { sch.request(high); });
+  ASSERT_TRUE(eventually([&] { return handled.load(); }));
+  rt.stop();
+  EXPECT_FALSE(during_step.load());
+  std::lock_guard lock(mu);
+  EXPECT_EQ(handler_thread, step_thread);
+  EXPECT_NE(handler_thread, std::this_thread::get_id());
+}
+
 TEST(Runtime, CrashedAppletLosesItsResourcesAndNothingElseIsAffected) {
   Model m;
   const ServiceId s = m.add_service("S");
@@ -202,57 +242,6 @@ TEST(Runtime, HolderThatDoesNotYieldIsRevokedByForceAndToldWhoGetsIt) {
   }
   EXPECT_TRUE(told);
   EXPECT_TRUE(forced);
-}
-
-// Seed §4.5.3: the docked battery applet asks for time, and in the accepted follow-up round
-// undocks before the drive gets the pilot; a rejected vote runs the reject round instead.
-TEST(Runtime, NegotiationRoundsRunTheirCodeBeforeTheHandOver) {
-  for (const bool vote : {true, false}) {
-    Model m;
-    const ServiceId pilot = m.add_service("Pilot");
-    const ServiceId dock = m.add_service("Dock");
-    m.add_dependency(dock, pilot);
-    m.add_bundle(m.add_applet("Battery"), "dock", {{dock, kX}});
-    const BundleId drive = m.add_bundle(m.add_applet("DriveTo"), "p", {{pilot, kX}}, kPriorityHigh);
-    Runtime rt(m);
-    std::atomic<bool> undocked{false}, stopped_hard{false}, docked{false};
-    std::atomic<int> drives_docked{0}, drives{0};
-    std::atomic<int> reply{-1};
-    rt.set_code("Battery", {[](AppletContext& c) { c.request("dock"); },
-                            [&](AppletContext& c) { c.use("dock", [&] { docked = true; }); },
-                            [&, vote](AppletContext& c, const Notification& n) {
-                              if (n.kind != Notification::Kind::kRevokeRequested) return;
-                              auto undock = std::make_shared<NegotiationRound>();
-                              undock->first = [&] { undocked = true; };
-                              undock->answer = {0ms, 0ms, true};
-                              auto hard = std::make_shared<NegotiationRound>();
-                              hard->first = [&] { stopped_hard = true; };
-                              NegotiationRound ask{{50ms, 200ms, vote}, {}, undock, hard};
-                              reply = static_cast<int>(c.negotiate("dock", ask).kind);
-                            },
-                            2ms});
-    rt.set_code("DriveTo", {{},
-                            [&](AppletContext& c) {
-                              c.use("p", [&] {
-                                ++drives;
-                                if (!undocked && !stopped_hard) ++drives_docked;
-                              });
-                            },
-                            {},
-                            2ms});
-    rt.start();
-    ASSERT_TRUE(eventually([&] { return docked.load(); }));
-    rt.with_scheduler([&](Scheduler& s) { s.request(drive); });
-    ASSERT_TRUE(eventually([&] { return drives > 0; }));
-    rt.stop();
-    EXPECT_EQ(drives_docked.load(), 0) << "the pilot moved while docked";
-    EXPECT_EQ(undocked.load(), vote);
-    EXPECT_EQ(stopped_hard.load(), !vote);
-    // The last reply: the undock round's "accept, no time" is accepted; the reject round
-    // answers with the default (a vote against), which is rejected.
-    EXPECT_EQ(reply.load(), static_cast<int>(vote ? Notification::Kind::kNegotiationAccepted
-                                                  : Notification::Kind::kNegotiationRejected));
-  }
 }
 
 TEST(Runtime, FailStopAppletGetsAnExceptionInsteadOfBlocking) {

@@ -3,6 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "test_support.hpp"
+
 namespace oscar::applets {
 namespace {
 
@@ -10,15 +12,7 @@ using std::chrono::milliseconds;
 using ::testing::HasSubstr;
 constexpr auto kX = Access::kExclusive;
 
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "no exception";
-}
+using testing::error_of;
 
 struct TwoApplets {
   Model m;
@@ -42,6 +36,11 @@ TEST(Scheduler, InvalidDeadlinesNameTheInequality) {
       }),
       HasSubstr("now + t_duration + c <= t_finish (eq. 4.10)"));
   EXPECT_THAT(error_of([&] { s.advance_to(milliseconds{100}); }), HasSubstr("time only advances"));
+  EXPECT_THAT(
+      error_of([&] {
+        s.set_deadline(t.low, Deadline{milliseconds{600}, milliseconds{-1}, milliseconds{2000}});
+      }),
+      HasSubstr("bundle 's': deadline t_duration -1 ms is negative"));
 }
 
 TEST(Scheduler, SameExclusiveServiceInTwoRequestedBundlesOfOneAppletIsRejected) {

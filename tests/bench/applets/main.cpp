@@ -185,7 +185,6 @@ int main(int argc, char** argv) {
     j["overhead_ms_avg"] = s.overhead.avg;
     j["overhead_ms_p99"] = s.overhead.p99;
     j["overhead_ms_max"] = s.overhead.max;
-    j["stress_seconds"] = s.seconds;
     nlohmann::ordered_json p;
     for (auto [n, us] : plans) p[std::to_string(n)] = us;
     j["plan_us"] = p;

@@ -41,12 +41,21 @@ class AppletContext {
   void trigger(const std::string& bundle);
   void set_priority(const std::string& bundle, int priority);
   void set_deadline(const std::string& bundle, std::optional<Deadline> deadline);
+  /// Answers a revocation with one round's answer only (no code, no follow-up).
   Notification negotiate(const std::string& bundle, const Negotiation& answer);
-  /// Runs a chain of rounds: each round's `first`, then its answer, then the follow-up for the
-  /// reply, until a round has none or the bundle is no longer being revoked; then yields the
-  /// bundle (seed §4.5.3: when the defined behaviour has run, the resource is taken). Call it from
-  /// the interrupt handler for kRevokeRequested. Returns the last reply.
-  Notification negotiate(const std::string& bundle, const NegotiationRound& round);
+  /// Starts a chain of negotiation rounds over a bundle being revoked (seed §4.5.3). This round
+  /// runs now: its `first`, then its answer. Each follow-up (for the reply) runs at a later
+  /// main-loop step, between steps like the interrupt handlers (Abb. 4.12), one round per step.
+  /// The chain ends when a round has no follow-up, after `negotiation_rounds_max` rounds, when
+  /// a round takes longer than `negotiation_round_max` (its code, or the wait until its follow-up
+  /// starts), or when the bundle is no longer being revoked; then the bundle is yielded (the
+  /// defined behaviour has run, so the resource is taken). Call it from the interrupt handler
+  /// for kRevokeRequested. A bundle hears from the reassigner of each of its services; while a
+  /// chain runs for it, further calls start nothing and return nothing.
+  /// Returns the scheduler's reply to this round, if it was answered.
+  std::optional<Notification> negotiate(const std::string& bundle, const NegotiationRound& round);
+  /// Whether a chain of negotiation rounds is under way for the bundle.
+  bool negotiating(const std::string& bundle) const;
   /// Whether the bundle is being revoked (revoke requested, not yet yielded or forced).
   bool being_revoked(const std::string& bundle) const;
   /// Runs `body` while the bundle is granted. If it is not, blocks until it is granted again, or

@@ -1,13 +1,15 @@
 #pragma once
 // The threaded runtime (seed 000 §4.4, §4.6.2): every applet in its own thread inside a wrapper
 // that contains crashes; interrupt handlers queued to the applet and run between its main-loop
-// steps (Abb. 4.12); a reassigner thread that revokes by force when the wait limit passes. The
+// steps (Abb. 4.12), with negotiation rounds spread over the steps (§4.5.3); a thread that lets
+// the scheduler's per-service reassigners revoke by force when a wait limit passes. The
 // decisions are the deterministic Scheduler's, driven by the steady clock.
 
 #include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
@@ -68,7 +70,16 @@ class Runtime {
     bool paused = false;
     bool crashed = false;
     bool has_code = false;
-    std::condition_variable cv;  // wakes this applet only (no thundering herd)
+    /// A chain of negotiation rounds under way (seed §4.5.3). Applet thread only.
+    struct Chain {
+      std::shared_ptr<const NegotiationRound> next;  ///< The follow-up to run.
+      std::chrono::steady_clock::time_point round_started;
+      std::uint64_t step = 0;  ///< Main-loop step in which the last round ran.
+      int rounds = 0;
+    };
+    std::map<BundleId, Chain> negotiations;  // applet thread only
+    std::uint64_t steps = 0;                 // main-loop steps so far; applet thread only
+    std::condition_variable cv;              // wakes this applet only (no thundering herd)
     std::thread thread;
   };
   using Clock = std::chrono::steady_clock;
@@ -76,11 +87,21 @@ class Runtime {
   milliseconds clock() const;
   void locked_call(const std::function<void(Scheduler&)>& f);  // lock held by caller
   void deliver();                                              // lock held
+  // Unlocks, then wakes the applets deliver() queued notifications for: a woken applet does
+  // not block on the mutex its waker still holds.
+  void wake(std::unique_lock<std::mutex>& lock);
   void applet_main(AppletId id);
+  // Runs one negotiation round for `bundle` and keeps or ends its chain (applet thread).
+  std::optional<Notification> run_round(AppletContext& ctx, BundleId bundle,
+                                        const NegotiationRound& round);
+  // Runs the follow-up rounds due in this main-loop step (applet thread).
+  void run_negotiations(AppletContext& ctx);
   void reassigner_main();
 
   mutable std::mutex mutex_;
-  std::condition_variable changed_;  // wakes the reassigner
+  std::condition_variable changed_;                // wakes the force thread
+  milliseconds forcing_at_ = milliseconds::max();  // the wait limit the force thread waits for
+  std::vector<Slot*> to_wake_;
   Scheduler scheduler_;
   std::vector<std::unique_ptr<Slot>> slots_;
   std::vector<Clock::time_point> waiting_since_;  // per bundle: asked, not yet granted

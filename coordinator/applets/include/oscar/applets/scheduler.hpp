@@ -1,8 +1,8 @@
 #pragma once
 // The deterministic scheduler core (seed 000 §4.1–4.6): requests, priorities, deadlines and
-// triggering drive the plan; per-service reassignment (inform, negotiate, wait, revoke by force,
-// grant) runs on a logical clock. No threads: the threaded Runtime and the scenario runner both
-// drive this class.
+// triggering drive the plan; per-service reassigners (inform, negotiate, wait, revoke by force,
+// grant, notify continuation) run on a logical clock. No threads: the threaded Runtime and the
+// scenario runner both drive this class.
 
 #include <chrono>
 #include <cstdint>
@@ -19,10 +19,11 @@ using std::chrono::milliseconds;
 
 /// Tunables of the scheduler; defaults follow the seed.
 struct SchedulerOptions {
-  milliseconds context_switch{0};             ///< c in the footnote to eq. 4.9–4.10.
-  milliseconds revoke_wait{5000};             ///< Wait for a release before revoking by force.
-  milliseconds negotiation_round_max{20000};  ///< Longest time one negotiation round may grant.
-  int negotiation_rounds_max = 3;             ///< Rounds per revocation (the scheduler decides).
+  milliseconds context_switch{0};  ///< c in the footnote to eq. 4.9–4.10.
+  milliseconds revoke_wait{5000};  ///< Wait for a release before revoking by force.
+  /// Longest a negotiation round may take and the most time one round may grant (seed §4.5.3).
+  milliseconds negotiation_round_max{20000};
+  int negotiation_rounds_max = 3;  ///< Rounds per reassigner and holder (the scheduler decides).
 };
 
 /// An applet's answer to a revocation (seed §4.5.3, "Verhandlungsrunden").
@@ -36,7 +37,7 @@ struct Negotiation {
 struct Notification {
   enum class Kind {
     kGranted,              ///< The bundle may be used (again).
-    kRevokeRequested,      ///< The plan gives the bundle to others: finish, yield or negotiate.
+    kRevokeRequested,      ///< The plan gives `service` to others: finish, yield or negotiate.
     kNegotiationAccepted,  ///< More time granted, until `until`.
     kNegotiationRejected,  ///< No more time; yield before `until`.
     kRevokedByForce,       ///< The wait limit passed: the bundle is gone.
@@ -45,9 +46,24 @@ struct Notification {
   Kind kind = Kind::kGranted;
   AppletId applet = 0;
   BundleId bundle = 0;
-  std::vector<AppletId> new_holders;  ///< Who gets the services (kRevokeRequested).
+  std::vector<AppletId> new_holders;  ///< Who gets `service` (kRevokeRequested).
   std::optional<BundleId> other;      ///< kDeadlineOverlap.
-  milliseconds until{0};              ///< Negotiation: the time by which to yield.
+  milliseconds until{0};              ///< Revocation, negotiation: the time by which to yield.
+  /// The service whose reassigner speaks (revocation, negotiation, force); none otherwise.
+  std::optional<ServiceId> service;
+};
+
+/// The state of one service's reassigner (seed §4.4.1, Abb. 4.13–4.14): it runs while bundles
+/// still hold the service that the plan gives to others (or to nobody). Each such holder has
+/// its own wait limit and negotiation rounds with this reassigner.
+struct Reassignment {
+  struct Giving {
+    BundleId bundle = 0;
+    milliseconds until{0};  ///< Revoked by force at this time unless yielded before.
+    int rounds = 0;         ///< Negotiation rounds so far.
+  };
+  std::vector<Giving> giving;  ///< Holders still giving the service back; empty: not running.
+  std::vector<AppletId> to;    ///< Applets the plan gives the service to next (sorted).
 };
 
 /// Pure scheduler: call its methods from one thread (the Runtime serialises them).
@@ -81,7 +97,9 @@ class Scheduler {
   void trigger(BundleId bundle);
   /// An applet crashed: all its bundles are released at once, nothing else is touched.
   void crash(AppletId applet);
-  /// An applet answers a revocation. Returns the notification it gets (accepted or rejected).
+  /// An applet answers a revocation: every reassigner taking a service of the bundle decides on
+  /// its own (it gets one notification per service). Returns the summary: accepted if all
+  /// accepted, `until` the earliest time by which the bundle must be yielded.
   /// @throws std::invalid_argument if the bundle is not being revoked.
   Notification negotiate(BundleId bundle, const Negotiation& answer);
 
@@ -89,8 +107,13 @@ class Scheduler {
   const Plan& plan() const { return plan_; }
   /// Whether a bundle may be used now (granted and handed over).
   bool active(BundleId bundle) const { return active_.at(bundle) != 0; }
-  /// Whether the bundle is being revoked and by when it must be yielded.
+  /// Whether the bundle is being revoked and by when it must be yielded (the earliest wait
+  /// limit among the reassigners of its services).
   std::optional<milliseconds> revoke_deadline(BundleId bundle) const;
+  /// The earliest wait limit of any running reassigner (when advance_to next revokes by force).
+  std::optional<milliseconds> next_forced_revocation() const;
+  /// The reassigner of a service; `giving` is empty when none runs.
+  const Reassignment& reassignment(ServiceId service) const { return reassigners_.at(service); }
   bool requested(BundleId bundle) const { return state_.at(bundle).requested; }
   int priority(BundleId bundle) const { return state_.at(bundle).priority; }
 
@@ -107,16 +130,33 @@ class Scheduler {
   std::uint64_t plans_computed() const { return plans_; }
 
  private:
-  struct Revocation {
-    milliseconds until{0};
-    int rounds = 0;
+  /// One use of a service that granting a bundle brings along (its own resources and, down the
+  /// hierarchy, the services' own uses). Two bundles clash on a service when they use it through
+  /// different users and one of those uses is exclusive (the plan's rule, Abb. 4.21).
+  struct FootUse {
+    ServiceId service = 0;
+    Use::By by = Use::By::kResource;
+    std::uint32_t user = 0;  ///< ResourceId or ServiceId, per `by`.
+    bool exclusive = false;
   };
 
+  /// A notification of `kind` to the bundle's applet, stamped now.
+  Notification notice(Notification::Kind kind, BundleId bundle,
+                      std::optional<ServiceId> service = std::nullopt) const;
   void replan();
   void update_handover();
-  const std::vector<ServiceId>& closure(ServiceId service) const;
+  const std::vector<FootUse>& footprint(BundleId bundle) const;
+  const std::vector<ServiceId>& services_of(BundleId bundle) const;
+  /// Whether the bundle uses `service` itself: one of its resources or, down the hierarchy, a
+  /// configured dependency of those. Not a service applet's resource, which that applet holds.
+  /// Its holder hears only from these reassigners (the others track it silently).
+  bool uses_itself(BundleId bundle, ServiceId service) const;
   bool conflicts(BundleId a, BundleId b) const;
   void check_bundle(BundleId bundle) const;
+  void start_giving(BundleId bundle);
+  void stop_giving(BundleId bundle);
+  Notification negotiate_with(ServiceId service, Reassignment::Giving& giving,
+                              const Negotiation& answer);
 
   Model model_;
   SchedulerOptions options_;
@@ -124,10 +164,13 @@ class Scheduler {
   std::vector<BundleState> state_;
   Plan plan_;
   std::vector<char> active_;
-  std::vector<std::optional<Revocation>> revoking_;
+  std::vector<char> revoking_;             // per bundle: in some reassigner's `giving`
+  std::vector<Reassignment> reassigners_;  // per service
   std::vector<Notification> notifications_;
   std::uint64_t plans_ = 0;
-  mutable std::vector<std::optional<std::vector<ServiceId>>> closure_cache_;
+  mutable std::vector<std::optional<std::vector<FootUse>>> footprint_cache_;  // sorted by service
+  mutable std::vector<std::optional<std::vector<ServiceId>>> services_cache_;
+  mutable std::vector<std::optional<std::vector<ServiceId>>> own_cache_;  // sorted
 };
 
 }  // namespace oscar::applets
