@@ -107,6 +107,24 @@ std::vector<std::uint64_t> check_topic(const std::string& file, const std::strin
   return seqs;
 }
 
+// Waits until the recorder subscribed to every kernel's output, then starts the kernels.
+void activate_when_recorded(Process& rec, const std::vector<std::string>& kernels) {
+  ASSERT_TRUE(eventually([&] {
+    const auto out = rec.output();
+    for (const auto& k : kernels) {
+      if (out.find("oscar/cue/" + k + "/out") == std::string::npos) return false;
+    }
+    return true;
+  })) << rec.output();
+  std::this_thread::sleep_for(1s);  // the sources' writers match the recorder's readers
+  DdsParticipant participant(test::test_domain(), "record_test");
+  ConfigClient client(participant, "coordinator");  // only it may activate
+  for (const auto& k : kernels) {
+    const auto reply = client.send(k, CMD_ACTIVATE, {k, "continuous:20ms"});
+    ASSERT_TRUE(reply.ok()) << k << ": " << reply.error();
+  }
+}
+
 std::vector<std::uint64_t> one_to(std::uint64_t n) {
   std::vector<std::uint64_t> v(n);
   for (std::uint64_t i = 0; i < n; ++i) v[i] = i + 1;
@@ -120,18 +138,7 @@ TEST(Record, HoldsEveryPublishedCueOfTheThreeSeedTypesInOrderWithItsBytes) {
   auto l = source("rl", "LineSeg3DSeq", kCount, "deactivated");
   auto g = source("rg", "GvImage", kCount, "deactivated");
   auto rec = recorder(file, {"--all", "--compression", "lz4"});
-  ASSERT_TRUE(eventually([&] {
-    const auto out = rec->output();
-    return out.find("rb/out") != std::string::npos && out.find("rl/out") != std::string::npos &&
-           out.find("rg/out") != std::string::npos;
-  })) << rec->output();
-  std::this_thread::sleep_for(1s);  // the sources' writers match the recorder's readers
-  DdsParticipant participant(test::test_domain(), "record_test");
-  ConfigClient client(participant, "coordinator");  // only it may activate
-  for (const auto* m : {"rb", "rl", "rg"}) {
-    const auto reply = client.send(m, CMD_ACTIVATE, {m, "continuous:20ms"});
-    ASSERT_TRUE(reply.ok()) << m << ": " << reply.error();
-  }
+  activate_when_recorded(*rec, {"rb", "rl", "rg"});
   std::this_thread::sleep_for(kCount * 20ms + 1500ms);
   kill(rec->pid(), SIGINT);
   ASSERT_EQ(rec->wait(10s), 0) << rec->output();
@@ -169,6 +176,34 @@ TEST(Record, AKilledRecorderLeavesAFileReadableUpToItsLastChunk) {
   EXPECT_THAT(info.output(), HasSubstr("messages:    " + std::to_string(seen) + " in " +
                                        std::to_string(scan.chunks) + " chunks"));
   EXPECT_THAT(info.output(), HasSubstr("oscar/cue/kg/out  oscar::GvImage"));
+}
+
+TEST(Record, SplitsBySizeIntoCompleteFilesThatTogetherHoldEveryCue) {
+  const auto file = temp("record_split.mcap");
+  constexpr int kCount = 40;  // 40 images of 432 KiB: ~17 MiB uncompressed
+  auto g = source("sg", "GvImage", kCount, "deactivated");
+  auto rec = recorder(file, {"sg/out", "--compression", "none", "--split-size", "4M"});
+  activate_when_recorded(*rec, {"sg"});
+  std::this_thread::sleep_for(kCount * 20ms + 1500ms);
+  kill(rec->pid(), SIGTERM);
+  ASSERT_EQ(rec->wait(10s), 0) << rec->output();
+  std::vector<std::uint64_t> seqs;
+  int files = 0;
+  const std::filesystem::path p(file);
+  for (;; ++files) {
+    const auto part = (p.parent_path() / (p.stem().string() + "_" + (files < 10 ? "00" : "0") +
+                                          std::to_string(files) + p.extension().string()))
+                          .string();
+    if (!std::filesystem::exists(part)) break;
+    EXPECT_THAT(rec->output(), HasSubstr("wrote " + part));
+    mcap::Reader r(part);
+    EXPECT_TRUE(r.has_summary()) << part;
+    EXPECT_LT(std::filesystem::file_size(part), 6u << 20) << "4 MiB and one chunk at most";
+    const auto more = check_topic<GvImage>(part, "sg");
+    seqs.insert(seqs.end(), more.begin(), more.end());
+  }
+  EXPECT_GE(files, 4);
+  EXPECT_EQ(seqs, one_to(kCount));
 }
 
 }  // namespace

@@ -17,7 +17,12 @@ void on_signal(int) { g_stop = true; }
 // "512M", "2G", "1000" -> bytes.
 std::uint64_t parse_size(const std::string& s) {
   std::size_t used = 0;
-  const double v = std::stod(s, &used);
+  double v = 0;
+  try {
+    v = std::stod(s, &used);
+  } catch (const std::exception&) {
+    v = -1;
+  }
   const std::string unit = s.substr(used);
   const double factor = unit.empty() || unit == "B"    ? 1
                         : unit == "K" || unit == "KiB" ? 1024.0
@@ -33,7 +38,12 @@ std::uint64_t parse_size(const std::string& s) {
 // "30s", "5m", "1h", "250ms" -> duration.
 std::chrono::nanoseconds parse_duration(const std::string& s) {
   std::size_t used = 0;
-  const double v = std::stod(s, &used);
+  double v = 0;
+  try {
+    v = std::stod(s, &used);
+  } catch (const std::exception&) {
+    v = -1;
+  }
   const std::string unit = s.substr(used);
   const double seconds = unit == "ms"                  ? 1e-3
                          : unit == "s" || unit.empty() ? 1

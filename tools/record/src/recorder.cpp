@@ -78,14 +78,16 @@ struct Recorder::Impl {
   };
 
   RecorderOptions o;
-  DdsParticipant participant;
-  std::vector<Topic> topics;
-  std::vector<std::unique_ptr<Listener>> listeners;
-  std::unique_ptr<mcap::Writer> writer;
   std::map<std::size_t, std::uint16_t> channel_of;  // topic index -> channel id in this file
   std::map<std::string, std::uint16_t> schema_of;   // type -> schema id in this file
   std::vector<std::string> files;
   std::uint64_t file_start_time = 0;
+  // The file before the participant (open_file() uses the members above): an unwritable path
+  // fails before anything joins the domain.
+  std::unique_ptr<mcap::Writer> writer;
+  DdsParticipant participant;
+  std::vector<Topic> topics;
+  std::vector<std::unique_ptr<Listener>> listeners;
   std::mutex mutex;
   std::deque<Sample> queue;
   std::uint64_t queued_bytes = 0;
@@ -93,9 +95,7 @@ struct Recorder::Impl {
   std::uint64_t written = 0, bytes = 0;
 
   explicit Impl(RecorderOptions options)
-      : o(std::move(options)), participant(o.domain, "oscar-record") {
-    open_file();
-  }
+      : o(std::move(options)), writer(open_file()), participant(o.domain, "oscar-record") {}
 
   ~Impl() {
     for (auto& t : topics) {
@@ -144,7 +144,8 @@ struct Recorder::Impl {
     }
   }
 
-  void open_file() {
+  // Creates the next file of the recording; its schemas and channels are added as used.
+  std::unique_ptr<mcap::Writer> open_file() {
     const auto path = (o.split_size_bytes || o.split_duration.count())
                           ? split_name(o.output, static_cast<int>(files.size()))
                           : o.output;
@@ -152,11 +153,12 @@ struct Recorder::Impl {
     w.compression = o.compression;
     w.chunk_size_bytes = o.chunk_size_bytes;
     w.library = "oscar-record";
-    writer = std::make_unique<mcap::Writer>(path, w);
+    auto next = std::make_unique<mcap::Writer>(path, w);
     files.push_back(path);
     channel_of.clear();
     schema_of.clear();
     file_start_time = 0;
+    return next;
   }
 
   std::uint16_t channel(std::size_t index) {
@@ -186,7 +188,7 @@ struct Recorder::Impl {
          (o.split_duration.count() && file_start_time &&
           s.log_time - file_start_time >= static_cast<std::uint64_t>(o.split_duration.count())))) {
       writer->close();
-      open_file();
+      writer = open_file();
     }
     if (!file_start_time) file_start_time = s.log_time;
     const auto header = read_cue_header(s.bytes);
