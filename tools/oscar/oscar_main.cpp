@@ -22,6 +22,7 @@ const char* const kUsage =
     "  swarm plan FILE       plan jobs and trajectories for a swarm\n"
     "  record [TOPIC...]     record cue topics to an MCAP file\n"
     "  info FILE             summarise an MCAP file\n"
+    "  replay FILE           republish a recording with its original timing\n"
     "  bench <what> ...      benchmarks: cueflow, applets, swarm\n"
     "\n"
     "`oscar <command> --help` shows a command's options.\n";
