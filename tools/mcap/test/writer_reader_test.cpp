@@ -119,6 +119,16 @@ TEST(Writer, AnUnwritablePathIsAClearError) {
   }
 }
 
+TEST(Writer, AFullDiskIsAClearError) {
+  // /dev/full accepts the open and fails every write with ENOSPC.
+  try {
+    Writer w("/dev/full");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "cannot write MCAP file '/dev/full': No space left on device");
+  }
+}
+
 TEST(Compression, NamesParseAndUnknownOnesAreRejected) {
   EXPECT_EQ(parse_compression("lz4"), Compression::kLz4);
   EXPECT_EQ(parse_compression("none"), Compression::kNone);
