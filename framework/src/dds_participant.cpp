@@ -159,6 +159,20 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
   void on_publisher_discovery(dds::DomainParticipant*,
                               eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
     note(info.info.topicName().to_string(), info.info.typeName().to_string());
+    if (info.status == eprosima::fastrtps::rtps::WriterDiscoveryInfo::DISCOVERED_WRITER) {
+      const auto& q = info.info.m_qos;
+      std::lock_guard lock(mutex_);
+      writers_[info.info.topicName().to_string()] = {
+          info.info.typeName().to_string(),
+          std::string(q.m_reliability.kind == dds::RELIABLE_RELIABILITY_QOS ? "reliable"
+                                                                            : "best_effort") +
+              (q.m_durability.kind == dds::TRANSIENT_LOCAL_DURABILITY_QOS ? ", transient_local"
+                                                                          : ", volatile")};
+    }
+  }
+  std::map<std::string, DdsParticipant::DiscoveredWriter> writers() const {
+    std::lock_guard lock(mutex_);
+    return writers_;
   }
   void on_subscriber_discovery(dds::DomainParticipant*,
                                eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
@@ -178,6 +192,7 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
   }
   mutable std::mutex mutex_;
   std::map<std::string, std::string> types_;
+  std::map<std::string, DdsParticipant::DiscoveredWriter> writers_;
 };
 
 DdsParticipant::DdsParticipant(int domain, const std::string& name, const NetworkConfig& network)
@@ -236,6 +251,10 @@ dds::Topic& DdsParticipant::topic(const std::string& name, dds::TopicDataType* t
 
 std::optional<std::string> DdsParticipant::discovered_type(const std::string& topic) const {
   return listener_->type_of(topic);
+}
+
+std::map<std::string, DdsParticipant::DiscoveredWriter> DdsParticipant::discovered_writers() const {
+  return listener_->writers();
 }
 
 }  // namespace oscar

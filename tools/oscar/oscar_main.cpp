@@ -25,6 +25,9 @@ const char* const kUsage =
     "  config MODULE CMD ... send a configuration command to a module\n"
     "  applets run FILE      run an applet-scheduler scenario\n"
     "  swarm plan FILE       plan jobs and trajectories for a swarm\n"
+    "  record [TOPIC...]     record cue topics to an MCAP file\n"
+    "  info FILE             summarise an MCAP file\n"
+    "  replay FILE           republish a recording with its original timing\n"
     "  bench <what> ...      benchmarks: cueflow, restart, applets, swarm\n"
     "\n"
     "`oscar <command> --help` shows a command's options.\n";

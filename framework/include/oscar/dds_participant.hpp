@@ -39,6 +39,13 @@ class DdsParticipant {
                                        eprosima::fastdds::dds::TopicDataType* type);
   /// The type discovery has seen for a topic (from remote writers and readers), if any.
   std::optional<std::string> discovered_type(const std::string& topic) const;
+  /// A remote writer discovery has seen: its topic's type and its QoS, e.g. "reliable, volatile".
+  struct DiscoveredWriter {
+    std::string type;
+    std::string qos;
+  };
+  /// Every topic with a remote writer, by name (what `oscar record` subscribes to).
+  std::map<std::string, DiscoveredWriter> discovered_writers() const;
 
  private:
   class Listener;
