@@ -13,6 +13,7 @@
 #include <fmt/ranges.h>
 
 #include "oscar/kernel_registry.hpp"
+#include "oscar/process_util.hpp"
 
 namespace oscar {
 namespace {
@@ -107,10 +108,7 @@ std::vector<std::string> plugin_search_path() {
       rest.remove_prefix(colon + 1);
     }
   }
-  std::error_code ec;
-  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    const auto dir = exe.parent_path();
+  if (const auto dir = program_dir(); !dir.empty()) {
     path.push_back((dir / ".." / "lib" / "oscar" / "plugins").lexically_normal().string());
     path.push_back((dir / ".." / "lib").lexically_normal().string());
   }

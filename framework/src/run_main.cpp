@@ -9,6 +9,7 @@
 
 #include "oscar/cue_types.hpp"
 #include "oscar/module.hpp"
+#include "oscar/process_util.hpp"
 #include "oscar/time.hpp"
 
 namespace {
@@ -79,11 +80,7 @@ int run_main(int argc, char** argv) {
   app.add_flag("--list-modules", modules, "list the modules of the system file and exit");
   CLI11_PARSE(app, argc, argv);
 
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);  // every thread started from here inherits it
+  auto signals = block_stop_signals();  // every thread started from here inherits it
 
   try {
     register_standard_cue_types();

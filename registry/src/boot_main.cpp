@@ -15,6 +15,7 @@
 
 #include "oscar/cue_types.hpp"
 #include "oscar/kernel_registry.hpp"
+#include "oscar/process_util.hpp"
 #include "oscar/registry/launch_command.hpp"
 #include "oscar/registry/log_printer.hpp"
 #include "oscar/registry/registry_client.hpp"
@@ -26,12 +27,6 @@
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::filesystem::path own_dir() {
-  std::error_code ec;
-  auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  return ec ? std::filesystem::path() : exe.parent_path();
-}
 
 // A netns host must exist before anything starts (tests and operators create them).
 void check_hosts(const oscar::SystemSpec& system) {
@@ -69,11 +64,7 @@ int main(int argc, char** argv) {
   app.add_flag("--check", check, "check the system file and its modules, start nothing");
   CLI11_PARSE(app, argc, argv);
 
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  const auto signals = oscar::block_stop_signals();
 
   oscar::LogPrinter log(stdout, isatty(1) != 0);
   try {
@@ -117,12 +108,12 @@ int main(int argc, char** argv) {
     oscar::Supervisor children(log_dir);
     const auto dom = std::to_string(system.domain);
     children.start("registry", 1,
-                   {(own_dir() / "oscar-registry").string(), "--system", file, "--host", local.name,
-                    "--domain", dom});
+                   {oscar::sibling_program("oscar-registry"), "--system", file, "--host",
+                    local.name, "--domain", dom});
     for (const auto& h : system.hosts) {
       children.start(
           "monitor-" + h.name, 1,
-          oscar::on_host(h, {(own_dir() / "oscar-monitor").string(), "--system", file, "--host",
+          oscar::on_host(h, {oscar::sibling_program("oscar-monitor"), "--system", file, "--host",
                              h.name, "--domain", dom, "--log-dir", log_dir + "/" + h.name}));
     }
     const auto running =
@@ -147,10 +138,8 @@ int main(int argc, char** argv) {
           duration_s > 0
               ? Clock::now() + std::chrono::milliseconds(static_cast<long>(duration_s * 1000))
               : Clock::time_point::max();
-      while (Clock::now() < until) {
-        timespec poll{0, 50'000'000};
-        siginfo_t info;
-        if (sigtimedwait(&signals, &info, &poll) > 0) break;
+      while (Clock::now() < until &&
+             !oscar::wait_for_stop(signals, std::chrono::milliseconds(50))) {
         log.flush();
       }
     }

@@ -15,6 +15,7 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
+#include "oscar/process_util.hpp"
 #include "oscar/registry/supervisor.hpp"
 #include "oscar/registry/system_spec.hpp"
 #include "oscar/topic_io.hpp"
@@ -22,12 +23,6 @@
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::filesystem::path own_dir() {
-  std::error_code ec;
-  auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  return ec ? std::filesystem::path() : exe.parent_path();
-}
 
 oscar::ProcessEvent event(const std::string& host, const std::string& module, unsigned incarnation,
                           oscar::ProcessEventKind kind, long pid) {
@@ -54,11 +49,7 @@ int main(int argc, char** argv) {
   app.add_option("--log-dir", log_dir, "where module output goes (default /tmp/oscar/...)");
   CLI11_PARSE(app, argc, argv);
 
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  const auto signals = oscar::block_stop_signals();
   spdlog::set_pattern("%H:%M:%S.%e %^%-5l%$ [monitor " + host + "] %v");
 
   try {
@@ -99,9 +90,7 @@ int main(int argc, char** argv) {
     auto next_beat = Clock::now();
     bool exit_requested = false;
     while (!exit_requested) {
-      timespec poll{0, 5'000'000};
-      siginfo_t info;
-      if (sigtimedwait(&signals, &info, &poll) > 0) break;
+      if (oscar::wait_for_stop(signals, std::chrono::milliseconds(5))) break;
       if (Clock::now() >= next_beat) {
         beats.write(beat);
         next_beat += beat_period;
@@ -116,7 +105,7 @@ int main(int argc, char** argv) {
           case oscar::LAUNCH_START: {
             auto args = q.argv();
             for (auto& a : args) {
-              if (a == "oscar-run") a = (own_dir() / "oscar-run").string();
+              if (a == "oscar-run") a = oscar::sibling_program("oscar-run");
             }
             try {
               const auto pid = supervisor.start(q.module_name(), q.incarnation(), args, q.env());

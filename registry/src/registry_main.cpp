@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
+#include "oscar/process_util.hpp"
 #include "oscar/registry/registry.hpp"
 
 int main(int argc, char** argv) {
@@ -17,11 +18,7 @@ int main(int argc, char** argv) {
   app.add_option("-d,--domain", domain, "DDS domain (default: the file's)");
   CLI11_PARSE(app, argc, argv);
 
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  auto signals = oscar::block_stop_signals();
   spdlog::set_pattern("%H:%M:%S.%e %^%-5l%$ %v");
   try {
     auto system = oscar::SystemSpec::load(file);

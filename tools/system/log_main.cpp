@@ -7,6 +7,7 @@
 #include <oscar/configPubSubTypes.h>
 #include <CLI/CLI.hpp>
 
+#include "oscar/process_util.hpp"
 #include "oscar/registry/log_printer.hpp"
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/topic_io.hpp"
@@ -23,11 +24,7 @@ int main(int argc, char** argv) {
   app.add_option("--duration", duration_s, "stop after this many seconds");
   app.add_flag("--no-colour", no_colour, "plain text even on a terminal");
   CLI11_PARSE(app, argc, argv);
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  const auto signals = oscar::block_stop_signals();
   try {
     auto participant = oscar::tool_participant("oscar-log", system_file, host, domain);
     oscar::LogPrinter printer(stdout, !no_colour && isatty(1) != 0);
@@ -37,10 +34,8 @@ int main(int argc, char** argv) {
     const auto until = duration_s > 0 ? std::chrono::steady_clock::now() +
                                             std::chrono::milliseconds(long(duration_s * 1000))
                                       : std::chrono::steady_clock::time_point::max();
-    while (std::chrono::steady_clock::now() < until) {
-      timespec poll{0, 50'000'000};
-      siginfo_t info;
-      if (sigtimedwait(&signals, &info, &poll) > 0) break;
+    while (std::chrono::steady_clock::now() < until &&
+           !oscar::wait_for_stop(signals, std::chrono::milliseconds(50))) {
       printer.flush();
     }
     printer.flush(true);

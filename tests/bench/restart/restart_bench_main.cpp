@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "oscar/process_util.hpp"
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/time.hpp"
 #include "process.hpp"     // tests/common
@@ -20,10 +21,6 @@
 
 namespace {
 using namespace std::chrono_literals;
-
-std::string own_bin(const std::string& program) {
-  return (std::filesystem::read_symlink("/proc/self/exe").parent_path() / program).string();
-}
 
 std::string temp(const std::string& name) {
   return (std::filesystem::temp_directory_path() / fmt::format("{}_{}", name, getpid())).string();
@@ -103,8 +100,9 @@ double boot_time_ms(int modules, bool netns, int domain) {
   std::ofstream(file) << yaml;
   std::vector<std::string> argv;
   if (netns) argv = hosts->on(1);
-  argv.insert(argv.end(), {own_bin("oscar-boot"), file, "--domain", std::to_string(domain),
-                           "--log-dir", temp("bench_boot20_logs"), "--duration", "1"});
+  argv.insert(argv.end(),
+              {oscar::sibling_program("oscar-boot"), file, "--domain", std::to_string(domain),
+               "--log-dir", temp("bench_boot20_logs"), "--duration", "1"});
   oscar::test::Process boot(argv, temp("bench_boot20") + ".log");
   if (boot.wait(120s) != 0)
     throw std::runtime_error("boot of 20 modules failed:\n" + boot.output());
@@ -137,8 +135,8 @@ modules:
   - { name: b, kernels: [ { type: relay, name: b, params: { type: Bool }, inputs: { in: a/out } } ], mode: single_step, restart: { max: 100000 } }
   - { name: c, kernels: [ { type: bench_sink, name: c, params: { type: Bool }, inputs: { in: b/out } } ], mode: single_step, restart: { max: 100000 } }
 )";
-    oscar::test::Process boot({own_bin("oscar-boot"), file, "--domain", std::to_string(domain),
-                               "--log-dir", temp("bench_restart_logs")},
+    oscar::test::Process boot({oscar::sibling_program("oscar-boot"), file, "--domain",
+                               std::to_string(domain), "--log-dir", temp("bench_restart_logs")},
                               temp("bench_restart") + ".log");
     oscar::DdsParticipant participant(domain, "bench-restart");
     oscar::RegistryClient registry(participant, "bench");
