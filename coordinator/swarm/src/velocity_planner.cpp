@@ -3,13 +3,30 @@
 #include <algorithm>
 #include <boost/graph/adjacency_list.hpp>
 #include <boost/graph/dijkstra_shortest_paths.hpp>
+#include <cmath>
 #include <limits>
+
+#include "oscar/swarm/forbidden_regions.hpp"
 
 namespace oscar::swarm {
 
+namespace {
+
+// A difference of two times carries the rounding of the larger one: at t = 1e6 s a double resolves
+// about 1.2e-10 s (seed §5.3.1). A full-speed edge computed as t_a + Δs / v must still pass
+// eq. 4.13 there, so the speed test allows a few units in the last place of the times involved.
+double time_slack(double t_a, double t_b) {
+  return 4 * std::numeric_limits<double>::epsilon() * std::max({1.0, std::abs(t_a), std::abs(t_b)});
+}
+
+}  // namespace
+
 VelocityPlanner::VelocityPlanner(double s_final, double t_start, std::vector<Polygon> regions,
                                  Settings settings)
-    : s_final_(s_final), t_start_(t_start), regions_(std::move(regions)), settings_(settings) {
+    : s_final_(s_final),
+      t_start_(t_start),
+      regions_(merge_regions(std::move(regions))),
+      settings_(settings) {
   if (settings_.v_leave <= 0) settings_.v_leave = settings_.v_max;
 }
 
@@ -23,8 +40,8 @@ bool VelocityPlanner::free(const Point& a, const Point& b) const {
 bool VelocityPlanner::edge_ok(const Point& a, const Point& b) const {
   const double ds = b.x() - a.x();
   const double dt = b.y() - a.y();
-  if (dt <= 0 || ds < -kEpsilon) return false;                        // eq. 4.12, forward only
-  if (ds > settings_.v_max * dt * (1 + 1e-12) + 1e-12) return false;  // eq. 4.13
+  if (dt <= 0 || ds < -kEpsilon) return false;  // eq. 4.12, forward only
+  if (ds > settings_.v_max * (dt + time_slack(a.y(), b.y())) + 1e-12) return false;  // eq. 4.13
   return free(a, b);
 }
 
@@ -47,7 +64,7 @@ std::optional<std::vector<Point>> VelocityPlanner::fixed_arrival(double t_final)
   const Point start(0, t_start_);
   const Point goal(s_final_, t_final);
   if (t_final < t_start_ ||
-      s_final_ > settings_.v_max * (t_final - t_start_) * (1 + 1e-12) + 1e-12) {
+      s_final_ > settings_.v_max * (t_final - t_start_ + time_slack(t_start_, t_final)) + 1e-12) {
     return std::nullopt;
   }
   std::vector<Point> nodes{start, goal};

@@ -19,6 +19,8 @@ class VelocityPlanner {
     double wait_threshold_s = 0;  ///< d_th of §4.3.4: shorter waits are not added
   };
 
+  /// Overlapping or edge-sharing regions are merged first (merge_regions), so no profile can run
+  /// along a seam between two of them.
   VelocityPlanner(double s_final, double t_start, std::vector<Polygon> regions, Settings settings);
 
   /// Fixed arrival at (s_final, t_final) (Anhang A.5) with waiting instead of crawling (§4.3.4):
