@@ -37,10 +37,16 @@ class VelocityPlanner {
  private:
   bool edge_ok(const Point& a, const Point& b) const;
   std::vector<Point> corners(double t_max) const;
+  bool inside_any(const Point& p) const;  // strictly inside some region
+
+  struct Bounds {
+    double s0, t0, s1, t1;
+  };
 
   double s_final_;
   double t_start_;
   std::vector<Polygon> regions_;
+  std::vector<Bounds> bounds_;  // of each region, for a cheap rejection in free()
   Settings settings_;
 };
 
