@@ -9,6 +9,7 @@
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <boost/geometry.hpp>
+#include <boost/geometry/algorithms/point_on_surface.hpp>
 #pragma GCC diagnostic pop
 
 namespace oscar::swarm {
@@ -118,14 +119,27 @@ std::vector<Polygon> merge_regions(std::vector<Polygon> regions) {
       continue;
     }
     bg::model::multi_polygon<Closed> merged{closed[group.front()]};
-    for (std::size_t k = 1; k < group.size(); ++k) {
-      bg::model::multi_polygon<Closed> next;
-      bg::union_(merged, closed[group[k]], next);
-      merged = std::move(next);
+    bool sound = true;
+    try {
+      for (std::size_t k = 1; k < group.size(); ++k) {
+        bg::model::multi_polygon<Closed> next;
+        bg::union_(merged, closed[group[k]], next);
+        merged = std::move(next);
+      }
+    } catch (const bg::exception&) {
+      sound = false;  // near-degenerate input: keep the pieces
+    }
+    // A forbidden region must never shrink: every piece keeps a point inside the union, and the
+    // union is no smaller than its largest piece. Otherwise the pieces are kept as they are.
+    const double merged_area = sound ? bg::area(merged) : 0.0;
+    for (std::size_t k = 0; sound && k < group.size(); ++k) {
+      Point inner;
+      bg::point_on_surface(closed[group[k]], inner);
+      sound = bg::covered_by(inner, merged) && merged_area >= bg::area(closed[group[k]]) - 1e-12;
     }
     const bool holes = std::any_of(merged.begin(), merged.end(),
                                    [](const Closed& p) { return !p.inners().empty(); });
-    if (holes || merged.empty()) {
+    if (!sound || holes || merged.empty()) {
       for (std::size_t i : group) result.push_back(std::move(regions[i]));
       continue;
     }

@@ -30,8 +30,9 @@ ForbiddenRegions compute_forbidden_regions(const std::vector<Point>& path,
 /// tiles and of neighbouring obstacles: fewer corners (the graph is cubic in them, seed §6.1.2),
 /// and no corner or wait edge on a seam that lies inside the union. Regions touching only at a
 /// point stay apart. A group whose union would have a hole (a free pocket inside) is kept as it
-/// was, since a Polygon has no holes. Near-collinear reflex vertices are dropped, which only grows
-/// a region.
+/// was, since a Polygon has no holes; so is a group whose union fails a soundness check (a piece
+/// not covered, or less area than a piece). Near-collinear reflex vertices are dropped, which only
+/// grows a region.
 std::vector<Polygon> merge_regions(std::vector<Polygon> regions);
 
 /// Which case of seed §4.3.3 (Abb. 4.18) a tile falls into.
