@@ -55,6 +55,10 @@ std::optional<std::vector<Point>> DubinsPathFinder::find(const Point& from, cons
   start->setYaw(heading);
   goal->setXY(to.x(), to.y());
   goal->setYaw(heading);
+  // atan2 gives π for a leg in -x direction, but OMPL's SO2 bounds are [-π, π): unnormalised, its
+  // distance asserts (found by the property test).
+  space->enforceBounds(start.get());
+  space->enforceBounds(goal.get());
   setup.setStartAndGoalStates(start, goal, 1e-6);
   setup.setup();
   const auto si = setup.getSpaceInformation();

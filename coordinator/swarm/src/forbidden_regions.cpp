@@ -2,8 +2,15 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
-#include <boost/geometry.hpp>
 #include <cmath>
+
+// GCC 12 reports a false maybe-uninitialized in Boost.Geometry's rescale policy of union_ (the
+// factor is set on every path that reads it); silenced for these headers only.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#include <boost/geometry.hpp>
+#include <boost/geometry/algorithms/point_on_surface.hpp>
+#pragma GCC diagnostic pop
 
 namespace oscar::swarm {
 
@@ -53,7 +60,99 @@ Box box_of(const std::vector<Point>& points) {
 Point sub(const Point& a, const Point& b) { return Point(a.x() - b.x(), a.y() - b.y()); }
 double norm(const Point& a) { return std::hypot(a.x(), a.y()); }
 
+// Drops vertices that are collinear with their neighbours or reflex by less than a sliver (the
+// kinks the tile overlap leaves on a merged boundary). Dropping a reflex vertex adds a triangle to
+// the region, so the result still contains the input.
+void drop_slivers(std::vector<Point>& ring) {
+  bool changed = true;
+  while (changed && ring.size() > 3) {
+    changed = false;
+    for (std::size_t i = 0; i < ring.size() && ring.size() > 3; ++i) {
+      const Point& a = ring[(i + ring.size() - 1) % ring.size()];
+      const Point& b = ring[i];
+      const Point& c = ring[(i + 1) % ring.size()];
+      const double chord = std::hypot(c.x() - a.x(), c.y() - a.y());
+      const double cross = (b.x() - a.x()) * (c.y() - b.y()) - (b.y() - a.y()) * (c.x() - b.x());
+      // Counter-clockwise ring: cross < 0 is a reflex vertex; its height over the chord is
+      // |cross| / chord.
+      if (chord > 0 && cross <= 0 && -cross <= 1e-7 * chord) {
+        ring.erase(ring.begin() + static_cast<long>(i));
+        changed = true;
+      }
+    }
+  }
+}
+
+std::size_t find_root(std::vector<std::size_t>& parent, std::size_t i) {
+  while (parent[i] != i) i = parent[i] = parent[parent[i]];
+  return i;
+}
+
 }  // namespace
+
+std::vector<Polygon> merge_regions(std::vector<Polygon> regions) {
+  const std::size_t n = regions.size();
+  if (n < 2) return regions;
+  std::vector<Closed> closed(n);
+  std::vector<Box> boxes(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    closed[i].outer().assign(regions[i].outer().begin(), regions[i].outer().end());
+    bg::correct(closed[i]);
+    boxes[i] = bg::return_envelope<Box>(closed[i]);
+  }
+  // Groups of regions that meet (overlap or touch), by union-find over box-overlapping pairs.
+  std::vector<std::size_t> parent(n);
+  for (std::size_t i = 0; i < n; ++i) parent[i] = i;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 1; j < n; ++j) {
+      if (!overlaps(boxes[i], boxes[j]) || find_root(parent, i) == find_root(parent, j)) continue;
+      if (bg::intersects(closed[i], closed[j])) parent[find_root(parent, j)] = find_root(parent, i);
+    }
+  }
+  std::vector<std::vector<std::size_t>> groups(n);
+  for (std::size_t i = 0; i < n; ++i) groups[find_root(parent, i)].push_back(i);
+  std::vector<Polygon> result;
+  for (const auto& group : groups) {
+    if (group.empty()) continue;
+    if (group.size() == 1) {
+      result.push_back(std::move(regions[group.front()]));
+      continue;
+    }
+    bg::model::multi_polygon<Closed> merged{closed[group.front()]};
+    bool sound = true;
+    try {
+      for (std::size_t k = 1; k < group.size(); ++k) {
+        bg::model::multi_polygon<Closed> next;
+        bg::union_(merged, closed[group[k]], next);
+        merged = std::move(next);
+      }
+    } catch (const bg::exception&) {
+      sound = false;  // near-degenerate input: keep the pieces
+    }
+    // A forbidden region must never shrink: every piece keeps a point inside the union, and the
+    // union is no smaller than its largest piece. Otherwise the pieces are kept as they are.
+    const double merged_area = sound ? bg::area(merged) : 0.0;
+    for (std::size_t k = 0; sound && k < group.size(); ++k) {
+      Point inner;
+      bg::point_on_surface(closed[group[k]], inner);
+      sound = bg::covered_by(inner, merged) && merged_area >= bg::area(closed[group[k]]) - 1e-12;
+    }
+    const bool holes = std::any_of(merged.begin(), merged.end(),
+                                   [](const Closed& p) { return !p.inners().empty(); });
+    if (!sound || holes || merged.empty()) {
+      for (std::size_t i : group) result.push_back(std::move(regions[i]));
+      continue;
+    }
+    for (const auto& piece : merged) {
+      std::vector<Point> ring(piece.outer().begin(), piece.outer().end() - 1);
+      drop_slivers(ring);
+      Polygon p;
+      p.outer().assign(ring.begin(), ring.end());
+      if (std::abs(bg::area(p)) > 1e-14) result.push_back(std::move(p));
+    }
+  }
+  return result;
+}
 
 TileCase classify_tile(const Point& dx, const Point& v) {
   const double len = norm(dx);
@@ -162,7 +261,7 @@ ForbiddenRegions compute_forbidden_regions(const std::vector<Point>& path,
       }
     }
   }
-  (void)s_total;
+  result.regions = merge_regions(std::move(result.regions));
   return result;
 }
 

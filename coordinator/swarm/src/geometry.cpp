@@ -47,11 +47,28 @@ double point_segment_distance(const Point& p, const Point& a, const Point& b) {
   return std::hypot(p.x() - (a.x() + u * dx), p.y() - (a.y() + u * dy));
 }
 
+namespace {
+
+// point_segment_distance(p, a, b) <= eps without a square root: this test runs for every edge of
+// every region in the s–t graph's visibility checks, where std::hypot was a third of the time.
+bool within(const Point& p, const Point& a, const Point& b, double eps) {
+  const double dx = b.x() - a.x();
+  const double dy = b.y() - a.y();
+  const double len2 = dx * dx + dy * dy;
+  double u = len2 > 0 ? ((p.x() - a.x()) * dx + (p.y() - a.y()) * dy) / len2 : 0.0;
+  u = std::clamp(u, 0.0, 1.0);
+  const double ex = p.x() - (a.x() + u * dx);
+  const double ey = p.y() - (a.y() + u * dy);
+  return ex * ex + ey * ey <= eps * eps;
+}
+
+}  // namespace
+
 bool strictly_inside(const Point& p, const Polygon& polygon) {
   const auto& v = vertices(polygon);
   bool inside = false;
   for (std::size_t i = 0, j = v.size() - 1; i < v.size(); j = i++) {
-    if (point_segment_distance(p, v[j], v[i]) <= kEpsilon) return false;
+    if (within(p, v[j], v[i], kEpsilon)) return false;
     if ((v[i].y() > p.y()) != (v[j].y() > p.y())) {
       const double x =
           v[j].x() + (p.y() - v[j].y()) * (v[i].x() - v[j].x()) / (v[i].y() - v[j].y());
@@ -64,6 +81,7 @@ bool strictly_inside(const Point& p, const Polygon& polygon) {
 std::vector<double> line_crossings(const Point& p, const Point& d, const Polygon& polygon) {
   std::vector<double> result;
   const auto& v = vertices(polygon);
+  const double dd = d.x() * d.x() + d.y() * d.y();
   for (std::size_t i = 0, j = v.size() - 1; i < v.size(); j = i++) {
     const Point& c = v[j];
     const double ex = v[i].x() - c.x();
@@ -71,10 +89,11 @@ std::vector<double> line_crossings(const Point& p, const Point& d, const Polygon
     const double den = d.x() * ey - d.y() * ex;
     const double wx = c.x() - p.x();
     const double wy = c.y() - p.y();
-    if (std::abs(den) <= 1e-15 * (std::hypot(d.x(), d.y()) * std::hypot(ex, ey) + 1e-300)) {
+    // |den| <= 1e-15 |d| |e|, squared (no square roots per edge).
+    if (den * den <= 1e-30 * dd * (ex * ex + ey * ey) + 1e-300) {
       // Parallel: if collinear, both edge ends count as crossings.
-      const double dd = d.x() * d.x() + d.y() * d.y();
-      if (dd > 0 && std::abs(wx * d.y() - wy * d.x()) <= kEpsilon * std::sqrt(dd)) {
+      const double cross = wx * d.y() - wy * d.x();
+      if (dd > 0 && cross * cross <= kEpsilon * kEpsilon * dd) {
         result.push_back((wx * d.x() + wy * d.y()) / dd);
         result.push_back(((v[i].x() - p.x()) * d.x() + (v[i].y() - p.y()) * d.y()) / dd);
       }

@@ -174,10 +174,14 @@ void Scheduler::add_node(const NodeSpec& spec) {
     throw std::invalid_argument(what + ": start lies within radius of a static obstacle");
   }
   TrajectoryPlanner planner(path_function(*n), obstacles_for(*n), {spec.max_speed_mps, 0, 0});
-  if (!planner.blocked_times(p, spec.t, kForever).empty()) {
-    throw std::invalid_argument(
-        what + ": idling at the start collides with a moving obstacle or another node");
+  auto tail = idle_tail(*n, planner, p, spec.t);
+  if (!tail) {
+    throw std::invalid_argument(what +
+                                ": idling at the start collides with a moving obstacle or another "
+                                "node, and no free place to get out of the way was found");
   }
+  n->committed = *tail;
+  n->working = n->committed;
   nodes_.push_back(std::move(n));
 }
 

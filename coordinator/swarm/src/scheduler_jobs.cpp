@@ -31,6 +31,45 @@ std::optional<double> next_free_start(const std::vector<std::pair<double, double
 
 }  // namespace
 
+std::optional<Trajectory> Scheduler::idle_tail(const NodeState& n, const TrajectoryPlanner& planner,
+                                               const Point& at, double t) const {
+  // After its last job a node idles where it is, but it is not nailed there: if a moving obstacle
+  // (or another node) comes by later, the node gets out of the way to a place that stays free for
+  // good (choice documented in README.md, "Idle nodes"). Candidates: the place itself, then rings
+  // of 8 points at 1, 2, 4, 8 and 16 m, then the node's start; nearest first.
+  const auto blocked_here = planner.blocked_times(at, t, kForever);
+  if (blocked_here.empty()) return Trajectory({{at.x(), at.y(), t}});
+  std::vector<Point> spots;
+  for (double r : {1.0, 2.0, 4.0, 8.0, 16.0}) {
+    for (int k = 0; k < 8; ++k) {
+      const double a = M_PI / 4 * k;
+      spots.emplace_back(at.x() + r * std::cos(a), at.y() + r * std::sin(a));
+    }
+  }
+  spots.emplace_back(n.spec.x, n.spec.y);
+  std::stable_sort(spots.begin(), spots.end(), [&](const Point& a, const Point& b) {
+    return distance(at, a) < distance(at, b);
+  });
+  const SpatialPathFinder& free_space = finder(n);
+  for (const auto& p : spots) {
+    if (!free_space.is_free(p)) continue;
+    const auto path = planner.path(at, p);
+    if (!path) continue;
+    const auto arrival = planner.earliest_arrival(*path, t, kForever / 2);
+    if (!arrival) continue;
+    // Arrive once whatever crosses the spot has passed, then stay for good.
+    double settle = *arrival;
+    for (const auto& [lo, hi] : planner.blocked_times(p, t, kForever)) {
+      if (hi > settle && hi - lo > kEpsilon) settle = std::max(settle, hi);
+    }
+    if (settle >= kForever / 2) continue;
+    auto leg = planner.fixed_arrival(*path, t, settle);
+    if (!leg || !planner.blocked_times(p, settle, kForever).empty()) continue;
+    return leg;
+  }
+  return std::nullopt;
+}
+
 bool Scheduler::try_candidate(const Slot& c, const JobSpec& spec, TransactionId tx,
                               Job& scheduled) {
   NodeState& n = state(c.node);
@@ -65,8 +104,10 @@ bool Scheduler::try_candidate(const Slot& c, const JobSpec& spec, TransactionId 
       auto leg2 = planner.fixed_arrival(*path2, end, c.t2);
       if (!leg2) continue;
       section.append(*leg2);
-    } else if (!planner.blocked_times(c.at, *start, kForever).empty()) {
-      continue;
+    } else {
+      auto tail = idle_tail(n, planner, c.at, end);
+      if (!tail) continue;
+      section.append(*tail);
     }
     record(tx, n, c.t1, stay_until);
     n.working = n.working.spliced(section, c.t1, stay_until);
@@ -189,8 +230,8 @@ bool Scheduler::try_unschedule(const std::string& job_id, TransactionId tx, bool
       if (k + 1 < list.size()) {
         const auto path = planner.path(from, list[k + 1].location());
         if (path) section = planner.fixed_arrival(*path, t1, t2);
-      } else if (planner.blocked_times(from, t1, kForever).empty()) {
-        section = Trajectory({{from.x(), from.y(), t1}});
+      } else {
+        section = idle_tail(n, planner, from, t1);
       }
       if (!section) {
         reason = fmt::format("job '{}': no collision-free trajectory around the gap", job_id);
@@ -214,11 +255,13 @@ bool Scheduler::try_unschedule(const std::string& job_id, TransactionId tx, bool
   throw std::invalid_argument(fmt::format("unknown job id '{}'", job_id));
 }
 
-ScheduleResult Scheduler::unschedule(const std::string& job_id) {
+// unschedule and remove_job: one removal in a transaction of its own, kept on success, aborted
+// on failure or throw.
+ScheduleResult Scheduler::removal(const std::string& job_id, bool replan) {
   ScheduleResult result;
   const TransactionId tx = open_transaction();
   try {
-    result.ok = try_unschedule(job_id, tx, true, result.reason);
+    result.ok = try_unschedule(job_id, tx, replan, result.reason);
   } catch (...) {
     abort(tx);
     throw;
@@ -231,22 +274,9 @@ ScheduleResult Scheduler::unschedule(const std::string& job_id) {
   return result;
 }
 
-ScheduleResult Scheduler::remove_job(const std::string& job_id) {
-  ScheduleResult result;
-  const TransactionId tx = open_transaction();
-  try {
-    result.ok = try_unschedule(job_id, tx, false, result.reason);
-  } catch (...) {
-    abort(tx);
-    throw;
-  }
-  if (!result.ok) {
-    abort(tx);
-  } else {
-    result.transaction = tx;
-  }
-  return result;
-}
+ScheduleResult Scheduler::unschedule(const std::string& job_id) { return removal(job_id, true); }
+
+ScheduleResult Scheduler::remove_job(const std::string& job_id) { return removal(job_id, false); }
 
 ScheduleResult Scheduler::reschedule(const JobSpec& spec) {
   validate(spec, true);

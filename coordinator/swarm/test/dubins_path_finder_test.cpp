@@ -28,6 +28,15 @@ TEST_F(DubinsPathFinderTest, MatchesTheExactPlannerWhereBothApply) {
   EXPECT_NEAR(path_length(*path), 10, 1e-6);
 }
 
+// Regression (property test): a leg in -x direction has heading atan2(0, -1) = π, outside OMPL's
+// SO2 bounds [-π, π); OMPL aborted on an assertion.
+TEST_F(DubinsPathFinderTest, LegInNegativeXDirectionIsStraight) {
+  DubinsPathFinder dubins({}, {.turning_radius_m = 0.5, .iterations = 500, .resolution_m = 0.1});
+  const auto path = dubins.find({10, 0}, {0, 0});
+  ASSERT_TRUE(path);
+  EXPECT_NEAR(path_length(*path), 10, 1e-6);
+}
+
 TEST_F(DubinsPathFinderTest, AroundAnObstacleNoShorterThanExactAndClose) {
   const std::vector<Polygon> obstacles{square(4, -2, 6, 2)};
   SpatialPathFinder exact(obstacles);

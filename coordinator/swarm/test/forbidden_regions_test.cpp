@@ -1,5 +1,7 @@
 #include "oscar/swarm/forbidden_regions.hpp"
 
+#include "oscar/swarm/trajectory_planner.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -119,6 +121,72 @@ TEST(ForbiddenRegions, StationaryCaseWithAStandingObstacleBlocksItsWholeSpan) {
   EXPECT_NEAR(r.blocked_times[0].second, 7, 1e-9);
   const auto miss = compute_forbidden_regions({{5, 0.7}}, moving(5, 0, 2, 5, 0, 7), 0, 20);
   EXPECT_TRUE(miss.blocked_times.empty());
+}
+
+bool has_exactly(const Polygon& p, std::vector<Point> expected) {
+  if (vertices(p).size() != expected.size()) return false;
+  for (const auto& e : expected) {
+    bool found = false;
+    for (const auto& v : vertices(p)) found = found || distance(v, e) < 1e-6;
+    if (!found) return false;
+  }
+  return true;
+}
+
+Polygon rect(double s0, double t0, double s1, double t1) {
+  return make_polygon({{s0, t0}, {s1, t0}, {s1, t1}, {s0, t1}}, "rect");
+}
+
+// A.7 line 36 (forbidden ← forbidden ∪ f): the tiles of two path segments are one region again.
+TEST(ForbiddenRegions, TilesOfCollinearPathSegmentsMergeIntoOneSquare) {
+  const std::vector<Point> split{{0, 0}, {5, 0}, {10, 0}};
+  const auto r = compute_forbidden_regions(split, moving(5, -5, 0, 5, 5, 10), 0, 20);
+  ASSERT_EQ(r.regions.size(), 1u);
+  EXPECT_TRUE(has_exactly(r.regions[0], {{4.5, 4.5}, {5.5, 4.5}, {5.5, 5.5}, {4.5, 5.5}}));
+  EXPECT_NEAR(total_area(r), 1.0, 1e-9);
+}
+
+TEST(ForbiddenRegions, TilesOfObstacleTrajectorySegmentsMergeIntoOneSquare) {
+  const MovingObstacle o{unit_square(), Trajectory({{5, -5, 0}, {5, 0, 5}, {5, 5, 10}})};
+  const auto r = compute_forbidden_regions(kPath, o, 0, 20);
+  ASSERT_EQ(r.regions.size(), 1u);
+  EXPECT_TRUE(has_exactly(r.regions[0], {{4.5, 4.5}, {5.5, 4.5}, {5.5, 5.5}, {4.5, 5.5}}));
+}
+
+TEST(ForbiddenRegions, OverlappingRegionsMergeIntoTheirUnion) {
+  const auto merged = merge_regions({rect(0, 0, 2, 2), rect(1, 1, 3, 3)});
+  ASSERT_EQ(merged.size(), 1u);
+  EXPECT_TRUE(
+      has_exactly(merged[0], {{0, 0}, {2, 0}, {2, 1}, {3, 1}, {3, 3}, {1, 3}, {1, 2}, {0, 2}}));
+  EXPECT_NEAR(bg::area(merged[0]), 7.0, 1e-12);
+}
+
+TEST(ForbiddenRegions, RegionsTouchingAtAPointOrApartStaySeparate) {
+  EXPECT_EQ(merge_regions({rect(0, 0, 1, 1), rect(1, 1, 2, 2)}).size(), 2u);
+  EXPECT_EQ(merge_regions({rect(0, 0, 1, 1), rect(3, 3, 4, 4)}).size(), 2u);
+}
+
+TEST(ForbiddenRegions, AUnionWithAHoleKeepsItsPieces) {
+  // Four bars around the free pocket [1, 2]²: a Polygon cannot hold the hole.
+  const auto merged =
+      merge_regions({rect(0, 0, 3, 1), rect(0, 2, 3, 3), rect(0, 0, 1, 3), rect(2, 0, 3, 3)});
+  EXPECT_EQ(merged.size(), 4u);
+}
+
+// Correctness, not only speed: two standing obstacles side by side block s in [4, 6] during
+// [5, 20]. Unmerged, a profile could wait on their shared edge s = 5 and arrive at 25. By hand:
+// wait at s = 4 until 20, then 6 m at 1 m/s, arrival 26.
+TEST(ForbiddenRegions, NoProfileWaitsOnTheSeamBetweenTwoObstacles) {
+  std::vector<MovingObstacle> obstacles{{unit_square(), Trajectory({{4.5, 0, 5}, {4.5, 0, 20}})},
+                                        {unit_square(), Trajectory({{5.5, 0, 5}, {5.5, 0, 20}})}};
+  SpatialPathFinder free_space({});
+  TrajectoryPlanner planner([&](const Point& a, const Point& b) { return free_space.find(a, b); },
+                            obstacles, {1, 0, 0});
+  const auto arrival = planner.earliest_arrival(kPath, 0, 100);
+  ASSERT_TRUE(arrival.has_value());
+  EXPECT_NEAR(*arrival, 26, 1e-6);
+  VelocityPlanner seams(10, 0, {rect(4, 5, 5, 20), rect(5, 5, 6, 20)}, {1, 0, 0});
+  EXPECT_FALSE(seams.free({5, 5}, {5, 20}));
 }
 
 }  // namespace

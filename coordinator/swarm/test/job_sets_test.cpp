@@ -1,7 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <stdexcept>
 
+#include "expect_error.hpp"
 #include "oscar/swarm/dependency_windows.hpp"
 #include "oscar/swarm/scheduler.hpp"
 
@@ -163,6 +165,50 @@ TEST(Transactions, CommitAndAbortPerNode) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("unknown or finished transaction"), std::string::npos);
   }
+}
+
+using test::expect_error;
+
+TEST(Scheduler, BadJobSetsAndWorldsGetClearErrors) {
+  Scheduler s({}, {});
+  s.add_node({"n1", 0.1, 1, 0, 0, 0, 0});
+  const Polygon area = square(4, -1, 6, 1);
+  expect_error(
+      [&] {
+        s.schedule(PeriodicSpec{{"P1", "P2"}, area, true, 0, 5, 10});
+      },
+      "0 < duration <= period");
+  expect_error(
+      [&] {
+        s.schedule(PeriodicSpec{{"P1", "P2"}, area, true, 0, std::nan(""), 1});
+      },
+      "0 < duration <= period");
+  expect_error(
+      [&] {
+        s.schedule(PeriodicSpec{{"P1", "P1"}, area, true, 0, 10, 1});
+      },
+      "duplicate id 'P1'");
+  expect_error(
+      [&] {
+        s.schedule(PeriodicSpec{{}, area, true, 0, 10, 1});
+      },
+      "ids must not be empty");
+  expect_error(
+      [&] {
+        s.schedule(DependentSpec{table_4_1(), {{"A", {"C"}}, {"C", {"A"}}}});
+      },
+      "cycle");
+  expect_error(
+      [&] {
+        s.schedule(DependentSpec{table_4_1(), {{"C", {"Z"}}}});
+      },
+      "unknown job id 'Z'");
+  EXPECT_TRUE(s.open_transactions().empty());
+  World bad;
+  bad.dynamic_obstacles.push_back({square(0, 0, 1, 1), Trajectory({{0, 0, 0}, {1, 1, 5e6}})});
+  expect_error([&] { Scheduler(bad, {}); }, "world.dynamic[0] trajectory time");
+  expect_error([&] { Trajectory({{0, 0, 0}, {1, 1, std::nan("")}}); }, "must be finite");
+  expect_error([&] { Trajectory({{0, 0, 5}, {1, 1, 4}}); }, "must not decrease");
 }
 
 }  // namespace

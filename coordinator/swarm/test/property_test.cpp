@@ -1,5 +1,6 @@
 // Random worlds, random operations, every result checked by the independent checker.
 #include <gtest/gtest.h>
+#include <ompl/util/RandomNumbers.h>
 
 #include <cstdlib>
 #include <random>
@@ -39,7 +40,8 @@ struct Stats {
   int attempted = 0, scheduled = 0;
 };
 
-void run_world(unsigned seed, Stats& stats) {
+// `dubins`: the share of nodes with a minimum turning radius (planned by OMPL, §4.3.1).
+void run_world(unsigned seed, Stats& stats, double dubins = 0) {
   std::mt19937 rng(seed);
   auto uni = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
   auto coin = [&](double p) { return uni(0, 1) < p; };
@@ -77,6 +79,7 @@ void run_world(unsigned seed, Stats& stats) {
   for (int i = 0, n = 2 + static_cast<int>(rng() % 3); i < n;) {
     NodeSpec spec{
         "n" + std::to_string(i), uni(0.1, 0.4), uni(0.3, 1.5), uni(0, kSize), uni(0, kSize), 0, 0};
+    if (coin(dubins)) spec.turning_radius_m = uni(0.2, 1.0);
     try {
       s.add_node(spec);
     } catch (const std::invalid_argument&) {
@@ -254,6 +257,21 @@ TEST(PropertyTest, RandomWorldsPassTheIndependentChecker) {
   RecordProperty("scheduled", stats.scheduled);
   RecordProperty("attempted", stats.attempted);
   std::printf("property test: %d of %d operations succeeded\n", stats.scheduled, stats.attempted);
+}
+
+// The same over worlds where about half the nodes have a turning radius. OMPL is seeded once per
+// process (ctest runs each test in its own process), so the worlds are reproducible; fewer worlds
+// because each Dubins leg may cost an RRT run.
+TEST(PropertyTest, RandomWorldsWithDubinsNodesPassTheIndependentChecker) {
+  ompl::RNG::setSeed(11);
+  Stats stats;
+  for (unsigned seed = 1001; seed <= 1030; ++seed) {
+    run_world(seed, stats, 0.5);
+    if (HasFatalFailure()) return;
+  }
+  EXPECT_GT(stats.scheduled, stats.attempted / 4) << stats.scheduled << " of " << stats.attempted;
+  std::printf("property test (Dubins): %d of %d operations succeeded\n", stats.scheduled,
+              stats.attempted);
 }
 
 TEST(Checker, CatchesACollisionAndSpeeding) {

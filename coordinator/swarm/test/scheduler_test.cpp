@@ -5,6 +5,9 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "expect_error.hpp"
+#include "schedule_checker.hpp"
+
 namespace oscar::swarm {
 namespace {
 
@@ -17,14 +20,14 @@ JobSpec job(const std::string& id, Polygon area, double t_min, double t_finish, 
 }
 
 // The set-up of seed §4.2.1 (Abb. 4.2/4.5): n1 is busy far away, n2 works at (3,1) until 20 and
-// at (7,1) from 50.
-Scheduler worked_example() {
-  Scheduler s({}, {});
-  s.add_node({"n1", 0.1, 0.5, 10, 10, 0, 0});
-  s.add_node({"n2", 0.1, 0.5, 3, 1, 0, 0});
-  for (const auto& spec : {job("X", square(9.9, 9.9, 10.1, 10.1), 5, 65, 60),
-                           job("A", square(2.9, 0.9, 3.1, 1.1), 10, 20, 10),
-                           job("B", square(6.9, 0.9, 7.1, 1.1), 50, 55, 5)}) {
+// at (7,1) from 50. `t0` shifts every time (and the present) to test long horizons.
+Scheduler worked_example(double t0 = 0) {
+  Scheduler s({}, {.present = t0});
+  s.add_node({"n1", 0.1, 0.5, 10, 10, t0, 0});
+  s.add_node({"n2", 0.1, 0.5, 3, 1, t0, 0});
+  for (const auto& spec : {job("X", square(9.9, 9.9, 10.1, 10.1), t0 + 5, t0 + 65, 60),
+                           job("A", square(2.9, 0.9, 3.1, 1.1), t0 + 10, t0 + 20, 10),
+                           job("B", square(6.9, 0.9, 7.1, 1.1), t0 + 50, t0 + 55, 5)}) {
     const auto r = s.schedule(spec);
     EXPECT_TRUE(r.ok) << r.reason;
     s.commit(r.transaction);  // an open transaction would lock the node's slot (§4.2.7)
@@ -61,6 +64,26 @@ TEST(Scheduler, WorkedExampleOfSection421PicksTheOnlyQualifyingPause) {
   const Point at_b = t.position_at(50);
   EXPECT_NEAR(at_b.x(), 7, 1e-9);
   EXPECT_NEAR(at_b.y(), 1, 1e-9);
+}
+
+// Seed §5.3.1: long horizons must not lose precision silently. Near the ±1e6 s limit the worked
+// example gives the same slot and start to well below a microsecond (a double resolves ~1e-10 s
+// there); beyond it the input is refused (BadInputGetsClearErrors).
+TEST(Scheduler, WorkedExampleNearTheTimeLimitKeepsItsPrecision) {
+  const double t0 = 999000;
+  Scheduler s = worked_example(t0);
+  const auto spec = job("J1", square(4, 2, 6, 4), t0 + 10, t0 + 60, 10);
+  const auto slots = s.qualifying_slots(spec, Point(5, 3));
+  ASSERT_EQ(slots.size(), 1u);
+  EXPECT_EQ(slots[0].node, "n2");
+  EXPECT_NEAR(slots[0].detour, 2 * std::sqrt(8.0) - 4, 1e-9);
+  const auto result = s.schedule(spec);
+  ASSERT_TRUE(result.ok) << result.reason;
+  EXPECT_NEAR(result.jobs[0].start - t0, 20 + std::sqrt(8.0) / 0.5, 1e-6);
+  s.commit(result.transaction);
+  const Point at_b = s.trajectory("n2").position_at(t0 + 50);
+  EXPECT_NEAR(at_b.x(), 7, 1e-6);
+  EXPECT_NEAR(at_b.y(), 1, 1e-6);
 }
 
 TEST(Scheduler, LoadFiguresOfTheWorkedExample) {
@@ -136,15 +159,7 @@ TEST(Scheduler, FrozenHorizonProtectsThePast) {
   EXPECT_NEAR(s.trajectory("n", false).position_at(30).x(), 0, 1e-12);
 }
 
-template <typename F>
-void expect_error(F f, const std::string& part) {
-  try {
-    f();
-    FAIL() << "no exception; expected one mentioning '" << part << "'";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
-  }
-}
+using test::expect_error;
 
 TEST(Scheduler, BadInputGetsClearErrors) {
   Scheduler s({}, {});
@@ -185,6 +200,78 @@ TEST(Scheduler, MovingObstacleMakesTheNodeWaitOrDodgeInTime) {
     const bool hit = std::abs(p.x() - 5) < 1.2 && std::abs(p.y() - oy) < 0.7;
     ASSERT_FALSE(hit) << "collision at t=" << time;
   }
+}
+
+// Checks a node's trajectory against one moving square with the independent checker.
+std::vector<std::string> clearance_violations(const Scheduler& s, const std::string& node,
+                                              const MovingObstacle& o, double half) {
+  check::Checker c;
+  check::Body n{node, {}, s.node(node).radius_m, {}, true, s.node(node).max_speed_mps};
+  for (const auto& w : s.trajectory(node).points()) n.trajectory.push_back({w.x, w.y, w.t});
+  check::Body b{
+      "obstacle", {{-half, -half}, {half, -half}, {half, half}, {-half, half}}, 0, {}, false, 0};
+  for (const auto& w : o.trajectory.points()) b.trajectory.push_back({w.x, w.y, w.t});
+  c.pair_clearance(n, b, 1000);
+  c.speed(n);
+  return c.violations;
+}
+
+// Regression: a node used to stay at its last job for good, so a job whose place a moving obstacle
+// crosses long after the job was refused. A swarm developer expects the idle node to step aside.
+TEST(Scheduler, IdleNodeStepsAsideForAnObstacleCrossingItsLastJobLater) {
+  World w;
+  const MovingObstacle crossing{square(-0.5, -0.5, 0.5, 0.5),
+                                Trajectory({{5, -10, 100}, {5, 10, 120}})};
+  w.dynamic_obstacles.push_back(crossing);
+  Scheduler s(std::move(w), {});
+  s.add_node({"n", 0.2, 1, 0, 0, 0, 0});
+  const auto r = s.schedule(job("J", square(4.9, -0.1, 5.1, 0.1), 10, 40, 5));
+  ASSERT_TRUE(r.ok) << r.reason;
+  s.commit(r.transaction);
+  EXPECT_NEAR(r.jobs[0].x, 5, 1e-9);
+  // At the job for its whole duration, away while the obstacle passes, and parked for good.
+  EXPECT_NEAR(s.trajectory("n").position_at(r.jobs[0].start + 2.5).x(), 5, 1e-9);
+  const Point at_crossing = s.trajectory("n").position_at(110);
+  EXPECT_GT(std::hypot(at_crossing.x() - 5, at_crossing.y()), 0.7);
+  EXPECT_LT(s.trajectory("n").end_time(), 110);
+  const auto violations = clearance_violations(s, "n", crossing, 0.5);
+  EXPECT_TRUE(violations.empty()) << violations.front();
+}
+
+// The periodic failure case of the benchmark: an obstacle parks on the place only after the last
+// repetition. With the old rule the set failed at its first job already.
+TEST(Scheduler, PeriodicSetSucceedsWhenTheObstacleComesAfterItsLastRepetition) {
+  World w;
+  const MovingObstacle parked{square(-2, -2, 2, 2), Trajectory({{5, 0, 75}, {5, 0, 90}})};
+  w.dynamic_obstacles.push_back(parked);
+  Scheduler s(std::move(w), {});
+  s.add_node({"n", 0.2, 1, 0, 0, 0, 0});
+  const auto r = s.schedule(PeriodicSpec{{"P1", "P2", "P3"}, square(4, -1, 6, 1), true, 10, 20, 5});
+  ASSERT_TRUE(r.ok) << r.reason;
+  s.commit(r.transaction);
+  const auto violations = clearance_violations(s, "n", parked, 2);
+  EXPECT_TRUE(violations.empty()) << violations.front();
+  // An obstacle on the place during the last period still makes the set fail, atomically.
+  World w2;
+  w2.dynamic_obstacles.push_back({square(-2, -2, 2, 2), Trajectory({{5, 0, 45}, {5, 0, 100}})});
+  Scheduler s2(std::move(w2), {});
+  s2.add_node({"n", 0.2, 1, 0, 0, 0, 0});
+  EXPECT_FALSE(
+      s2.schedule(PeriodicSpec{{"P1", "P2", "P3"}, square(4, -1, 6, 1), true, 10, 20, 5}).ok);
+  EXPECT_TRUE(s2.jobs("n", false).empty());
+}
+
+// A node added where something will pass later steps aside instead of being refused.
+TEST(Scheduler, NodeAddedInTheWayOfALaterObstacleStepsAside) {
+  World w;
+  const MovingObstacle crossing{square(-0.5, -0.5, 0.5, 0.5),
+                                Trajectory({{0, -10, 10}, {0, 10, 30}})};
+  w.dynamic_obstacles.push_back(crossing);
+  Scheduler s(std::move(w), {});
+  s.add_node({"n", 0.2, 1, 0, 0, 0, 0});
+  EXPECT_GT(s.trajectory("n").points().size(), 1u);
+  const auto violations = clearance_violations(s, "n", crossing, 0.5);
+  EXPECT_TRUE(violations.empty()) << violations.front();
 }
 
 }  // namespace

@@ -25,6 +25,16 @@ ForbiddenRegions compute_forbidden_regions(const std::vector<Point>& path,
                                            const MovingObstacle& obstacle, double t_lo,
                                            double t_hi);
 
+/// Merges forbidden regions that overlap or share an edge into their union (seed A.7 line 36:
+/// forbidden ← forbidden ∪ f), so that the s–t graph sees one boundary instead of the seams of
+/// tiles and of neighbouring obstacles: fewer corners (the graph is cubic in them, seed §6.1.2),
+/// and no corner or wait edge on a seam that lies inside the union. Regions touching only at a
+/// point stay apart. A group whose union would have a hole (a free pocket inside) is kept as it
+/// was, since a Polygon has no holes; so is a group whose union fails a soundness check (a piece
+/// not covered, or less area than a piece). Near-collinear reflex vertices are dropped, which only
+/// grows a region.
+std::vector<Polygon> merge_regions(std::vector<Polygon> regions);
+
 /// Which case of seed §4.3.3 (Abb. 4.18) a tile falls into.
 enum class TileCase { kRegular, kParallel, kStationary };
 

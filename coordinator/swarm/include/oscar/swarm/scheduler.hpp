@@ -70,9 +70,10 @@ class Scheduler {
   Scheduler(Scheduler&&) noexcept;
   Scheduler& operator=(Scheduler&&) noexcept;
 
-  /// Adds a node idle at its start (seed §5.2 addNode).
-  /// @throws std::invalid_argument on a duplicate id, bad numbers, or a start inside an obstacle
-  /// or too close to another node.
+  /// Adds a node idle at its start (seed §5.2 addNode). If a moving obstacle or another node will
+  /// cross the start later, the node's trajectory steps aside in time (README, "Idle nodes").
+  /// @throws std::invalid_argument on a duplicate id, bad numbers, a start inside an obstacle or
+  /// too close to another node, or no free place to step aside to.
   void add_node(const NodeSpec& spec);
 
   /// Schedules one job in a new transaction (seed §4.2.1, A.4).
@@ -135,8 +136,11 @@ class Scheduler {
   bool try_schedule(const JobSpec& spec, TransactionId tx, const std::optional<Point>& at,
                     std::string& reason, Job& scheduled);
   bool try_candidate(const Slot& c, const JobSpec& spec, TransactionId tx, Job& scheduled);
+  ScheduleResult removal(const std::string& job_id, bool replan);
   bool try_unschedule(const std::string& job_id, TransactionId tx, bool replan,
                       std::string& reason);
+  std::optional<Trajectory> idle_tail(const NodeState& n, const TrajectoryPlanner& planner,
+                                      const Point& at, double t) const;
   bool locked_by_other(const NodeState& n, TransactionId tx, double lo, double hi) const;
   void record(TransactionId tx, NodeState& n, double lo, double hi);
   std::vector<Point> sample_locations(const Polygon& area);

@@ -19,6 +19,8 @@ class VelocityPlanner {
     double wait_threshold_s = 0;  ///< d_th of §4.3.4: shorter waits are not added
   };
 
+  /// Overlapping or edge-sharing regions are merged first (merge_regions), so no profile can run
+  /// along a seam between two of them.
   VelocityPlanner(double s_final, double t_start, std::vector<Polygon> regions, Settings settings);
 
   /// Fixed arrival at (s_final, t_final) (Anhang A.5) with waiting instead of crawling (§4.3.4):
@@ -35,10 +37,16 @@ class VelocityPlanner {
  private:
   bool edge_ok(const Point& a, const Point& b) const;
   std::vector<Point> corners(double t_max) const;
+  bool inside_any(const Point& p) const;  // strictly inside some region
+
+  struct Bounds {
+    double s0, t0, s1, t1;
+  };
 
   double s_final_;
   double t_start_;
   std::vector<Polygon> regions_;
+  std::vector<Bounds> bounds_;  // of each region, for a cheap rejection in free()
   Settings settings_;
 };
 
