@@ -9,6 +9,9 @@
 
 #include "oscar/config_client.hpp"
 #include "oscar/module.hpp"
+#include "oscar/topic_io.hpp"
+
+#include <oscar/configPubSubTypes.h>
 #include "process.hpp"  // tests/common
 #include "test_kernels.hpp"
 
@@ -28,8 +31,7 @@ bool eventually(const std::function<bool()>& condition, std::chrono::millisecond
 }
 
 std::string temp(const std::string& name) {
-  return (std::filesystem::temp_directory_path() /
-          (name + "_" + std::to_string(getpid())))
+  return (std::filesystem::temp_directory_path() / (name + "_" + std::to_string(getpid())))
       .string();
 }
 
@@ -60,8 +62,8 @@ TEST(CueFlow, PushAcrossProcessesDeliversEveryCueInOrder) {
                            "sink.report=" + report, "-p", "sink.expect=200", "-i",
                            "sink.in=src/out", "-m", "single_step"});
   std::this_thread::sleep_for(300ms);
-  auto src = run("src", {"-k", "bench_source:src", "-p", "src.type=LineSeg3DSeq", "-m",
-                         "continuous:2ms"});
+  auto src =
+      run("src", {"-k", "bench_source:src", "-p", "src.type=LineSeg3DSeq", "-m", "continuous:2ms"});
   ASSERT_TRUE(eventually([&] { return std::filesystem::exists(report); }))
       << sink->output() << src->output();
   const auto r = nlohmann::json::parse(std::ifstream(report));
@@ -97,8 +99,8 @@ TEST(CueFlow, PullAcrossProcessesForAGivenTime) {
 }
 
 TEST(CueFlow, PrefetchReturnsAtOnceAndDeliversLater) {
-  auto src = run("src", {"-k", "bench_source:src", "-p", "src.type=GvImage", "-m",
-                         "continuous:20ms"});
+  auto src =
+      run("src", {"-k", "bench_source:src", "-p", "src.type=GvImage", "-m", "continuous:20ms"});
   auto consumer = local_module(R"(
 name: consumer
 mode: deactivated
@@ -218,12 +220,42 @@ kernels: [ { type: test_collect, name: sink, inputs: { in: src/out } } ]
   EXPECT_THAT(reply.error(), HasSubstr("refused: 'rogue_module' may not deactivate module 'src'"));
 }
 
+// Configuration is at least once: a client repeats a command (same sender and id) until it sees
+// the reply. The module must answer every repeat and apply the command only once.
+TEST(CueFlow, ARepeatedCommandIsAnsweredAgainButAppliedOnce) {
+  auto module = local_module(R"(
+name: counted
+kernels: [ { type: test_counter, name: counter, mode: "single_step:command" } ]
+)");
+  auto& counter = dynamic_cast<test::Counter&>(module->kernel("counter").kernel());
+  DdsParticipant participant(test::test_domain(), "test:repeater");
+  std::atomic<int> replies{0};
+  TopicReader<ConfigReply, ConfigReplyPubSubType> reply_reader(
+      participant, "oscar/config_reply/counted", qos::state_reader(16),
+      [&](const ConfigReply& r, const auto&) {
+        if (r.id() == 77 && r.ok()) ++replies;
+      });
+  TopicWriter<ConfigCommand, ConfigCommandPubSubType> writer(participant, "oscar/config/counted",
+                                                             qos::state_writer(16));
+  ASSERT_TRUE(eventually([&] { return writer.matched() > 0 && reply_reader.matched() > 0; }));
+  ConfigCommand trigger;
+  trigger.id(77);
+  trigger.sender("coordinator");
+  trigger.target("counted");
+  trigger.kind(CMD_TRIGGER);
+  trigger.args({"counter"});
+  for (int i = 0; i < 3; ++i) writer.write(trigger);
+  ASSERT_TRUE(eventually([&] { return replies.load() == 3; })) << replies.load() << " replies";
+  std::this_thread::sleep_for(50ms);
+  EXPECT_EQ(counter.count_.load(), 1) << "the repeats were applied again";
+}
+
 TEST(CueFlow, ACommandToAnUnknownModuleIsAClearError) {
   DdsParticipant participant(test::test_domain(), "test:coordinator");
   ConfigClient coordinator(participant, "coordinator");
-  EXPECT_THAT([&] { coordinator.send("nobody", CMD_SUSPEND, {}, 500ms); },
-              testing::ThrowsMessage<std::runtime_error>(
-                  HasSubstr("no module named 'nobody' is running")));
+  EXPECT_THAT(
+      [&] { coordinator.send("nobody", CMD_SUSPEND, {}, 500ms); },
+      testing::ThrowsMessage<std::runtime_error>(HasSubstr("no module named 'nobody' is running")));
 }
 
 TEST(OscarRun, BadInputExitsWithAClearMessage) {
