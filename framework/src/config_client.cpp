@@ -22,6 +22,7 @@ namespace dds = eprosima::fastdds::dds;
 struct ConfigClient::Channel {
   dds::DataWriter* writer = nullptr;
   dds::DataReader* reader = nullptr;
+  std::mutex mutex;  // one command at a time to this module
 };
 
 ConfigClient::ConfigClient(DdsParticipant& participant, std::string sender)
@@ -55,8 +56,16 @@ ConfigClient::Channel& ConfigClient::channel(const std::string& module) {
 
 ConfigReply ConfigClient::send(const std::string& module, CommandKind kind,
                                std::vector<std::string> args, std::chrono::milliseconds timeout) {
-  std::lock_guard lock(mutex_);
-  auto& c = channel(module);
+  Channel* channel_ptr = nullptr;
+  unsigned long long id = 0;
+  {
+    std::lock_guard lock(mutex_);
+    channel_ptr = &channel(module);
+    id = next_id_++;
+  }
+  // One command at a time per module (its replies share one reader); modules in parallel.
+  auto& c = *channel_ptr;
+  std::lock_guard channel_lock(c.mutex);
   const auto until = std::chrono::steady_clock::now() + timeout;
   // Wait until the module reads our commands and we read its replies.
   for (;;) {
@@ -73,7 +82,7 @@ ConfigReply ConfigClient::send(const std::string& module, CommandKind kind,
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   ConfigCommand cmd;
-  cmd.id(next_id_++);
+  cmd.id(id);
   cmd.sender(sender_);
   cmd.target(module);
   cmd.kind(kind);

@@ -80,7 +80,8 @@ dds::DomainParticipantQos participant_qos(const std::string& name, const Network
   }
   // Leave quickly and announce often: a vanished participant must not linger for 20 s.
   builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(3, 0);
-  builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(1, 0);
+  builtin.discovery_config.leaseDuration_announcementperiod =
+      eprosima::fastrtps::Duration_t(0, 200000000);
   return qos;
 }
 

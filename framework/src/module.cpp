@@ -72,7 +72,7 @@ Module::Module(ModuleSpec spec, const std::vector<std::string>& plugin_path)
           fmt::format("{}: kernel '{}' ({}): {}", k.where, k.name, k.type, e.what()));
     }
     slot->mode = spec_.effective_mode(k);
-    slot->stub = spec_.stub;
+    slot->stub = k.stub.value_or(spec_.stub);
     for (const auto& [input, wiring] : k.inputs) {
       if (!wiring.source.empty()) slot->sources[input] = wiring.source;
     }

@@ -291,6 +291,31 @@ const KernelSpec* ModuleSpec::find_kernel(const std::string& kernel_name) const 
   return nullptr;
 }
 
+void ModuleSpec::restore(const YAML::Node& state) {
+  if (!state.IsMap()) throw std::invalid_argument("restore: expected a map of kernel: state");
+  for (const auto& kv : state) {
+    const auto kernel = kv.first.as<std::string>();
+    auto it = std::find_if(kernels.begin(), kernels.end(),
+                           [&](const KernelSpec& k) { return k.name == kernel; });
+    if (it == kernels.end()) {
+      throw std::invalid_argument(
+          fmt::format("restore: module '{}' has no kernel '{}'", name, kernel));
+    }
+    const auto what = "restore: kernel '" + kernel + "'";
+    check_yaml_keys(kv.second, "<restore>", what, {"mode", "stub", "params", "inputs"});
+    if (const auto m = kv.second["mode"]) it->mode = ModeSpec::parse_text(m.as<std::string>());
+    if (const auto st = kv.second["stub"]) it->stub = st.as<bool>();
+    if (const auto p = kv.second["params"]) {
+      if (!it->params || !it->params.IsMap()) it->params = YAML::Node(YAML::NodeType::Map);
+      for (const auto& param : p) it->params[param.first.as<std::string>()] = param.second;
+    }
+    if (const auto in = kv.second["inputs"]) {
+      for (const auto& wire : in)
+        it->inputs[wire.first.as<std::string>()].source = wire.second.as<std::string>();
+    }
+  }
+}
+
 ModeSpec ModuleSpec::effective_mode(const KernelSpec& kernel) const {
   if (kernel.mode) return *kernel.mode;
   if (mode.kind == ModeSpec::Kind::kContinuous && &kernel != &kernels.front()) {

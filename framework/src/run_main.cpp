@@ -75,6 +75,10 @@ int run_main(int argc, char** argv) {
   app.add_option("--incarnation", incarnation, "which start of this module this is (registry)")
       ->check(CLI::PositiveNumber);
   app.add_flag("--suspended", suspended, "start suspended (the registry resumes it)");
+  std::string restore;
+  app.add_option("--restore", restore,
+                 "YAML {kernel: {mode, stub, params, inputs}}: the configuration a restarted "
+                 "module gets back (the registry passes it)");
   app.add_flag("--check", check, "load and check the module, print it, and exit");
   app.add_flag("--list-types", list, "list the kernel types that can be loaded and exit");
   app.add_flag("--list-modules", modules, "list the modules of the system file and exit");
@@ -102,6 +106,7 @@ int run_main(int argc, char** argv) {
     if (!mode.empty()) spec.mode = ModeSpec::parse_text(mode);
     if (stub) spec.stub = true;
     spec.incarnation = incarnation;
+    if (!restore.empty()) spec.restore(YAML::Load(restore));
     spec.start_suspended = suspended;
     Module module(std::move(spec), plugin_search_path());
     if (check) {

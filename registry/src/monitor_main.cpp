@@ -86,15 +86,18 @@ int main(int argc, char** argv) {
     spdlog::info("watching host '{}' (domain {}), module output in {}", host, system.domain,
                  log_dir);
     std::map<std::string, Clock::time_point> stopping;  // SIGKILL if still there by then
-    const auto beat_period = system.lease / 3;
-    auto next_beat = Clock::now();
+    // The heartbeat has a thread of its own: starting processes must not delay it.
+    std::jthread beater([&](std::stop_token stop) {
+      auto next = Clock::now();
+      while (!stop.stop_requested()) {
+        beats.write(beat);
+        next += system.lease / 3;
+        std::this_thread::sleep_until(next);
+      }
+    });
     bool exit_requested = false;
     while (!exit_requested) {
       if (oscar::wait_for_stop(signals, std::chrono::milliseconds(5))) break;
-      if (Clock::now() >= next_beat) {
-        beats.write(beat);
-        next_beat += beat_period;
-      }
       std::deque<oscar::LaunchRequest> todo;
       {
         std::lock_guard lock(mutex);
@@ -149,6 +152,8 @@ int main(int argc, char** argv) {
         events.write(ev);
       }
     }
+    beater.request_stop();
+    beater.join();
     for (const auto& x : supervisor.stop_all(std::chrono::milliseconds(5000))) {
       auto ev = event(host, x.module, x.incarnation, oscar::PROC_EXITED, x.pid);
       ev.exit_code(x.exit_code);

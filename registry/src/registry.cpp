@@ -1,6 +1,7 @@
 #include "oscar/registry/registry.hpp"
 
 #include <algorithm>
+#include <future>
 #include <set>
 
 #include <fmt/format.h>
@@ -74,31 +75,38 @@ Registry::Tracked* Registry::find(const std::string& name) {
 void Registry::on_monitor_beat(const MonitorBeat& beat) {
   auto& mon = monitors_[beat.host()];
   if (mon.alive && mon.pid == beat.pid()) return;
-  const bool lapsed = !mon.alive && mon.pid == beat.pid();  // it was slow, not gone
   const bool back = !mon.alive && mon.pid != 0;
   mon = Monitor{beat.pid(), true, beat.log_dir()};
   spdlog::info("registry: monitor of host '{}' is {} (pid {})", beat.host(), back ? "back" : "up",
                beat.pid());
   for (auto& m : modules_) {
-    if (m->spec->spec.host != beat.host() || m->process_gone || m->incarnation == 0) continue;
-    if (lapsed) {
-      // Its modules may still run: have them killed and restart once their exits are reported.
+    if (m->spec->spec.host != beat.host() || m->process_gone || m->incarnation == 0 ||
+        m->status == "running" || m->status == "starting") {
+      continue;
+    }
+    if (m->launched_by == beat.pid()) {
+      // The monitor was only slow: a failed module of it may still run. Kill it; the restart
+      // follows its reported exit.
       io_->send(LAUNCH_KILL, beat.host(), beat.pid(), m->spec->spec.name, m->incarnation, {}, {});
-    } else if (back) {
-      m->process_gone = true;  // they died with the previous monitor (PR_SET_PDEATHSIG)
+    } else {
+      m->process_gone = true;  // it died with its monitor (PR_SET_PDEATHSIG)
     }
   }
   publish();
 }
 
+// A lapsed monitor means the registry cannot start or stop anything on that host for now. Its
+// modules are judged by their own heartbeats: if the host is really gone, or the monitor died
+// (its modules die with it), those lapse too and the modules fail as "host lost".
 void Registry::on_monitor_lost(const std::string& host, long pid) {
   auto it = monitors_.find(host);
   if (it == monitors_.end() || !it->second.alive || it->second.pid != pid) return;
   it->second.alive = false;
   spdlog::error("registry: host '{}' lost (its monitor, pid {}, stopped answering)", host, pid);
   for (auto& m : modules_) {
-    if (m->spec->spec.host == host && (m->status == "running" || m->status == "starting")) {
-      fail(*m, fmt::format("host '{}' lost", host), false);
+    if (m->spec->spec.host == host && m->status == "restarting" &&
+        m->last_failure.find("heartbeat lost") != std::string::npos) {
+      m->last_failure = fmt::format("host '{}' lost ({})", host, m->last_failure);
     }
   }
   publish();
@@ -130,7 +138,10 @@ void Registry::on_process_event(const ProcessEvent& e) {
 void Registry::on_module_lost(const std::string& module, unsigned incarnation) {
   auto* m = find(module);
   if (!m || shutting_down_ || incarnation != m->incarnation || m->status != "running") return;
-  fail(*m, fmt::format("heartbeat lost for {} (hung or stopped)", format_duration(system_.lease)),
+  const auto reason =
+      fmt::format("heartbeat lost for {} (hung or stopped)", format_duration(system_.lease));
+  const auto& host = m->spec->spec.host;
+  fail(*m, monitors_[host].alive ? reason : fmt::format("host '{}' lost ({})", host, reason),
        false);
 }
 
@@ -156,7 +167,6 @@ void Registry::on_module_state(const ModuleState& s) {
 }
 
 void Registry::started(Tracked& m, const ModuleState& now) {
-  if (m.config) reapply(m, now);
   m.status = "running";
   m.running_since = Clock::now();
   spdlog::info("registry: module '{}' running (incarnation {}, pid {})", m.spec->spec.name,
@@ -173,13 +183,15 @@ void Registry::started(Tracked& m, const ModuleState& now) {
 
 void Registry::fail(Tracked& m, const std::string& reason, bool process_gone) {
   const auto& name = m.spec->spec.name;
+  const auto& mon = monitors_[m.spec->spec.host];
   m.status = "failed";
   m.last_failure = reason;
-  m.process_gone = process_gone;
+  // A module whose monitor has been replaced died with its monitor.
+  m.process_gone = process_gone || (mon.pid != m.launched_by && mon.alive);
   if (m.has_state) m.config = m.state;  // what the next incarnation gets back
   spdlog::error("registry: module '{}' failed: {}", name, reason);
-  const auto& mon = monitors_[m.spec->spec.host];
-  if (!process_gone && mon.alive) {
+  publish();  // the failure is known now; suspending the others comes next
+  if (!m.process_gone && mon.alive) {
     io_->send(LAUNCH_KILL, m.spec->spec.host, mon.pid, name, m.incarnation, {}, {});
   }
   suspend_all();
@@ -224,15 +236,17 @@ void Registry::fail(Tracked& m, const std::string& reason, bool process_gone) {
   publish();
 }
 
-void Registry::launch(Tracked& m, unsigned incarnation, bool suspended) {
+void Registry::launch(Tracked& m, unsigned incarnation) {
   const auto& host = m.spec->spec.host;
   const auto& mon = monitors_[host];
   m.incarnation = incarnation;
+  m.launched_by = mon.pid;
+  m.suspended = false;
   m.status = "starting";
   m.process_gone = false;
   m.has_state = false;
-  const auto argv =
-      module_command(system_, *m.spec, incarnation, suspended, "oscar-run", mon.log_dir);
+  auto argv = module_command(system_, *m.spec, incarnation, false, "oscar-run", mon.log_dir);
+  if (m.config) argv.insert(argv.end(), {"--restore", restore_text(*m.config)});
   io_->send(LAUNCH_START, host, mon.pid, m.spec->spec.name, incarnation, argv,
             {"OSCAR_RUN_DIR=" + mon.log_dir});
   spdlog::info("registry: starting '{}' on '{}' (incarnation {})", m.spec->spec.name, host,
@@ -247,11 +261,11 @@ void Registry::tick() {
     const auto& mon = monitors_[m->spec->spec.host];
     if (!mon.alive) continue;
     if (m->status == "waiting") {
-      launch(*m, 1, false);
+      launch(*m, 1);
       publish();
     } else if (m->status == "restarting" && m->process_gone && now >= m->restart_at) {
       if (m->incarnation > 0) ++m->restarts;
-      launch(*m, m->incarnation + 1, true);
+      launch(*m, m->incarnation + 1);
       publish();
     }
   }
@@ -278,41 +292,29 @@ void Registry::tick() {
   if (now - last_publish_ > std::chrono::seconds(1)) publish();
 }
 
-// The new incarnation starts from its YAML; give it back what the coordinator had changed.
-void Registry::reapply(Tracked& m, const ModuleState& now) {
-  const auto& before = *m.config;
-  for (const auto& k : before.kernels()) {
-    const auto it = std::find_if(now.kernels().begin(), now.kernels().end(),
-                                 [&](const KernelState& n) { return n.name() == k.name(); });
-    if (it == now.kernels().end()) continue;
-    const auto was = YAML::Load(k.params());
-    const auto is = YAML::Load(it->params());
-    for (const auto& kv : was) {
-      const auto name = kv.first.Scalar();
-      if (!is[name] || is[name].Scalar() != kv.second.Scalar()) {
-        configure(m.spec->spec.name, CMD_SET_PARAM, {k.name(), name, kv.second.Scalar()});
-      }
-    }
+// What the coordinator had made of the module (modes, stub, parameters, wiring), from its last
+// announcement, as `oscar-run --restore` takes it: the new incarnation starts configured.
+std::string Registry::restore_text(const ModuleState& last) {
+  YAML::Emitter out;
+  out << YAML::Flow << YAML::BeginMap;
+  for (const auto& k : last.kernels()) {
+    out << YAML::Key << k.name() << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "mode" << YAML::Value
+        << (k.mode() == "continuous"    ? fmt::format("continuous:{}ns", k.cycle_ns())
+            : k.mode() == "deactivated" ? std::string("deactivated")
+            : k.trigger() == "default" || k.trigger().empty() ? std::string("single_step")
+                                                              : "single_step:" + k.trigger());
+    out << YAML::Key << "stub" << YAML::Value << k.stub();
+    out << YAML::Key << "params" << YAML::Value << YAML::Load(k.params());
+    out << YAML::Key << "inputs" << YAML::Value << YAML::BeginMap;
     for (const auto& wire : k.inputs()) {
-      if (std::find(it->inputs().begin(), it->inputs().end(), wire) != it->inputs().end()) continue;
       const auto eq = wire.find('=');
-      configure(m.spec->spec.name, CMD_REWIRE, {k.name(), wire.substr(0, eq), wire.substr(eq + 1)});
+      out << YAML::Key << wire.substr(0, eq) << YAML::Value << wire.substr(eq + 1);
     }
-    if (k.mode() != it->mode() || k.cycle_ns() != it->cycle_ns() || k.trigger() != it->trigger()) {
-      if (k.mode() == "deactivated") {
-        configure(m.spec->spec.name, CMD_DEACTIVATE, {k.name()});
-      } else {
-        const auto mode = k.mode() == "continuous"
-                              ? fmt::format("continuous:{}ns", k.cycle_ns())
-                              : (k.trigger() == "default" ? std::string("single_step")
-                                                          : "single_step:" + k.trigger());
-        configure(m.spec->spec.name, CMD_ACTIVATE, {k.name(), mode});
-      }
-    }
-    if (k.stub() != it->stub()) {
-      configure(m.spec->spec.name, CMD_STUB, {k.name(), k.stub() ? "on" : "off"});
-    }
+    out << YAML::EndMap << YAML::EndMap;
   }
+  out << YAML::EndMap;
+  return out.c_str();
 }
 
 // `replacement` takes over: inputs that read kernel i of the failed module now read kernel i
@@ -342,9 +344,12 @@ void Registry::rewire_consumers(const Tracked& failed, const Tracked& replacemen
 // The caller publishes the new state once it has decided what happens next.
 void Registry::suspend_all() {
   if (state_ == "suspended") return;
+  std::vector<Tracked*> targets;
   for (auto& m : modules_) {
-    if (m->status == "running") configure(m->spec->spec.name, CMD_SUSPEND, {});
+    if (m->status == "running" && !m->suspended) targets.push_back(m.get());
   }
+  const auto ok = configure_all(targets, CMD_SUSPEND);
+  for (std::size_t i = 0; i < targets.size(); ++i) targets[i]->suspended = ok[i];
   state_ = "suspended";
 }
 
@@ -358,22 +363,44 @@ void Registry::resume_if_whole() {
                           m->spec->restart.continue_on_limit;
     if (m->status == "failed" && !given_up) return;
   }
+  // A restarted module starts running (configured by --restore): only the others wait.
+  std::vector<Tracked*> targets;
   for (auto& m : modules_) {
-    if (m->status == "running") configure(m->spec->spec.name, CMD_RESUME, {});
+    if (m->status == "running" && m->suspended) targets.push_back(m.get());
   }
+  const auto ok = configure_all(targets, CMD_RESUME);
+  for (std::size_t i = 0; i < targets.size(); ++i) targets[i]->suspended = !ok[i];
   set_system("running", "resumed");
 }
 
 bool Registry::configure(const std::string& module, CommandKind kind,
                          std::vector<std::string> args) {
+  const auto start = Clock::now();
   try {
     const auto reply = config_.send(module, kind, std::move(args), std::chrono::milliseconds(2000));
     if (!reply.ok()) spdlog::warn("registry: {}: {}", module, reply.error());
+    const auto took = Clock::now() - start;
+    if (took > std::chrono::milliseconds(100)) {
+      spdlog::warn("registry: command {} to '{}' took {}", static_cast<int>(kind), module,
+                   format_duration(std::chrono::duration_cast<std::chrono::nanoseconds>(took)));
+    }
     return reply.ok();
   } catch (const std::exception& e) {
     spdlog::warn("registry: {}", e.what());
     return false;
   }
+}
+
+// The same command to several modules at once: the slowest reply sets the pace, not the sum.
+std::vector<bool> Registry::configure_all(const std::vector<Tracked*>& targets, CommandKind kind) {
+  std::vector<std::future<bool>> replies;
+  for (auto* m : targets) {
+    replies.push_back(std::async(
+        std::launch::async, [this, m, kind] { return configure(m->spec->spec.name, kind, {}); }));
+  }
+  std::vector<bool> ok;
+  for (auto& r : replies) ok.push_back(r.get());
+  return ok;
 }
 
 void Registry::on_request(const RegistryRequest& r) {

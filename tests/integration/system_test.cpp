@@ -152,7 +152,10 @@ kernels: [ { type: test_collect, name: watch, inputs: { in: src/out } } ]
     if (at(cues[i]) > killed && at(cues[i - 1]) <= killed) {
       gap_from = at(cues[i - 1]);
       gap_to = at(cues[i]);
-      EXPECT_LE(h.seq() - cues[i - 1]->header().seq(), 2u)
+      // The numbers skipped are those of the outage (the source's 20 ms cycle; the watcher,
+      // not part of the system, also misses cues until it has discovered the new writer).
+      const auto skipped = h.seq() - cues[i - 1]->header().seq() - 1;
+      EXPECT_LE(skipped, (gap_to - gap_from) / 20'000'000 + 1)
           << "numbering continues across the restart";
     }
     if (at(cues[i]) > killed) ++after_kill;
@@ -216,9 +219,11 @@ TEST(Registry, AtTheRestartLimitTheModuleIsGivenUpAndTheRestContinuesIfThePolicy
   BootedSystem sys("limit_continue", limited("continue"));
   kill_twice(sys);
   const auto s = sys.wait_for([](const SystemState& st) {
-    return entry(st, "flaky")->status() == "failed" && st.state() == "running";
+    return entry(st, "flaky")->last_failure().find("restart limit 1 reached") !=
+               std::string::npos &&
+           st.state() == "running";
   });
-  EXPECT_THAT(entry(s, "flaky")->last_failure(), HasSubstr("restart limit 1 reached"));
+  EXPECT_EQ(entry(s, "flaky")->status(), "failed");
   sys.wait_for([](const SystemState& st) { return !entry(st, "steady")->state().suspended(); });
 }
 

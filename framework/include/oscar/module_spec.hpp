@@ -44,7 +44,8 @@ struct KernelSpec {
   YAML::Node params;
   std::map<std::string, InputWiring> inputs;
   std::optional<ModeSpec> mode;
-  std::string where;  ///< "file:line" of its YAML entry, for messages
+  std::optional<bool> stub;  ///< overrides the module's `stub` for this kernel
+  std::string where;         ///< "file:line" of its YAML entry, for messages
 };
 
 struct ModuleSpec {
@@ -74,6 +75,10 @@ struct ModuleSpec {
   static ModuleSpec load(const std::string& path, const std::string& module = "");
 
   const KernelSpec* find_kernel(const std::string& kernel_name) const;
+  /// Applies what a running incarnation had been configured to (the registry passes it to a
+  /// restarted module): `{kernel: {mode: M, stub: B, params: {..}, inputs: {in: k/ch}}}`.
+  /// @throws std::invalid_argument naming the kernel and key.
+  void restore(const YAML::Node& state);
   /// The mode a kernel starts in: its own, or derived from the module's mode (a continuous
   /// module runs its first kernel continuously and triggers the others).
   ModeSpec effective_mode(const KernelSpec& kernel) const;

@@ -66,9 +66,10 @@ Failures fail_modules(oscar::RegistryClient& registry, const std::vector<std::st
     if (!detected || !back) throw std::runtime_error(name + " did not come back within 30 s");
     f.detect_ms.push_back(static_cast<double>(detected->stamp_ns() - t0) / 1e6);
     f.resume_ms.push_back(static_cast<double>(back->stamp_ns() - t0) / 1e6);
-    std::fprintf(stderr, "\r%s %d/%d", sig == SIGKILL ? "kill -9" : "SIGSTOP", i + 1, count);
+    std::fprintf(stderr, "%s %d/%d (%s): failure seen after %.1f ms, running after %.1f ms\n",
+                 sig == SIGKILL ? "kill -9" : "SIGSTOP", i + 1, count, name.c_str(),
+                 f.detect_ms.back(), f.resume_ms.back());
   }
-  std::fprintf(stderr, "\n");
   return f;
 }
 

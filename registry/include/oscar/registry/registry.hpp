@@ -57,13 +57,14 @@ class Registry {
   void tick();
 
   void fail(Tracked& m, const std::string& reason, bool process_gone);
-  void launch(Tracked& m, unsigned incarnation, bool suspended);
+  void launch(Tracked& m, unsigned incarnation);
   void started(Tracked& m, const ModuleState& state);
-  void reapply(Tracked& m, const ModuleState& now);
+  static std::string restore_text(const ModuleState& last);
   void rewire_consumers(const Tracked& failed, const Tracked& replacement);
   void suspend_all();
   void resume_if_whole();
   bool configure(const std::string& module, CommandKind kind, std::vector<std::string> args);
+  std::vector<bool> configure_all(const std::vector<Tracked*>& targets, CommandKind kind);
   void shutdown();
   void set_system(const std::string& state, const std::string& message);
   void publish();
