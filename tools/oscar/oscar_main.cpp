@@ -28,7 +28,12 @@ const char* const kUsage =
     "  record [TOPIC...]     record cue topics to an MCAP file\n"
     "  info FILE             summarise an MCAP file\n"
     "  replay FILE           republish a recording with its original timing\n"
-    "  bench <what> ...      benchmarks: cueflow, restart, applets, swarm\n"
+    "  topics                topics of the running system with types, QoS and rates\n"
+    "  echo TOPIC            print a topic's samples readably (headers, fields)\n"
+    "  hz TOPIC              a topic's rate and the min/max/std of its period\n"
+    "  graph [-o FILE.svg]   the running system as a graph (modules, kernels, channels)\n"
+    "  new-module NAME ...   generate a module: kernel, CMake, README, unit test\n"
+    "  bench <what> ...      benchmarks: cueflow, restart, applets, swarm, record, replay\n"
     "\n"
     "`oscar <command> --help` shows a command's options.\n";
 
