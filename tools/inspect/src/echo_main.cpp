@@ -83,8 +83,8 @@ int main(int argc, char** argv) {
         } catch (const std::exception& e) {
           text = fmt::format("# cannot decode {} bytes: {}", bytes.size(), e.what());
         }
-        fmt::print("--- {} ({}) received {}.{:09}\n{}\n", topic, type, received / 1'000'000'000,
-                   received % 1'000'000'000, text);
+        fmt::print("--- {} ({}) received {}\n{}\n", topic, type, oscar::inspect::utc_text(received),
+                   text);
         std::fflush(stdout);
         ++shown;
         lock.lock();

@@ -170,7 +170,9 @@ class Parser {
   std::map<std::string, std::vector<std::string>>& enums_;
 };
 
-std::string utc(std::uint64_t ns) {
+}  // namespace
+
+std::string utc_text(std::uint64_t ns) {
   const std::time_t s = static_cast<std::time_t>(ns / 1'000'000'000);
   std::tm tm{};
   gmtime_r(&s, &tm);
@@ -179,7 +181,7 @@ std::string utc(std::uint64_t ns) {
   return fmt::format("{}.{:09}Z", buf, ns % 1'000'000'000);
 }
 
-}  // namespace
+namespace {}  // namespace
 
 void IdlTypes::add(const std::string& idl_text) {
   Parser(tokenize(idl_text), structs_, enums_).definitions("");
@@ -279,7 +281,7 @@ class Decoder {
       if (name == "oscar::CueHeader" && m.name == "stamps" && out.size() > start + 2) {
         const auto first = out.substr(start + 1, out.find_first_of(",]", start) - start - 1);
         if (!first.empty() && std::isdigit(static_cast<unsigned char>(first[0])))
-          out += "  # generated " + utc(std::stoull(first));
+          out += "  # generated " + utc_text(std::stoull(first));
       }
     }
   }

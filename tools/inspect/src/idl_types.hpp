@@ -49,4 +49,7 @@ class IdlTypes {
   std::map<std::string, std::vector<std::string>> enums_;
 };
 
+/// A time in ns since the epoch as UTC text, e.g. "2026-11-22T09:43:47.838715176Z".
+std::string utc_text(std::uint64_t ns);
+
 }  // namespace oscar::inspect
