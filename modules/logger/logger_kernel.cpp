@@ -1,5 +1,6 @@
 #include "logger_kernel.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <regex>
 #include <set>
@@ -132,18 +133,24 @@ std::uint16_t Logger::channel(const std::string& source, const std::string& type
 }
 
 void Logger::process(Cycle& cycle) {
+  // This cycle's cues of all inputs in the order they arrived: the file is in log-time order.
+  std::vector<std::pair<Port::Item, const Port*>> items;
   for (auto& port : ports_) {
-    for (const auto& item : port->take()) {
-      if (!writer_) open();
-      mcap::MessageView m;
-      m.channel_id = channel(item.header->source(), port->type());
-      m.sequence = static_cast<std::uint32_t>(item.header->seq());
-      m.log_time = static_cast<std::uint64_t>(item.received);
-      m.publish_time = item.header->stamps().empty() ? m.log_time : item.header->stamps()[0];
-      m.data = item.bytes;
-      writer_->write(m);
-      if (!unflushed_since_) unflushed_since_ = cycle.now();
-    }
+    for (auto& item : port->take()) items.emplace_back(std::move(item), port.get());
+  }
+  std::stable_sort(items.begin(), items.end(), [](const auto& a, const auto& b) {
+    return a.first.received < b.first.received;
+  });
+  for (const auto& [item, port] : items) {
+    if (!writer_) open();
+    mcap::MessageView m;
+    m.channel_id = channel(item.header->source(), port->type());
+    m.sequence = static_cast<std::uint32_t>(item.header->seq());
+    m.log_time = static_cast<std::uint64_t>(item.received);
+    m.publish_time = item.header->stamps().empty() ? m.log_time : item.header->stamps()[0];
+    m.data = item.bytes;
+    writer_->write(m);
+    if (!unflushed_since_) unflushed_since_ = cycle.now();
   }
   if (writer_ && unflushed_since_ &&
       cycle.now() - unflushed_since_ >= static_cast<Stamp>(params_.flush_every.count())) {

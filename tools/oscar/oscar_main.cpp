@@ -54,7 +54,8 @@ int main(int argc, char** argv) {
   int first_arg = 2;
   if (program == "oscar-bench") {
     if (argc < 3) {
-      std::fputs("usage: oscar bench <cueflow|restart|applets|swarm> [args...]\n", stderr);
+      std::fputs("usage: oscar bench <cueflow|restart|applets|swarm|record|replay> [args...]\n",
+                 stderr);
       return 2;
     }
     program += std::string("-") + argv[2];

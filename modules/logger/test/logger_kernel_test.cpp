@@ -52,6 +52,7 @@ TEST(Logger, WritesEveryCueOfEveryInputAsMcapWithItsHeaderTimes) {
   }            // the kernel is destroyed: the file is finished
   mcap::Reader reader(file);
   std::vector<std::string> seen;
+  std::uint64_t last_log_time = 0;
   reader.read_messages([&](const mcap::Channel& c, const mcap::MessageView& m) {
     const std::vector<std::uint8_t> bytes(m.data.begin(), m.data.end());
     if (c.topic == "oscar/cue/sig/out") {
@@ -71,6 +72,8 @@ TEST(Logger, WritesEveryCueOfEveryInputAsMcapWithItsHeaderTimes) {
       EXPECT_EQ(m.publish_time, 555u);
     }
     seen.push_back(c.topic + "#" + std::to_string(m.sequence));
+    EXPECT_GE(m.log_time, last_log_time) << "the file is in the order the cues arrived";
+    last_log_time = m.log_time;
   });
   EXPECT_THAT(seen, testing::UnorderedElementsAre("oscar/cue/sig/out#1", "oscar/cue/sig/out#2",
                                                   "oscar/cue/sig/out#3", "oscar/cue/cam/lines#7"));
