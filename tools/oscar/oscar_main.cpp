@@ -28,7 +28,12 @@ const char* const kUsage =
     "  record [TOPIC...]     record cue topics to an MCAP file\n"
     "  info FILE             summarise an MCAP file\n"
     "  replay FILE           republish a recording with its original timing\n"
-    "  bench <what> ...      benchmarks: cueflow, restart, applets, swarm\n"
+    "  topics                topics of the running system with types, QoS and rates\n"
+    "  echo TOPIC            print a topic's samples readably (headers, fields)\n"
+    "  hz TOPIC              a topic's rate and the min/max/std of its period\n"
+    "  graph [-o FILE.svg]   the running system as a graph (modules, kernels, channels)\n"
+    "  new-module NAME ...   generate a module: kernel, CMake, README, unit test\n"
+    "  bench <what> ...      benchmarks: cueflow, restart, applets, swarm, record, replay\n"
     "\n"
     "`oscar <command> --help` shows a command's options.\n";
 
@@ -49,7 +54,8 @@ int main(int argc, char** argv) {
   int first_arg = 2;
   if (program == "oscar-bench") {
     if (argc < 3) {
-      std::fputs("usage: oscar bench <cueflow|restart|applets|swarm> [args...]\n", stderr);
+      std::fputs("usage: oscar bench <cueflow|restart|applets|swarm|record|replay> [args...]\n",
+                 stderr);
       return 2;
     }
     program += std::string("-") + argv[2];

@@ -1,0 +1,98 @@
+// oscar echo TOPIC: every sample of a topic, readably (YAML-like), decoded from its CDR with the
+// type's IDL (the embedded OSCAR IDL texts), headers with seq, source and stamps.
+#include <atomic>
+#include <condition_variable>
+#include <csignal>
+#include <cstdio>
+#include <deque>
+#include <mutex>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "idl_texts.hpp"  // tools/record
+#include "idl_types.hpp"
+#include "oscar/registry/registry_client.hpp"
+#include "raw_tap.hpp"
+#include "recorder.hpp"  // topic_of
+#include "tool_options.hpp"
+
+namespace {
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop = true; }
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"oscar echo: print the samples of a topic readably"};
+  oscar::inspect::ToolOptions tool;
+  tool.add_to(app);
+  std::string topic_arg;
+  long count = 0;
+  double timeout_s = 5;
+  std::size_t max_items = 16;
+  app.add_option("TOPIC", topic_arg, "kernel/channel (the cue topic) or a full topic name")
+      ->required();
+  app.add_option("-n,--count", count, "exit after this many samples (0: until Ctrl-C)");
+  app.add_option("--timeout", timeout_s, "seconds to wait for a writer of the topic");
+  app.add_option("--max-items", max_items, "items shown of a long sequence");
+  CLI11_PARSE(app, argc, argv);
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  try {
+    const auto topic = oscar::record::topic_of(topic_arg);
+    oscar::inspect::IdlTypes types;
+    std::set<std::string> texts;
+    for (const auto& [name, text] : oscar::record::idl_texts()) {
+      if (texts.insert(text).second) types.add(text);
+    }
+    auto participant =
+        oscar::tool_participant("oscar-echo", tool.system_file, tool.host, tool.domain);
+    const auto type = oscar::inspect::wait_for_writer(
+        *participant, topic, std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));
+    if (type.empty()) {
+      fmt::print(stderr, "oscar echo: no writer of topic '{}' appeared on domain {} within {} s\n",
+                 topic, participant->domain(), timeout_s);
+      return 1;
+    }
+    if (!types.has(type)) {
+      fmt::print(stderr, "oscar echo: topic '{}' has type '{}', whose IDL is unknown here\n", topic,
+                 type);
+      return 1;
+    }
+    std::mutex mutex;
+    std::condition_variable cv;
+    std::deque<std::pair<std::vector<std::uint8_t>, std::uint64_t>> queue;
+    oscar::inspect::RawTap tap(*participant, [&](const std::string&, auto bytes, auto t) {
+      std::lock_guard lock(mutex);
+      queue.emplace_back(std::move(bytes), t);
+      cv.notify_one();
+    });
+    tap.subscribe(topic);
+    const oscar::inspect::IdlTypes::Options options{max_items};
+    long shown = 0;
+    while (!g_stop && (count == 0 || shown < count)) {
+      std::unique_lock lock(mutex);
+      cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return !queue.empty(); });
+      while (!queue.empty() && (count == 0 || shown < count)) {
+        auto [bytes, received] = std::move(queue.front());
+        queue.pop_front();
+        lock.unlock();
+        std::string text;
+        try {
+          text = types.to_text(type, bytes, options);
+        } catch (const std::exception& e) {
+          text = fmt::format("# cannot decode {} bytes: {}", bytes.size(), e.what());
+        }
+        fmt::print("--- {} ({}) received {}\n{}\n", topic, type, oscar::inspect::utc_text(received),
+                   text);
+        std::fflush(stdout);
+        ++shown;
+        lock.lock();
+      }
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "oscar echo: %s\n", e.what());
+    return 1;
+  }
+}

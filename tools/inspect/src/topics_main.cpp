@@ -1,0 +1,77 @@
+// oscar topics: every topic with a writer on the domain, its type, QoS and measured rate.
+#include <atomic>
+#include <cstdio>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "oscar/registry/registry_client.hpp"
+#include "raw_tap.hpp"
+#include "tool_options.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"oscar topics: the topics of the running system, with types and rates"};
+  oscar::inspect::ToolOptions tool;
+  tool.add_to(app);
+  double duration_s = 2;
+  bool json = false, all = false;
+  app.add_option("--duration", duration_s, "seconds to listen (discovery and rates)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--json", json, "print a JSON array");
+  app.add_flag("-a,--all", all, "also OSCAR's own topics (registry, config, log), not only cues");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    auto participant =
+        oscar::tool_participant("oscar-topics", tool.system_file, tool.host, tool.domain);
+    std::mutex mutex;
+    std::map<std::string, std::uint64_t> counts;
+    oscar::inspect::RawTap tap(*participant, [&](const std::string& topic, auto, auto) {
+      std::lock_guard lock(mutex);
+      ++counts[topic];
+    });
+    const auto wanted = [&](const std::string& t) { return all || t.rfind("oscar/cue/", 0) == 0; };
+    // Discovery first (a quarter of the time), then count samples for the rest.
+    const auto total = std::chrono::milliseconds(static_cast<long>(duration_s * 1000));
+    const auto start = std::chrono::steady_clock::now();
+    std::this_thread::sleep_for(total / 4);
+    for (const auto& [name, w] : participant->discovered_writers()) {
+      if (wanted(name)) tap.subscribe(name);
+    }
+    {
+      std::lock_guard lock(mutex);
+      counts.clear();
+    }
+    const auto counting_from = std::chrono::steady_clock::now();
+    std::this_thread::sleep_until(start + total);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - counting_from).count();
+    std::map<std::string, std::uint64_t> final_counts;
+    {
+      std::lock_guard lock(mutex);
+      final_counts = counts;
+    }
+    nlohmann::json out = nlohmann::json::array();
+    std::size_t width = 5;
+    const auto writers = participant->discovered_writers();
+    for (const auto& [name, w] : writers) width = std::max(width, wanted(name) ? name.size() : 0);
+    if (!json)
+      fmt::print("{:<{}}  {:<22}  {:>9}  {}\n", "TOPIC", width, "TYPE", "RATE (Hz)", "QOS");
+    for (const auto& [name, w] : writers) {
+      if (!wanted(name)) continue;
+      const double hz = static_cast<double>(final_counts[name]) / seconds;
+      if (json) {
+        out.push_back({{"topic", name}, {"type", w.type}, {"qos", w.qos}, {"rate_hz", hz}});
+      } else {
+        fmt::print("{:<{}}  {:<22}  {:>9.1f}  {}\n", name, width, w.type, hz, w.qos);
+      }
+    }
+    if (json) fmt::print("{}\n", out.dump(2));
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "oscar topics: %s\n", e.what());
+    return 1;
+  }
+}

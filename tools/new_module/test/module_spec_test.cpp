@@ -1,0 +1,101 @@
+#include "module_spec.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+namespace oscar::new_module {
+namespace {
+using testing::HasSubstr;
+using testing::ThrowsMessage;
+
+ModuleSpec valid() {
+  ModuleSpec s;
+  s.name = "line_fuser";
+  s.inputs = {{"left", "LineSeg3DSeq"}, {"trigger", "Bool"}};
+  s.outputs = {{"fused", "LineSeg3DSeq"}};
+  s.params = {{"gain", "double", "1.5"}, {"period", "duration", "33ms"}};
+  return s;
+}
+
+void expect_error(const ModuleSpec& s, const std::string& message) {
+  EXPECT_THAT(
+      [&] {
+        s.validate({"relay", "logger"});
+      },
+      ThrowsMessage<std::invalid_argument>(HasSubstr(message)));
+}
+
+TEST(ModuleSpec, AcceptsAValidModuleAndNamesItsClass) {
+  EXPECT_NO_THROW(valid().validate({"relay"}));
+  EXPECT_EQ(valid().class_name(), "LineFuser");
+}
+
+TEST(ModuleSpec, ParsesPortsAndParams) {
+  const auto p = ModuleSpec::parse_port("img:oscar::GvImage", "--input");
+  EXPECT_EQ(p.name, "img");
+  EXPECT_EQ(p.type, "GvImage");
+  const auto q = ModuleSpec::parse_param("label:string=a b");
+  EXPECT_EQ(q.default_value, "a b");
+  EXPECT_THAT([] { ModuleSpec::parse_port("img", "--input"); },
+              ThrowsMessage<std::invalid_argument>(
+                  HasSubstr("--input 'img': expected name:Type, e.g. image:GvImage")));
+  EXPECT_THAT([] { ModuleSpec::parse_param("gain:double"); },
+              ThrowsMessage<std::invalid_argument>(
+                  HasSubstr("--param 'gain:double': expected name:type=default")));
+}
+
+TEST(ModuleSpec, RejectsBadNamesClashesTypesAndDefaults) {
+  auto s = valid();
+  s.name = "2fast";
+  expect_error(s, "module name '2fast' is not a C++ identifier");
+  s.name = "LineFuser";
+  expect_error(s, "module name 'LineFuser' must be snake_case");
+  s.name = "relay";
+  expect_error(s,
+               "module name 'relay' is taken: a kernel type or module folder of that name exists");
+  s = valid();
+  s.inputs[0].name = "class";
+  expect_error(s, "input 'class' is a C++ keyword");
+  s = valid();
+  s.inputs[1].name = "left";
+  expect_error(s, "input 'left': the name is used twice");
+  s = valid();
+  s.outputs[0].type = "Image";
+  expect_error(s, "output 'fused': unknown cue type 'Image' (known: Bool, LineSeg3DSeq, GvImage)");
+  s = valid();
+  s.params[0].type = "float";
+  expect_error(
+      s, "param 'gain': unknown type 'float' (known: bool, int, int64, double, string, duration)");
+  s = valid();
+  s.params[1].default_value = "soon";
+  expect_error(s, "param 'period': default 'soon' is no duration value (e.g. 33ms, 1.5s)");
+  s = valid();
+  s.outputs.clear();
+  expect_error(s, "a module needs at least one --output name:Type");
+}
+
+TEST(ModuleSpec, GeneratesTheFolderOfAModule) {
+  auto s = valid();
+  const auto files = generate(s);
+  ASSERT_EQ(files.size(), 5u);
+  EXPECT_EQ(files.at("CMakeLists.txt"),
+            "oscar_add_module(NAME line_fuser SOURCES line_fuser_kernel.cpp TEST "
+            "test/line_fuser_kernel_test.cpp)\n");
+  const auto& hpp = files.at("line_fuser_kernel.hpp");
+  EXPECT_THAT(hpp, HasSubstr("class LineFuser final : public oscar::Kernel"));
+  EXPECT_THAT(hpp, HasSubstr("    double gain = 1.5;\n"));
+  EXPECT_THAT(
+      hpp, HasSubstr("    std::chrono::nanoseconds period = std::chrono::nanoseconds{33000000};"));
+  EXPECT_THAT(hpp, HasSubstr("  oscar::Input<oscar::Bool>& trigger_;"));
+  EXPECT_THAT(hpp, HasSubstr("  oscar::Output<oscar::LineSeg3DSeq>& fused_;"));
+  EXPECT_THAT(files.at("line_fuser_kernel.cpp"),
+              HasSubstr("OSCAR_REGISTER_KERNEL(oscar::modules::LineFuser, \"line_fuser\")"));
+  EXPECT_THAT(files.at("README.md"), HasSubstr("| `left` | in | `oscar::LineSeg3DSeq` |"));
+  EXPECT_THAT(files.at("README.md"), HasSubstr("| `period` | duration | `33ms` |"));
+  s.out_of_tree = true;
+  EXPECT_THAT(generate(s).at("CMakeLists.txt"), HasSubstr("find_package(oscar REQUIRED)"));
+  EXPECT_THAT(generate(s).at("line_fuser_kernel.cpp"), HasSubstr("namespace line_fuser_module {"));
+}
+
+}  // namespace
+}  // namespace oscar::new_module
