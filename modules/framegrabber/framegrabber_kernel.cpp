@@ -106,7 +106,7 @@ void Framegrabber::open() {
   params_.cy = scene_->options().cy;
 }
 
-void Framegrabber::process(Cycle&) {
+void Framegrabber::process(Cycle& cycle) {
   open();
   if (ended_) return;
   GroundTruth truth;
@@ -126,10 +126,10 @@ void Framegrabber::process(Cycle&) {
     }
   }
   ++frames_;
-  publish(full, std::move(truth));
+  publish(full, std::move(truth), cycle.now());
 }
 
-void Framegrabber::publish(const cv::Mat& full, GroundTruth truth) {
+void Framegrabber::publish(const cv::Mat& full, GroundTruth truth, Stamp acquired) {
   const int div = scale_divisor(params_.frame_mode);
   cv::Mat img = full;
   if (div > 1) cv::resize(full, img, {full.cols / div, full.rows / div}, 0, 0, cv::INTER_AREA);
@@ -143,6 +143,7 @@ void Framegrabber::publish(const cv::Mat& full, GroundTruth truth) {
     for (auto& c : t.corners()) c *= f;
   }
   CameraImage frame;
+  append_stamp(frame.header(), acquired);  // the grab started at the cycle's time
   frame.camera_id(name_);
   frame.encoding("mono8");
   frame.width(static_cast<std::uint16_t>(img.cols));
@@ -155,6 +156,7 @@ void Framegrabber::publish(const cv::Mat& full, GroundTruth truth) {
   frame.data().assign(img.data, img.data + img.total());
   frame.truth(std::move(truth));
   GvImage grey;
+  grey.header() = frame.header();
   grey.dx(static_cast<std::int16_t>(img.cols));
   grey.dy(static_cast<std::int16_t>(img.rows));
   grey.image() = frame.data();
@@ -163,10 +165,10 @@ void Framegrabber::publish(const cv::Mat& full, GroundTruth truth) {
 }
 
 // Stub: a flat grey frame of the configured size with no tags, so detectors downstream can run.
-void Framegrabber::stub(Cycle&) {
+void Framegrabber::stub(Cycle& cycle) {
   cv::Mat full(params_.height, params_.width, CV_8U, cv::Scalar(128));
   ++frames_;
-  publish(full, GroundTruth{});
+  publish(full, GroundTruth{}, cycle.now());
 }
 
 }  // namespace oscar::modules

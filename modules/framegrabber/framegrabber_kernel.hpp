@@ -45,7 +45,7 @@ class Framegrabber final : public Kernel {
 
  private:
   void open();
-  void publish(const cv::Mat& full, GroundTruth truth);
+  void publish(const cv::Mat& full, GroundTruth truth, Stamp acquired);
 
   Output<GvImage>& image_;
   Output<CameraImage>& frame_;

@@ -9,22 +9,9 @@
 
 #include <oscar/perception_types.hpp>
 
+#include "perception_geometry.hpp"
+
 namespace oscar::modules {
-
-/// A tag on the synthetic target: its tag36h11 id and its centre in the target frame (metres).
-struct TagPlacement {
-  int id = 0;
-  Eigen::Vector3d offset_m = Eigen::Vector3d::Zero();
-};
-
-/// "0:-0.08,0,0;1:0.08,0,0" -> placements. @throws std::invalid_argument naming the entry.
-std::vector<TagPlacement> parse_tag_layout(const std::string& text);
-/// "x,y,z" -> vector. @throws std::invalid_argument naming `what`.
-Eigen::Vector3d parse_vector3(const std::string& text, const std::string& what);
-
-/// Pose3 (IDL) <-> Eigen.
-Pose3 to_pose3(const Eigen::Isometry3d& pose);
-Eigen::Isometry3d from_pose3(const Pose3& pose);
 
 struct SceneOptions {
   int width = 640, height = 480;
