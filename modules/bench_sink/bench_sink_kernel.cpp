@@ -80,11 +80,10 @@ void BenchSink::process(Cycle& cycle) {
               static_cast<std::ptrdiff_t>(std::min<std::size_t>(
                   stats_.delivery_ns.size(), stats_.received - received_at_last_log_)),
           stats_.delivery_ns.end());
-      cycle.log().info(
-          "{}: {} cues ({:.1f} Hz), last seq {}, gaps {}, latency p50 {:.0f} us, {} stamps",
-          params_.type, stats_.received,
-          static_cast<double>(stats_.received - received_at_last_log_) / seconds, stats_.last_seq,
-          stats_.gaps, percentiles_us(recent).p50, stats_.stamps_max);
+      cycle.log().info("{}: {} cues ({:.1f} Hz), last seq {}, gaps {}, latency p50 {:.0f} us, {} stamps",
+                       params_.type, stats_.received,
+                       static_cast<double>(stats_.received - received_at_last_log_) / seconds,
+                       stats_.last_seq, stats_.gaps, percentiles_us(recent).p50, stats_.stamps_max);
     }
     last_log_ = cycle.now();
     received_at_last_log_ = stats_.received;
