@@ -1,5 +1,7 @@
 #include "landmark_pose_kernel.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <thread>
 
@@ -17,6 +19,7 @@ void LandmarkPoseFusion::Params::describe(ParamSpec& spec) {
       .at_least(0);
   spec.field("wait_b", wait_b, "pull/prefetch: how long to ask B for this cycle's result")
       .at_least(0);
+  spec.field("log_every", log_every, "log a summary this often (0 = never)").at_least(0);
 }
 
 LandmarkPoseFusion::LandmarkPoseFusion(KernelSetup& setup)
@@ -35,7 +38,7 @@ void LandmarkPoseFusion::on_params_changed() {
 // B's detections of the image taken with A's (within max_skew). With push they are in the ring
 // already (on one host MarkBDetect runs before this kernel). With pull or prefetch (B on
 // another host, seed 004 §4.2) B may still be working: ask again until wait_b is up.
-Input<TagDetections>::Ptr LandmarkPoseFusion::matching_b(Stamp acquired, Cycle&) {
+Input<TagDetections>::Ptr LandmarkPoseFusion::matching_b(Stamp acquired) {
   const auto matches = [&](const Input<TagDetections>::Ptr& b) {
     return b && std::llabs(generation_stamp(b->header()) - acquired) <= params_.max_skew.count();
   };
@@ -79,7 +82,16 @@ void LandmarkPoseFusion::process(Cycle& cycle) {
   const auto news = tags_a_.take_new();
   if (news.empty()) return;
   const auto& a = *news.back().cue;  // the newest image of A; older ones are superseded
-  const auto b = matching_b(generation_stamp(a.header()), cycle);
+  const auto asked = std::chrono::steady_clock::now();
+  const auto b = matching_b(generation_stamp(a.header()));
+  // The fused pose exists once B's result is here: with pull/prefetch that may be later than
+  // the cycle's start, and the stamp says so.
+  Stamp fused_at = cycle.now();
+  if (tags_b_.transfer() != Transfer::kPush) {
+    fused_at += std::chrono::duration_cast<std::chrono::nanoseconds>(
+                    std::chrono::steady_clock::now() - asked)
+                    .count();
+  }
   oscar::LandmarkPose cue;
   cue.header() = a.header();
   cue.truth(a.truth());
@@ -113,8 +125,49 @@ void LandmarkPoseFusion::process(Cycle& cycle) {
     cue.pose(to_pose3(fused));
     cue.spread_m(spread);
   }
-  append_stamp(cue.header(), cycle.now());
+  append_stamp(cue.header(), fused_at);
+  account(cue, cycle);
   pose_.publish(std::move(cue));
+}
+
+void LandmarkPoseFusion::account(const oscar::LandmarkPose& cue, Cycle& cycle) {
+  if (params_.log_every.count() == 0) return;
+  if (window_start_ == 0) window_start_ = cycle.now();
+  ++poses_;
+  if (cue.cameras().size() == 2) ++both_;
+  const auto& st = cue.header().stamps();
+  // Acquisition of the first image to the fused pose: stamps[0] is A's grab, B's grab follows
+  // A's two stamps when B was used.
+  Stamp acquired = static_cast<Stamp>(st.front());
+  if (st.size() >= 5) acquired = std::min(acquired, static_cast<Stamp>(st[2]));
+  latencies_ms_.push_back((static_cast<Stamp>(st.back()) - acquired) / 1e6);
+  if (cue.valid() && cue.truth().valid()) {
+    ++truths_;
+    const auto pose = from_pose3(cue.pose()), truth = from_pose3(cue.truth().target());
+    worst_mm_ = std::max(worst_mm_, (pose.translation() - truth.translation()).norm() * 1000);
+    worst_deg_ = std::max(
+        worst_deg_,
+        Eigen::Quaterniond(pose.rotation()).angularDistance(Eigen::Quaterniond(truth.rotation())) *
+            180 / M_PI);
+  }
+  const double window_s = (cycle.now() - window_start_) / 1e9;
+  if (window_s * 1e9 < static_cast<double>(params_.log_every.count())) return;
+  std::sort(latencies_ms_.begin(), latencies_ms_.end());
+  const auto pct = [&](double p) {
+    return latencies_ms_[std::min(latencies_ms_.size() - 1,
+                                  static_cast<std::size_t>(p * latencies_ms_.size()))];
+  };
+  const auto truth = truths_ == 0 ? std::string("no ground truth")
+                                  : fmt::format("vs ground truth worst {:.1f} mm {:.2f} deg",
+                                                worst_mm_, worst_deg_);
+  cycle.log().info(
+      "{} poses in {:.1f} s ({:.1f}/s), {} from both cameras; acquisition->pose p50 {:.1f} ms "
+      "p99 {:.1f} ms; {}",
+      poses_, window_s, poses_ / window_s, both_, pct(0.5), pct(0.99), truth);
+  window_start_ = cycle.now();
+  poses_ = both_ = truths_ = 0;
+  latencies_ms_.clear();
+  worst_mm_ = worst_deg_ = 0;
 }
 
 // Stub: the target 0.7 m straight ahead, seen by two tags.

@@ -21,6 +21,7 @@ class LandmarkPoseFusion final : public Kernel {
     std::string tag_layout = "0:-0.08,0,0;1:0.08,0,0";  ///< tag id : centre in the target frame
     std::chrono::nanoseconds max_skew{std::chrono::milliseconds(80)};
     std::chrono::nanoseconds wait_b{std::chrono::milliseconds(200)};
+    std::chrono::nanoseconds log_every{std::chrono::seconds(1)};  ///< 0 = no summary
     void describe(ParamSpec& spec);
   };
   explicit LandmarkPoseFusion(KernelSetup& setup);
@@ -29,7 +30,8 @@ class LandmarkPoseFusion final : public Kernel {
   void on_params_changed() override;
 
  private:
-  Input<TagDetections>::Ptr matching_b(Stamp acquired, Cycle& cycle);
+  Input<TagDetections>::Ptr matching_b(Stamp acquired);
+  void account(const oscar::LandmarkPose& cue, Cycle& cycle);
   void add_estimates(const TagDetections& tags, std::vector<Eigen::Isometry3d>& out,
                      oscar::LandmarkPose& cue) const;
 
@@ -38,6 +40,11 @@ class LandmarkPoseFusion final : public Kernel {
   Output<oscar::LandmarkPose>& pose_;
   Params params_;
   std::map<int, Eigen::Vector3d> layout_;
+  // The periodic summary (log_every): poses, latencies acquisition -> pose, truth errors.
+  Stamp window_start_ = 0;
+  std::uint64_t poses_ = 0, both_ = 0, truths_ = 0;
+  std::vector<double> latencies_ms_;
+  double worst_mm_ = 0, worst_deg_ = 0;
 };
 
 }  // namespace oscar::modules

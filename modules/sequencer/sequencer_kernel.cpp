@@ -101,6 +101,7 @@ void Sequencer::on_deactivate() {
   {
     std::lock_guard lock(mutex_);
     stop_ = true;
+    queue_.clear();
   }
   wake_.notify_all();
   if (worker_.joinable()) worker_.join();
@@ -112,51 +113,33 @@ void Sequencer::on_deactivate() {
 void Sequencer::worker_loop() {
   std::unique_lock lock(mutex_);
   while (!stop_) {
-    if (pending_.empty()) {
+    if (queue_.empty()) {
       wake_.wait(lock);
       continue;
     }
-    const auto [module, kernel] = pending_.front();
-    pending_.pop_front();
-    const auto mode = pending_mode_;
-    const auto timeout = pending_timeout_;
+    const Command c = queue_.front();
+    const auto timeout = timeout_;
     lock.unlock();
     std::string error;
     try {
-      const auto reply =
-          client_->send(module, CMD_SET_PARAM, {kernel, "frame_mode", mode}, timeout);
+      const auto reply = client_->send(c.module, c.kind, c.args, timeout);
       if (!reply.ok()) error = reply.error();
     } catch (const std::exception& e) {
       error = e.what();
     }
     lock.lock();
+    queue_.pop_front();
     if (!error.empty()) {
       worker_error_ =
-          fmt::format("setting frame_mode {} on {}/{}: {}", mode, module, kernel, error);
+          fmt::format("{} {}/{} failed: {}", c.kind == CMD_TRIGGER ? "triggering" : "configuring",
+                      c.module, c.args.front(), error);
+      queue_.clear();  // the rest of this cycle's sequence would run out of order
     }
   }
-}
-
-void Sequencer::send_frame_mode(const std::string& mode) {
-  std::lock_guard lock(mutex_);
-  pending_mode_ = mode;
-  pending_timeout_ = std::chrono::duration_cast<std::chrono::milliseconds>(params_.timeout);
-  pending_.assign(grabbers_.begin(), grabbers_.end());
-  applied_mode_ = mode;
-  wake_.notify_all();
 }
 
 void Sequencer::process(Cycle& cycle) {
   connect();
-  {
-    std::lock_guard lock(mutex_);
-    if (!worker_error_.empty()) {
-      const auto e = std::move(worker_error_);
-      worker_error_.clear();
-      applied_mode_.clear();  // try again next cycle
-      throw std::runtime_error("sequencer: " + e);
-    }
-  }
   std::string mode = params_.frame_mode;
   if (!schedule_.empty()) {
     std::uint64_t period = 0;
@@ -170,18 +153,29 @@ void Sequencer::process(Cycle& cycle) {
       at -= n;
     }
   }
+  std::lock_guard lock(mutex_);
+  if (!worker_error_.empty()) {
+    const auto e = std::move(worker_error_);
+    worker_error_.clear();
+    applied_mode_.clear();  // set it again next cycle
+    throw std::runtime_error("sequencer: " + e);
+  }
+  if (!queue_.empty()) {  // the last cycle's commands are still on their way
+    if (++skipped_ == 1 || skipped_ % 100 == 0) {
+      cycle.log().warn("previous sequence still running: cycle skipped ({} so far)", skipped_);
+    }
+    return;
+  }
+  timeout_ = std::chrono::duration_cast<std::chrono::milliseconds>(params_.timeout);
   if (!mode.empty() && mode != applied_mode_) {
     cycle.log().info("frame mode -> {}", mode);
-    send_frame_mode(mode);
-  }
-  const auto timeout = std::chrono::duration_cast<std::chrono::milliseconds>(params_.timeout);
-  for (const auto& [module, kernel] : steps_) {
-    const auto reply = client_->send(module, CMD_TRIGGER, {kernel}, timeout);
-    if (!reply.ok()) {
-      throw std::runtime_error(
-          fmt::format("sequencer: triggering {}/{} failed: {}", module, kernel, reply.error()));
+    for (const auto& [module, kernel] : grabbers_) {
+      queue_.push_back({module, CMD_SET_PARAM, {kernel, "frame_mode", mode}});
     }
+    applied_mode_ = mode;
   }
+  for (const auto& [module, kernel] : steps_) queue_.push_back({module, CMD_TRIGGER, {kernel}});
+  wake_.notify_all();
 }
 
 // Stub: no commands (a sequencer without the system it drives has nothing plausible to send).

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include <oscar/config.h>
 #include <oscar/kernel.hpp>
 
 namespace oscar {
@@ -43,7 +44,6 @@ class Sequencer final : public Kernel {
  private:
   using Target = std::pair<std::string, std::string>;  // module, kernel
   void connect();
-  void send_frame_mode(const std::string& mode);
   void worker_loop();
 
   Params params_;
@@ -52,15 +52,21 @@ class Sequencer final : public Kernel {
   std::string applied_mode_;
   std::unique_ptr<DdsParticipant> participant_;
   std::unique_ptr<ConfigClient> client_;
-  // set_param to a kernel of this very module waits for the processing thread, which is
-  // running this kernel: such commands go through a worker thread.
+  // Commands go out from a worker thread, in order: a kernel of this very module can only take
+  // a set_param between kernel calls, and a trigger for it is answered by the module's
+  // configuration thread, so process() must not wait for replies.
+  struct Command {
+    std::string module;
+    CommandKind kind;
+    std::vector<std::string> args;
+  };
   std::thread worker_;
   std::mutex mutex_;
   std::condition_variable wake_;
-  std::deque<Target> pending_;  // (module, kernel) to set to pending_mode_
-  std::string pending_mode_;
-  std::chrono::milliseconds pending_timeout_{2000};
+  std::deque<Command> queue_;
+  std::chrono::milliseconds timeout_{2000};
   std::string worker_error_;
+  std::uint64_t skipped_ = 0;
   bool stop_ = false;
 };
 
