@@ -15,7 +15,7 @@ namespace oscar::modules {
 
 void LandmarkPoseFusion::Params::describe(ParamSpec& spec) {
   spec.field("tag_layout", tag_layout, "tags on the target 'id:x,y,z;...' (target frame, m)");
-  spec.field("max_skew", max_skew, "B's image may be this much older or newer than A's")
+  spec.field("max_skew", max_skew, "B's image may be this much older than A's (newer: any)")
       .at_least(0);
   spec.field("wait_b", wait_b, "pull/prefetch: how long to ask B for this cycle's result")
       .at_least(0);
@@ -35,25 +35,27 @@ void LandmarkPoseFusion::on_params_changed() {
   for (const auto& t : parse_tag_layout(params_.tag_layout)) layout_[t.id] = t.offset_m;
 }
 
-// B's detections of the image taken with A's (within max_skew). With push they are in the ring
-// already (on one host MarkBDetect runs before this kernel). With pull or prefetch (B on
-// another host, seed 004 §4.2) B may still be working: ask again until wait_b is up.
+// B's newest detections, if its image was taken at most max_skew before A's (on one host B's
+// image is taken after A's; across hosts B is triggered first, just before A). With push they
+// are in the ring already (on one host MarkBDetect runs before this kernel). With pull or
+// prefetch (B on another host, seed 004 §4.2) B may still be working on this cycle's image: ask
+// again until wait_b is up.
 Input<TagDetections>::Ptr LandmarkPoseFusion::matching_b(Stamp acquired) {
   const auto matches = [&](const Input<TagDetections>::Ptr& b) {
-    return b && std::llabs(generation_stamp(b->header()) - acquired) <= params_.max_skew.count();
+    return b && generation_stamp(b->header()) >= acquired - params_.max_skew.count();
   };
   if (tags_b_.transfer() == Transfer::kPush) {
-    auto b = tags_b_.nearest(acquired);
+    auto b = tags_b_.latest();
     return matches(b) ? b : nullptr;
   }
   const auto deadline = std::chrono::steady_clock::now() + params_.wait_b;
   for (;;) {
-    auto future = tags_b_.prefetch(PullQuery::kNearest, acquired);
+    auto future = tags_b_.prefetch(PullQuery::kLatest);
     const auto left = deadline - std::chrono::steady_clock::now();
     auto b = future.get(std::max<std::chrono::nanoseconds>(left, std::chrono::nanoseconds(0)));
     if (matches(b)) return b;
     if (std::chrono::steady_clock::now() >= deadline) return nullptr;
-    // B's result for this image is not there yet; a short pause keeps the asking gentle.
+    // B's result for this cycle is not there yet; a short pause keeps the asking gentle.
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
 }
@@ -101,7 +103,7 @@ void LandmarkPoseFusion::process(Cycle& cycle) {
     for (const auto s : b->header().stamps()) cue.header().stamps().push_back(s);
     add_estimates(*b, estimates, cue);
   } else {
-    cycle.log().debug("no detections of B within {} ms of A's image",
+    cycle.log().debug("no detections of B taken at most {} ms before A's image",
                       params_.max_skew.count() / 1e6);
   }
   cue.estimates(static_cast<std::uint32_t>(estimates.size()));

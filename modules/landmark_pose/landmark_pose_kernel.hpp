@@ -19,7 +19,7 @@ class LandmarkPoseFusion final : public Kernel {
  public:
   struct Params {
     std::string tag_layout = "0:-0.08,0,0;1:0.08,0,0";  ///< tag id : centre in the target frame
-    std::chrono::nanoseconds max_skew{std::chrono::milliseconds(80)};
+    std::chrono::nanoseconds max_skew{std::chrono::milliseconds(30)};
     std::chrono::nanoseconds wait_b{std::chrono::milliseconds(200)};
     std::chrono::nanoseconds log_every{std::chrono::seconds(1)};  ///< 0 = no summary
     void describe(ParamSpec& spec);

@@ -5,10 +5,10 @@
 #include <mutex>
 #include <thread>
 
-#include <Eigen/Core>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
+#include <Eigen/Core>
 
 #include "booted_system.hpp"
 #include "landmark_summary.hpp"  // tests/common
@@ -99,7 +99,8 @@ TEST(Landmarks, OneHostDetectsTheTagsAtTheCycleRateAndFusesThePoseOfTheGroundTru
 
   // Frame mode by configuration: the coordinator tells the sequencer, which sets both grabbers.
   for (const auto& [mode, width] : {std::pair{"half", 320}, std::pair{"quarter", 160}}) {
-    const auto reply = sys.config().send("landmarks", CMD_SET_PARAM, {"control", "frame_mode", mode});
+    const auto reply =
+        sys.config().send("landmarks", CMD_SET_PARAM, {"control", "frame_mode", mode});
     ASSERT_TRUE(reply.ok()) << reply.error();
     bool seen = false;
     for (int i = 0; i < 50 && !seen; ++i) {

@@ -38,9 +38,9 @@ TEST(LandmarksOnTwoHosts, BootsAndFusesBothCamerasAsOnOneHost) {
   const auto log_dir = temp("landmarks2_logs");
   std::filesystem::remove_all(log_dir);
   auto argv = hosts.on(1);  // boot and the registry run on pc1
-  argv.insert(argv.end(), {test::bin("oscar-boot"), file, "--domain",
-                           std::to_string(test::test_domain()), "--log-dir", log_dir, "--timeout",
-                           "40", "--duration", "8"});
+  argv.insert(argv.end(),
+              {test::bin("oscar-boot"), file, "--domain", std::to_string(test::test_domain()),
+               "--log-dir", log_dir, "--timeout", "40", "--duration", "8"});
   test::Process boot(argv, temp("landmarks2_boot.log"));
   ASSERT_EQ(boot.wait(90s), 0) << boot.output();
 
