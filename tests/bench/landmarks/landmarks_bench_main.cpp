@@ -122,7 +122,8 @@ Result run(const std::string& config, int width, int height, double seconds, boo
   watch_argv.insert(watch_argv.end(), {own_bin("oscar-bench-landmarks"), "--watch", "--system",
                                        file, "--host", host, "--domain", std::to_string(domain),
                                        "--seconds", fmt::format("{}", seconds), "--out", out});
-  oscar::test::Process watcher(watch_argv, temp("bench_landmarks_watch.log"));
+  oscar::test::Process watcher(
+      watch_argv, temp(two_hosts ? "bench_landmarks_watch2" : "bench_landmarks_watch1"));
   if (watcher.wait(std::chrono::seconds(static_cast<int>(seconds) + 60)) != 0) {
     throw std::runtime_error("the watcher failed: " + watcher.output());
   }
