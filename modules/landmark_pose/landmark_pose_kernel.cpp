@@ -56,7 +56,7 @@ Input<TagDetections>::Ptr LandmarkPoseFusion::matching_b(Stamp acquired) {
     if (matches(b)) return b;
     if (std::chrono::steady_clock::now() >= deadline) return nullptr;
     // B's result for this cycle is not there yet; a short pause keeps the asking gentle.
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
   }
 }
 

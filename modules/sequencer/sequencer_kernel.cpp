@@ -91,8 +91,8 @@ void Sequencer::connect() {
   }
   participant_ = std::make_unique<DdsParticipant>(domain, "oscar:sequencer", network);
   client_ = std::make_unique<ConfigClient>(*participant_, "coordinator");
+  std::lock_guard lock(mutex_);
   stop_ = false;
-  worker_ = std::thread([this] { worker_loop(); });
 }
 
 void Sequencer::on_activate() { connect(); }
@@ -101,23 +101,34 @@ void Sequencer::on_deactivate() {
   {
     std::lock_guard lock(mutex_);
     stop_ = true;
-    queue_.clear();
+    for (auto& [module, lane] : lanes_) lane.queue.clear();
   }
   wake_.notify_all();
-  if (worker_.joinable()) worker_.join();
+  for (auto& [module, lane] : lanes_) {
+    if (lane.thread.joinable()) lane.thread.join();
+  }
+  lanes_.clear();
   client_.reset();
   participant_.reset();
   applied_mode_.clear();
 }
 
-void Sequencer::worker_loop() {
+bool Sequencer::busy() const {
+  for (const auto& [module, lane] : lanes_) {
+    if (!lane.queue.empty()) return true;
+  }
+  return false;
+}
+
+void Sequencer::worker_loop(const std::string& module) {
   std::unique_lock lock(mutex_);
+  auto& queue = lanes_.at(module).queue;  // std::map: the reference stays valid
   while (!stop_) {
-    if (queue_.empty()) {
+    if (queue.empty()) {
       wake_.wait(lock);
       continue;
     }
-    const Command c = queue_.front();
+    const Command c = queue.front();
     const auto timeout = timeout_;
     lock.unlock();
     std::string error;
@@ -128,12 +139,12 @@ void Sequencer::worker_loop() {
       error = e.what();
     }
     lock.lock();
-    queue_.pop_front();
+    queue.pop_front();
     if (!error.empty()) {
       worker_error_ =
           fmt::format("{} {}/{} failed: {}", c.kind == CMD_TRIGGER ? "triggering" : "configuring",
                       c.module, c.args.front(), error);
-      queue_.clear();  // the rest of this cycle's sequence would run out of order
+      queue.clear();  // the rest of this cycle's sequence would run out of order
     }
   }
 }
@@ -160,21 +171,27 @@ void Sequencer::process(Cycle& cycle) {
     applied_mode_.clear();  // set it again next cycle
     throw std::runtime_error("sequencer: " + e);
   }
-  if (!queue_.empty()) {  // the last cycle's commands are still on their way
+  if (busy()) {  // the last cycle's commands are still on their way
     if (++skipped_ == 1 || skipped_ % 100 == 0) {
       cycle.log().warn("previous sequence still running: cycle skipped ({} so far)", skipped_);
     }
     return;
   }
   timeout_ = std::chrono::duration_cast<std::chrono::milliseconds>(params_.timeout);
+  const auto lane = [&](const std::string& module) -> std::deque<Command>& {
+    auto [it, added] = lanes_.try_emplace(module);
+    if (added) it->second.thread = std::thread([this, module] { worker_loop(module); });
+    return it->second.queue;
+  };
   if (!mode.empty() && mode != applied_mode_) {
     cycle.log().info("frame mode -> {}", mode);
     for (const auto& [module, kernel] : grabbers_) {
-      queue_.push_back({module, CMD_SET_PARAM, {kernel, "frame_mode", mode}});
+      lane(module).push_back({module, CMD_SET_PARAM, {kernel, "frame_mode", mode}});
     }
     applied_mode_ = mode;
   }
-  for (const auto& [module, kernel] : steps_) queue_.push_back({module, CMD_TRIGGER, {kernel}});
+  for (const auto& [module, kernel] : steps_)
+    lane(module).push_back({module, CMD_TRIGGER, {kernel}});
   wake_.notify_all();
 }
 

@@ -2,6 +2,7 @@
 
 #include <condition_variable>
 #include <deque>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -44,7 +45,8 @@ class Sequencer final : public Kernel {
  private:
   using Target = std::pair<std::string, std::string>;  // module, kernel
   void connect();
-  void worker_loop();
+  void worker_loop(const std::string& module);
+  bool busy() const;  // with mutex_ held
 
   Params params_;
   std::vector<Target> steps_, grabbers_;
@@ -52,18 +54,22 @@ class Sequencer final : public Kernel {
   std::string applied_mode_;
   std::unique_ptr<DdsParticipant> participant_;
   std::unique_ptr<ConfigClient> client_;
-  // Commands go out from a worker thread, in order: a kernel of this very module can only take
-  // a set_param between kernel calls, and a trigger for it is answered by the module's
-  // configuration thread, so process() must not wait for replies.
+  // Commands go out from worker threads, one per target module, each module's in order: a kernel
+  // of this very module can only take a set_param between kernel calls, and a trigger for it is
+  // answered by the module's configuration thread, so process() must not wait for replies; and
+  // a remote module's trigger must not hold up the local one (both cameras start together).
   struct Command {
     std::string module;
     CommandKind kind;
     std::vector<std::string> args;
   };
-  std::thread worker_;
+  struct Lane {
+    std::thread thread;
+    std::deque<Command> queue;
+  };
+  std::map<std::string, Lane> lanes_;  // by module
   std::mutex mutex_;
   std::condition_variable wake_;
-  std::deque<Command> queue_;
   std::chrono::milliseconds timeout_{2000};
   std::string worker_error_;
   std::uint64_t skipped_ = 0;
