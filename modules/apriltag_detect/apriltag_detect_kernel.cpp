@@ -154,6 +154,11 @@ void AprilTagDetect::detect(const CameraImage& image, Cycle& cycle) {
         name_, image.camera_id(), w, h, image.data().size(), image.encoding()));
   }
   apriltag_detection_info_t info{};
+  if (params_.estimate_pose && params_.tag_size_m <= 0) {  // set to 0 while running
+    throw std::runtime_error(fmt::format(
+        "apriltag_detect '{}': estimate_pose needs tag_size_m > 0 (the tag's edge in metres)",
+        name_));
+  }
   if (params_.estimate_pose) {
     info.tagsize = params_.tag_size_m;
     info.fx = params_.fx > 0 ? params_.fx : image.fx();

@@ -133,6 +133,23 @@ TEST(AprilTagDetect, PoseWithoutIntrinsicsIsAClearErrorAndPublishesNothing) {
   EXPECT_EQ(det.take_count("tags"), 0u);
 }
 
+TEST(AprilTagDetect, ATagSizeSetToZeroWhileRunningIsAnErrorNotAZeroPose) {
+  KernelHarness det("apriltag_detect", YAML::Load("{}"), "mark_a");
+  det.instance().ports().params.set_text("tag_size_m", "0");
+  CameraImage img;
+  img.encoding("mono8");
+  img.width(16);
+  img.height(16);
+  img.fx(10);
+  img.fy(10);
+  img.cx(8);
+  img.cy(8);
+  img.data().assign(256, 0);
+  det.feed("image", img);
+  EXPECT_THAT(error_of(det), HasSubstr("estimate_pose needs tag_size_m > 0"));
+  EXPECT_EQ(det.take_count("tags"), 0u);
+}
+
 TEST(AprilTagDetect, AnImageThatIsNotMono8OfItsSizeIsAnError) {
   KernelHarness det("apriltag_detect", YAML::Load("{estimate_pose: false}"), "mark_a");
   CameraImage img;
