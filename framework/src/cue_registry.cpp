@@ -4,6 +4,7 @@
 
 #include "oscar/cue_type_info.hpp"
 #include "oscar/cue_types.hpp"
+#include "oscar/perception_types.hpp"
 
 namespace oscar {
 namespace {
@@ -44,6 +45,9 @@ void register_standard_cue_types() {
   cue_type_info<Bool>();
   cue_type_info<LineSeg3DSeq>();
   cue_type_info<GvImage>();
+  cue_type_info<CameraImage>();
+  cue_type_info<TagDetections>();
+  cue_type_info<LandmarkPose>();
 }
 
 }  // namespace oscar

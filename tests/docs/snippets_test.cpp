@@ -1,5 +1,6 @@
-// Docs stay true: every code block in docs/ and README.md marked `<!-- snippet: PATH -->` must
-// appear verbatim in PATH (STYLE.md: documentation code is cut from compiled files).
+// Docs stay true: every code block in docs/, README.md and modules/*/README.md marked `<!--
+// snippet: PATH -->` must appear verbatim in PATH (STYLE.md: documentation code is cut from
+// compiled files).
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -22,6 +23,9 @@ TEST(DocSnippets, EveryMarkedCodeBlockMatchesItsSource) {
   for (const auto& e : fs::directory_iterator(root / "docs")) {
     if (e.path().extension() == ".md") docs.push_back(e.path());
   }
+  for (const auto& e : fs::directory_iterator(root / "modules")) {
+    if (fs::exists(e.path() / "README.md")) docs.push_back(e.path() / "README.md");
+  }
   int checked = 0;
   const std::string marker = "<!-- snippet: ";
   for (const auto& doc : docs) {
@@ -35,7 +39,8 @@ TEST(DocSnippets, EveryMarkedCodeBlockMatchesItsSource) {
       const auto block = text.substr(body, close - body);
       ASSERT_TRUE(fs::exists(source)) << doc << ": snippet source " << source << " is missing";
       EXPECT_NE(read(source).find(block), std::string::npos)
-          << doc << ": this block is no longer in " << source << ":\n" << block;
+          << doc << ": this block is no longer in " << source << ":\n"
+          << block;
       ++checked;
     }
   }

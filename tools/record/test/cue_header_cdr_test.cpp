@@ -48,5 +48,13 @@ TEST(IdlTexts, AreSelfContainedAndKeyedByQualifiedName) {
   EXPECT_TRUE(texts.count("oscar::LineSeg3DSeq"));
 }
 
+TEST(IdlTexts, HoldThePerceptionTypes) {
+  const auto& texts = idl_texts();
+  for (const char* type : {"oscar::CameraImage", "oscar::TagDetections", "oscar::LandmarkPose"}) {
+    ASSERT_TRUE(texts.count(type)) << type;
+    EXPECT_NE(texts.at(type).find("struct Pose3"), std::string::npos) << type;
+  }
+}
+
 }  // namespace
 }  // namespace oscar::record
