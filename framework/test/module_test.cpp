@@ -354,5 +354,27 @@ TEST(ModuleBadInput, MalformedYamlNamesFileLineAndColumn) {
               ThrowsMessage<std::invalid_argument>(HasSubstr(file.string() + ":4:")));
 }
 
+// What the registry hands a restarted module (oscar-run --restore): the coordinator's changes.
+TEST(ModuleSpec, RestoreAppliesModesStubParametersAndWiring) {
+  auto spec = ModuleSpec::from_yaml(YAML::Load(R"(
+name: m
+kernels:
+  - { type: test_counter, name: src }
+  - { type: test_collect, name: sink, params: { factor: 1 }, inputs: { in: src/out } }
+)"),
+                                    "test");
+  spec.restore(YAML::Load(
+      "{src: {mode: 'continuous:5000000ns', stub: true}, sink: {params: {factor: 3}, inputs: "
+      "{in: other/out}}}"));
+  EXPECT_EQ(spec.kernels[0].mode->describe(), "continuous(5ms)");
+  EXPECT_EQ(spec.kernels[0].stub, true);
+  EXPECT_EQ(spec.kernels[1].params["factor"].as<int>(), 3);
+  EXPECT_EQ(spec.kernels[1].inputs.at("in").source, "other/out");
+  EXPECT_THAT([&] { spec.restore(YAML::Load("{ghost: {stub: true}}")); },
+              ThrowsMessage<std::invalid_argument>(HasSubstr("module 'm' has no kernel 'ghost'")));
+  EXPECT_THAT([&] { spec.restore(YAML::Load("{src: {colour: red}}")); },
+              ThrowsMessage<std::invalid_argument>(HasSubstr("unknown key 'colour'")));
+}
+
 }  // namespace
 }  // namespace oscar

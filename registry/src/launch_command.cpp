@@ -36,8 +36,8 @@ std::vector<std::string> on_host(const HostSpec& host, const std::vector<std::st
 }
 
 std::vector<std::string> module_command(const SystemSpec& system, const SystemModule& module,
-                                        unsigned incarnation, bool suspended,
-                                        const std::string& oscar_run, const std::string& log_dir) {
+                                        unsigned incarnation, const std::string& oscar_run,
+                                        const std::string& log_dir) {
   std::vector<std::string> argv;
   if (module.debug.gdbserver_port > 0) {
     argv = {"gdbserver", fmt::format("127.0.0.1:{}", module.debug.gdbserver_port)};
@@ -49,7 +49,6 @@ std::vector<std::string> module_command(const SystemSpec& system, const SystemMo
   argv.insert(argv.end(), {oscar_run, system.file, "--module", module.spec.name, "--incarnation",
                            std::to_string(incarnation), "--domain",
                            std::to_string(module.spec.domain.value_or(system.domain))});
-  if (suspended) argv.push_back("--suspended");
   return argv;
 }
 

@@ -245,7 +245,7 @@ void Registry::launch(Tracked& m, unsigned incarnation) {
   m.status = "starting";
   m.process_gone = false;
   m.has_state = false;
-  auto argv = module_command(system_, *m.spec, incarnation, false, "oscar-run", mon.log_dir);
+  auto argv = module_command(system_, *m.spec, incarnation, "oscar-run", mon.log_dir);
   if (m.config) argv.insert(argv.end(), {"--restore", restore_text(*m.config)});
   io_->send(LAUNCH_START, host, mon.pid, m.spec->spec.name, incarnation, argv,
             {"OSCAR_RUN_DIR=" + mon.log_dir});

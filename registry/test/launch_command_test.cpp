@@ -38,14 +38,14 @@ SystemSpec one_module(const std::string& debug) {
 
 TEST(LaunchCommand, ModuleCommandNamesFileModuleIncarnationAndDomain) {
   const auto s = one_module("");
-  EXPECT_EQ(module_command(s, s.modules[0], 3, true, "oscar-run", "/logs"),
-            (Argv{"oscar-run", "sys.yaml", "--module", "cam", "--incarnation", "3", "--domain", "9",
-                  "--suspended"}));
+  EXPECT_EQ(
+      module_command(s, s.modules[0], 3, "oscar-run", "/logs"),
+      (Argv{"oscar-run", "sys.yaml", "--module", "cam", "--incarnation", "3", "--domain", "9"}));
 }
 
 TEST(LaunchCommand, GdbserverListensOnLoopbackOnly) {
   const auto s = one_module(", debug: { gdbserver: 2345 }");
-  const auto argv = module_command(s, s.modules[0], 1, false, "oscar-run", "/logs");
+  const auto argv = module_command(s, s.modules[0], 1, "oscar-run", "/logs");
   ASSERT_GE(argv.size(), 3u);
   EXPECT_EQ(argv[0], "gdbserver");
   EXPECT_EQ(argv[1], "127.0.0.1:2345");
@@ -54,7 +54,7 @@ TEST(LaunchCommand, GdbserverListensOnLoopbackOnly) {
 
 TEST(LaunchCommand, ValgrindWritesItsLogBesideTheModules) {
   const auto s = one_module(", debug: { valgrind: [--leak-check=full] }");
-  const auto argv = module_command(s, s.modules[0], 2, false, "oscar-run", "/logs");
+  const auto argv = module_command(s, s.modules[0], 2, "oscar-run", "/logs");
   EXPECT_EQ(
       Argv(argv.begin(), argv.begin() + 4),
       (Argv{"valgrind", "--log-file=/logs/cam.2.valgrind.log", "--leak-check=full", "oscar-run"}));
