@@ -31,7 +31,7 @@ class ThreeHosts : public testing::Test {
     file_ = temp("netns_system") + ".yaml";
     std::ofstream(file_) << fmt::format(R"(
 system: three
-lease: 300ms
+lease: 1s
 hosts:
   h1: {{ local: true, address: {} }}
   h2: {{ netns: {}, address: {} }}
