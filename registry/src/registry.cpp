@@ -1,14 +1,13 @@
+// The registry's events: monitors, process events, module announcements and heartbeats,
+// requests, and what a failure sets off (the actions are in registry_actions.cpp).
 #include "oscar/registry/registry.hpp"
 
 #include <algorithm>
-#include <future>
-#include <set>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
-#include "oscar/registry/launch_command.hpp"
 #include "oscar/time.hpp"
 #include "registry_io.hpp"
 #include "registry_tracked.hpp"
@@ -236,173 +235,6 @@ void Registry::fail(Tracked& m, const std::string& reason, bool process_gone) {
   publish();
 }
 
-void Registry::launch(Tracked& m, unsigned incarnation) {
-  const auto& host = m.spec->spec.host;
-  const auto& mon = monitors_[host];
-  m.incarnation = incarnation;
-  m.launched_by = mon.pid;
-  m.suspended = false;
-  m.status = "starting";
-  m.process_gone = false;
-  m.has_state = false;
-  auto argv = module_command(system_, *m.spec, incarnation, "oscar-run", mon.log_dir);
-  if (m.config) argv.insert(argv.end(), {"--restore", restore_text(*m.config)});
-  io_->send(LAUNCH_START, host, mon.pid, m.spec->spec.name, incarnation, argv,
-            {"OSCAR_RUN_DIR=" + mon.log_dir});
-  spdlog::info("registry: starting '{}' on '{}' (incarnation {})", m.spec->spec.name, host,
-               incarnation);
-}
-
-// Launches what is due: at boot every module whose monitor is up, later the restarts whose
-// backoff has passed (once the failed process is gone and its host's monitor answers).
-void Registry::tick() {
-  const auto now = Clock::now();
-  for (auto& m : modules_) {
-    const auto& mon = monitors_[m->spec->spec.host];
-    if (!mon.alive) continue;
-    if (m->status == "waiting") {
-      launch(*m, 1);
-      publish();
-    } else if (m->status == "restarting" && m->process_gone && now >= m->restart_at) {
-      if (m->incarnation > 0) ++m->restarts;
-      launch(*m, m->incarnation + 1);
-      publish();
-    }
-  }
-  // DDS reports a lapsed lease only for a writer it has seen alive; a module that hangs before
-  // its first heartbeat arrives is caught here, by the age of its last heartbeat.
-  for (auto& m : modules_) {
-    if (m->status != "running") continue;
-    const auto last =
-        std::max(m->running_since, io_->last_beat(m->spec->spec.name, m->incarnation));
-    if (now - last > system_.lease * 2) on_module_lost(m->spec->spec.name, m->incarnation);
-  }
-  if (state_ == "booting") {
-    std::vector<std::string> missing;
-    for (const auto& m : modules_) {
-      if (m->status != "running" && m->status != "standby") missing.push_back(m->spec->spec.name);
-    }
-    if (missing.empty()) {
-      set_system("running", "all modules announced");
-    } else if (message_ != "waiting for: " + fmt::format("{}", fmt::join(missing, ", "))) {
-      message_ = fmt::format("waiting for: {}", fmt::join(missing, ", "));
-      publish();
-    }
-  }
-  if (now - last_publish_ > std::chrono::seconds(1)) publish();
-}
-
-// What the coordinator had made of the module (modes, stub, parameters, wiring), from its last
-// announcement, as `oscar-run --restore` takes it: the new incarnation starts configured.
-std::string Registry::restore_text(const ModuleState& last) {
-  YAML::Emitter out;
-  out << YAML::Flow << YAML::BeginMap;
-  for (const auto& k : last.kernels()) {
-    out << YAML::Key << k.name() << YAML::Value << YAML::BeginMap;
-    out << YAML::Key << "mode" << YAML::Value
-        << (k.mode() == "continuous"    ? fmt::format("continuous:{}ns", k.cycle_ns())
-            : k.mode() == "deactivated" ? std::string("deactivated")
-            : k.trigger() == "default" || k.trigger().empty() ? std::string("single_step")
-                                                              : "single_step:" + k.trigger());
-    out << YAML::Key << "stub" << YAML::Value << k.stub();
-    out << YAML::Key << "params" << YAML::Value << YAML::Load(k.params());
-    out << YAML::Key << "inputs" << YAML::Value << YAML::BeginMap;
-    for (const auto& wire : k.inputs()) {
-      const auto eq = wire.find('=');
-      out << YAML::Key << wire.substr(0, eq) << YAML::Value << wire.substr(eq + 1);
-    }
-    out << YAML::EndMap << YAML::EndMap;
-  }
-  out << YAML::EndMap;
-  return out.c_str();
-}
-
-// `replacement` takes over: inputs that read kernel i of the failed module now read kernel i
-// of the replacement (same channel names; boot checked the replacement is standby).
-void Registry::rewire_consumers(const Tracked& failed, const Tracked& replacement) {
-  const auto& from = failed.spec->spec.kernels;
-  const auto& to = replacement.spec->spec.kernels;
-  for (auto& c : modules_) {
-    if (c->status != "running" || !c->has_state || c.get() == &replacement) continue;
-    for (const auto& k : c->state.kernels()) {
-      for (const auto& wire : k.inputs()) {
-        const auto eq = wire.find('=');
-        const auto source = wire.substr(eq + 1);
-        const auto kernel = source.substr(0, source.find('/'));
-        for (std::size_t i = 0; i < from.size() && i < to.size(); ++i) {
-          if (from[i].name != kernel) continue;
-          const auto target = to[i].name + source.substr(source.find('/'));
-          spdlog::info("registry: rewiring {}.{} from {} to {}", k.name(), wire.substr(0, eq),
-                       source, target);
-          configure(c->spec->spec.name, CMD_REWIRE, {k.name(), wire.substr(0, eq), target});
-        }
-      }
-    }
-  }
-}
-
-// The caller publishes the new state once it has decided what happens next.
-void Registry::suspend_all() {
-  if (state_ == "suspended") return;
-  std::vector<Tracked*> targets;
-  for (auto& m : modules_) {
-    if (m->status == "running" && !m->suspended) targets.push_back(m.get());
-  }
-  const auto ok = configure_all(targets, CMD_SUSPEND);
-  for (std::size_t i = 0; i < targets.size(); ++i) targets[i]->suspended = ok[i];
-  state_ = "suspended";
-}
-
-// Resumes once no module is on its way back; a module given up (or replaced) no longer counts.
-void Registry::resume_if_whole() {
-  if (state_ != "suspended") return;
-  for (const auto& m : modules_) {
-    if (m->status == "starting" || m->status == "restarting") return;
-    const bool given_up = m->status == "failed" &&
-                          m->spec->restart.kind == RestartPolicy::Kind::kAuto &&
-                          m->spec->restart.continue_on_limit;
-    if (m->status == "failed" && !given_up) return;
-  }
-  // A restarted module starts running (configured by --restore): only the others wait.
-  std::vector<Tracked*> targets;
-  for (auto& m : modules_) {
-    if (m->status == "running" && m->suspended) targets.push_back(m.get());
-  }
-  const auto ok = configure_all(targets, CMD_RESUME);
-  for (std::size_t i = 0; i < targets.size(); ++i) targets[i]->suspended = !ok[i];
-  set_system("running", "resumed");
-}
-
-bool Registry::configure(const std::string& module, CommandKind kind,
-                         std::vector<std::string> args) {
-  const auto start = Clock::now();
-  try {
-    const auto reply = config_.send(module, kind, std::move(args), std::chrono::milliseconds(2000));
-    if (!reply.ok()) spdlog::warn("registry: {}: {}", module, reply.error());
-    const auto took = Clock::now() - start;
-    if (took > std::chrono::milliseconds(100)) {
-      spdlog::warn("registry: command {} to '{}' took {}", static_cast<int>(kind), module,
-                   format_duration(std::chrono::duration_cast<std::chrono::nanoseconds>(took)));
-    }
-    return reply.ok();
-  } catch (const std::exception& e) {
-    spdlog::warn("registry: {}", e.what());
-    return false;
-  }
-}
-
-// The same command to several modules at once: the slowest reply sets the pace, not the sum.
-std::vector<bool> Registry::configure_all(const std::vector<Tracked*>& targets, CommandKind kind) {
-  std::vector<std::future<bool>> replies;
-  for (auto* m : targets) {
-    replies.push_back(std::async(
-        std::launch::async, [this, m, kind] { return configure(m->spec->spec.name, kind, {}); }));
-  }
-  std::vector<bool> ok;
-  for (auto& r : replies) ok.push_back(r.get());
-  return ok;
-}
-
 void Registry::on_request(const RegistryRequest& r) {
   std::string error;
   if (r.kind() == REG_SHUTDOWN) {
@@ -425,68 +257,6 @@ void Registry::on_request(const RegistryRequest& r) {
                         r.module_name(), m->status);
   }
   io_->reply(r.id(), error);
-}
-
-void Registry::shutdown() {
-  set_system("stopping", "shutting down in reverse boot order");
-  for (auto it = modules_.rbegin(); it != modules_.rend(); ++it) {
-    auto& m = **it;
-    if (m.process_gone || m.incarnation == 0) continue;
-    const auto& mon = monitors_[m.spec->spec.host];
-    if (mon.alive)
-      io_->send(LAUNCH_STOP, m.spec->spec.host, mon.pid, m.spec->spec.name, m.incarnation, {}, {});
-    // In order: wait for this one to end before stopping the next.
-    const auto until = Clock::now() + std::chrono::seconds(6);
-    std::unique_lock lock(mutex_);
-    while (!m.process_gone && mon.alive && Clock::now() < until) {
-      wake_.wait_for(lock, std::chrono::milliseconds(10), [&] { return !events_.empty(); });
-      while (!events_.empty()) {
-        auto event = std::move(events_.front());
-        events_.pop_front();
-        lock.unlock();
-        event();
-        lock.lock();
-      }
-    }
-    m.status = "stopped";
-  }
-  for (const auto& [host, mon] : monitors_) {
-    if (mon.alive) io_->send(LAUNCH_EXIT, host, mon.pid, "", 0, {}, {});
-  }
-  set_system("stopped", "all modules stopped");
-}
-
-void Registry::set_system(const std::string& state, const std::string& message) {
-  if (state != state_) spdlog::info("registry: system {} ({})", state, message);
-  state_ = state;
-  message_ = message;
-  publish();
-}
-
-void Registry::publish() {
-  SystemState s;
-  s.system(system_.name);
-  s.state(state_);
-  s.message(message_);
-  s.stamp_ns(static_cast<unsigned long long>(wall_now()));
-  for (const auto& [host, mon] : monitors_) {
-    if (!mon.alive) s.hosts_lost().push_back(host);
-  }
-  for (const auto& m : modules_) {
-    ModuleEntry e;
-    e.name(m->spec->spec.name);
-    e.host(m->spec->spec.host);
-    e.pid(static_cast<std::int32_t>(m->pid));
-    e.incarnation(m->incarnation);
-    e.status(m->status);
-    e.restarts(m->restarts);
-    e.last_failure(m->last_failure);
-    e.cues_per_s(m->cues_per_s);
-    if (m->has_state) e.state(m->state);
-    s.modules().push_back(std::move(e));
-  }
-  io_->publish(s);
-  last_publish_ = Clock::now();
 }
 
 }  // namespace oscar
