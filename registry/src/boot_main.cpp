@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <mutex>
 #include <set>
 
 #include <fmt/format.h>
@@ -92,9 +93,11 @@ int main(int argc, char** argv) {
                                  system.domain, log_dir));
     oscar::DdsParticipant participant(system.domain, "oscar-boot",
                                       oscar::NetworkConfig::for_host(system.root, local.name));
+    std::mutex last_line_mutex;  // DDS may call back from its UDP and shared-memory threads
     std::string last_line;
     oscar::RegistryClient registry(participant, "boot", [&](const oscar::SystemState& s) {
       auto line = fmt::format("system {}: {}{}", s.state(), s.message(), summary(s));
+      std::lock_guard lock(last_line_mutex);
       if (line != last_line) {
         log.note("registry", line, s.state() == "suspended" ? oscar::LOG_WARN : oscar::LOG_INFO);
         last_line = std::move(line);
