@@ -36,8 +36,13 @@ mode: { single_step: { trigger: command } }
   std::uint64_t frames() {
     return module_->kernel("cam").ports().find_output("frame")->published();
   }
+  // Through the module's state: it reads parameters under the frame's lock, while set_param
+  // changes them on the module's own threads.
   std::string frame_mode() {
-    return module_->kernel("cam").ports().params.find("frame_mode")->get();
+    for (const auto& k : module_->state().kernels()) {
+      if (k.name() == "cam") return YAML::Load(k.params())["frame_mode"].as<std::string>();
+    }
+    return "";
   }
   template <class Pred>
   bool eventually(Pred pred) {
