@@ -39,7 +39,8 @@ mode: { single_step: { trigger: command } }
   // Through the module's state: it reads parameters under the frame's lock, while set_param
   // changes them on the module's own threads.
   std::string frame_mode() {
-    for (const auto& k : module_->state().kernels()) {
+    const auto state = module_->state();  // kept: a range-for would not extend its life
+    for (const auto& k : state.kernels()) {
       if (k.name() == "cam") return YAML::Load(k.params())["frame_mode"].as<std::string>();
     }
     return "";
