@@ -113,6 +113,11 @@ void Sequencer::on_deactivate() {
   applied_mode_.clear();
 }
 
+bool Sequencer::idle() {
+  std::lock_guard lock(mutex_);
+  return !busy();
+}
+
 bool Sequencer::busy() const {
   for (const auto& [module, lane] : lanes_) {
     if (!lane.queue.empty()) return true;

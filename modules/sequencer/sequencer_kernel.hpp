@@ -41,6 +41,9 @@ class Sequencer final : public Kernel {
   void on_activate() override;
   void on_deactivate() override;
   void on_params_changed() override;
+  /// True when no command of an earlier cycle is still on its way (a cycle that finds one
+  /// pending is skipped).
+  bool idle();
 
  private:
   using Target = std::pair<std::string, std::string>;  // module, kernel

@@ -11,6 +11,8 @@
 #include <oscar/perception_types.hpp>
 #include <oscar/testing/conformance.hpp>
 
+#include "../sequencer_kernel.hpp"
+
 namespace oscar {
 namespace {
 using ::testing::HasSubstr;
@@ -83,12 +85,19 @@ TEST_F(Cameras, SetsTheFrameModeByConfigurationAndFollowsItsSchedule) {
       "sequencer",
       YAML::Load("{framegrabbers: 'cams:cam', frame_mode_schedule: 'quarter:1,half:2'}"),
       "control");
-  seq.step();
+  auto& sequencer = dynamic_cast<modules::Sequencer&>(seq.kernel());
+  // Each step waits until the last one's commands are through: a step that finds them still
+  // on their way is skipped (and the schedule moves on with the cycle count).
+  const auto step = [&] {
+    ASSERT_TRUE(eventually([&] { return sequencer.idle(); }));
+    seq.step();
+  };
+  step();
   EXPECT_TRUE(eventually([&] { return frame_mode() == "quarter"; })) << frame_mode();
-  seq.step();
+  step();
   EXPECT_TRUE(eventually([&] { return frame_mode() == "half"; })) << frame_mode();
-  seq.step();
-  seq.step();  // the schedule repeats
+  step();
+  step();  // the schedule repeats
   EXPECT_TRUE(eventually([&] { return frame_mode() == "quarter"; })) << frame_mode();
 }
 
