@@ -29,11 +29,13 @@ class VideoSource final : public FrameSource {
       throw std::runtime_error(
           fmt::format("{} '{}' does not exist", device ? "video device" : "video file", path_));
     }
-    const bool opened = device ? capture_.open(path_, cv::CAP_V4L2) : capture_.open(path_);
+    // One backend each (V4L2 for devices, FFmpeg for files): no probing of the others, whose
+    // GStreamer path scans USB devices and leaks in plugins it unloads again.
+    const bool opened = capture_.open(path_, device ? cv::CAP_V4L2 : cv::CAP_FFMPEG);
     if (!opened || !capture_.isOpened()) {
       throw std::runtime_error(
-          fmt::format("cannot open {} '{}' (OpenCV found no backend that reads it)",
-                      device ? "video device" : "video file", path_));
+          fmt::format("cannot open {} '{}' (OpenCV's {} backend cannot read it)",
+                      device ? "video device" : "video file", path_, device ? "V4L2" : "FFmpeg"));
     }
     can_rewind_ = !device;
   }
