@@ -98,12 +98,12 @@ int main(int argc, char** argv) {
     bool exit_requested = false;
     while (!exit_requested) {
       if (oscar::wait_for_stop(signals, std::chrono::milliseconds(5))) break;
-      std::deque<oscar::LaunchRequest> todo;
+      std::deque<oscar::LaunchRequest> batch;  // handled without holding the lock
       {
         std::lock_guard lock(mutex);
-        todo.swap(requests);
+        batch.swap(requests);
       }
-      for (const auto& q : todo) {
+      for (const auto& q : batch) {
         switch (q.kind()) {
           case oscar::LAUNCH_START: {
             auto args = q.argv();
