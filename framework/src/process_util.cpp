@@ -1,5 +1,6 @@
 #include "oscar/process_util.hpp"
 
+#include <malloc.h>
 #include <pthread.h>
 
 namespace oscar {
@@ -28,6 +29,13 @@ bool wait_for_stop(const sigset_t& signals, std::chrono::milliseconds timeout) {
   timespec wait{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
   siginfo_t info;
   return sigtimedwait(&signals, &info, &wait) > 0;
+}
+
+void keep_cue_memory_in_process() {
+  // The largest mmap threshold glibc allows on 64-bit; setting it also stops glibc from moving
+  // the threshold (and the trim threshold with it) on its own.
+  mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
+  mallopt(M_TRIM_THRESHOLD, 64 * 1024 * 1024);
 }
 
 }  // namespace oscar

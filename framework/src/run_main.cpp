@@ -88,6 +88,7 @@ int run_main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   auto signals = block_stop_signals();  // every thread started from here inherits it
+  keep_cue_memory_in_process();
 
   try {
     register_standard_cue_types();

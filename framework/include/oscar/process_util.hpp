@@ -1,6 +1,6 @@
 #pragma once
-/// @file What every OSCAR program does the same way: find the programs installed beside it, and
-/// turn SIGINT/SIGTERM into an orderly stop.
+/// @file What every OSCAR program does the same way: find the programs installed beside it, turn
+/// SIGINT/SIGTERM into an orderly stop, and keep the heap suited to large cues.
 
 #include <signal.h>
 
@@ -20,5 +20,12 @@ std::string sibling_program(const std::string& program);
 sigset_t block_stop_signals();
 /// True if SIGINT or SIGTERM arrived within `timeout`.
 bool wait_for_stop(const sigset_t& signals, std::chrono::milliseconds timeout);
+
+/// Keeps freed cue memory (camera images of hundreds of KB) inside the process instead of handing
+/// it back to the kernel after each cue: large blocks come from the heap, not from a fresh mmap,
+/// and the heap is trimmed only when more than 64 MB lie free at its top. glibc's defaults
+/// otherwise cost a page fault per 4 KB of every received image (442 KB: +40 µs per cue, see
+/// docs/benchmarks.md). Call once at start-up in processes that carry cues.
+void keep_cue_memory_in_process();
 
 }  // namespace oscar
