@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include "oscar/shared_memory.hpp"
 
 namespace oscar {
 namespace dds = eprosima::fastdds::dds;
@@ -30,6 +31,10 @@ bool is_ipv4(const std::string& s) {
 // RTPS well-known ports (spec 9.6.1.1): PB + DG * domain + d1 + PG * participant.
 std::uint32_t metatraffic_unicast_port(int domain, int participant) {
   return static_cast<std::uint32_t>(7400 + 250 * domain + 10 + 2 * participant);
+}
+// ... and the user unicast port (d3 = 11), the one shared memory listens on.
+std::uint32_t user_unicast_port(int domain, int participant) {
+  return metatraffic_unicast_port(domain, participant) + 1;
 }
 
 // True if nobody on this host has bound the UDP port on that address.
@@ -201,10 +206,18 @@ DdsParticipant::DdsParticipant(int domain, const std::string& name, const Networ
   if (network.interfaces.empty()) throw std::invalid_argument("network: no interface given");
   auto* factory = dds::DomainParticipantFactory::get_instance();
   dds::StatusMask mask = dds::StatusMask::none();
-  for (int id = 0; id < network.max_participants_per_host && !participant_; ++id) {
-    if (!udp_port_free(network.interfaces.front(), metatraffic_unicast_port(domain, id))) continue;
-    participant_ = factory->create_participant(domain, participant_qos(name, network, domain, id),
-                                               listener_.get(), mask);
+  // The lowest free participant id, but not one whose shared-memory port a killed process left
+  // behind while another id is free: the others would keep sending into the dead port for up to
+  // 2 s (see shared_memory.hpp). Such an id is taken only when no other is left.
+  for (const bool avoid_zombies : {network.shared_memory, false}) {
+    for (int id = 0; id < network.max_participants_per_host && !participant_; ++id) {
+      if (!udp_port_free(network.interfaces.front(), metatraffic_unicast_port(domain, id)))
+        continue;
+      if (avoid_zombies && shared_memory_port_is_zombie(user_unicast_port(domain, id))) continue;
+      participant_ = factory->create_participant(domain, participant_qos(name, network, domain, id),
+                                                 listener_.get(), mask);
+    }
+    if (participant_) break;
   }
   if (!participant_) {
     throw std::runtime_error(fmt::format(

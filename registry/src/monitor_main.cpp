@@ -18,6 +18,7 @@
 #include "oscar/process_util.hpp"
 #include "oscar/registry/supervisor.hpp"
 #include "oscar/registry/system_spec.hpp"
+#include "oscar/shared_memory.hpp"
 #include "oscar/topic_io.hpp"
 
 namespace {
@@ -86,6 +87,10 @@ int main(int argc, char** argv) {
     spdlog::info("watching host '{}' (domain {}), module output in {}", host, system.domain,
                  log_dir);
     std::map<std::string, Clock::time_point> stopping;  // SIGKILL if still there by then
+    // What killed modules leave in /dev/shm goes once the others have let go of them (the 3 s
+    // discovery lease of a participant, plus Fast DDS's 1-2 s port watchdog).
+    oscar::DeadSharedMemorySweeper shared_memory(std::chrono::seconds(5));
+    auto next_sweep = Clock::now();
     // The heartbeat has a thread of its own: starting processes must not delay it.
     std::jthread beater([&](std::stop_token stop) {
       auto next = Clock::now();
@@ -150,6 +155,12 @@ int main(int argc, char** argv) {
         ev.signal(x.signal);
         ev.detail(x.last_output);
         events.write(ev);
+      }
+      if (Clock::now() >= next_sweep) {
+        if (const auto n = shared_memory.sweep(); n > 0) {
+          spdlog::info("removed {} shared-memory segments and ports of dead processes", n);
+        }
+        next_sweep = Clock::now() + std::chrono::seconds(1);
       }
     }
     beater.request_stop();

@@ -183,6 +183,7 @@ void Registry::started(Tracked& m, const ModuleState& now) {
 void Registry::fail(Tracked& m, const std::string& reason, bool process_gone) {
   const auto& name = m.spec->spec.name;
   const auto& mon = monitors_[m.spec->spec.host];
+  const auto failed_at = Clock::now();  // the backoff runs while the others are suspended
   m.status = "failed";
   m.last_failure = reason;
   // A module whose monitor has been replaced died with its monitor.
@@ -199,7 +200,7 @@ void Registry::fail(Tracked& m, const std::string& reason, bool process_gone) {
     case RestartPolicy::Kind::kAuto:
       if (static_cast<int>(m.restarts) < policy.max) {
         m.status = "restarting";
-        m.restart_at = Clock::now() + policy.backoff;
+        m.restart_at = failed_at + policy.backoff;
         set_system("suspended",
                    fmt::format("'{}' {}; restart {} of {} in {}", name, reason, m.restarts + 1,
                                policy.max, format_duration(policy.backoff)));

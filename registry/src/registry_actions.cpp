@@ -15,6 +15,10 @@
 #include "registry_tracked.hpp"
 
 namespace oscar {
+namespace {
+constexpr std::chrono::milliseconds kFirstBeatGrace{3000};
+}  // namespace
+
 void Registry::launch(Tracked& m, unsigned incarnation) {
   const auto& host = m.spec->spec.host;
   const auto& mon = monitors_[host];
@@ -49,12 +53,18 @@ void Registry::tick() {
     }
   }
   // DDS reports a lapsed lease only for a writer it has seen alive; a module that hangs before
-  // its first heartbeat arrives is caught here, by the age of its last heartbeat.
+  // its first heartbeat arrives is caught here, by the age of its last heartbeat. Its first
+  // heartbeat may come late although it runs (it announced itself): discovery of a fresh
+  // process's heartbeat writer took up to 2 s here, so the first one gets that long.
   for (auto& m : modules_) {
     if (m->status != "running") continue;
-    const auto last =
-        std::max(m->running_since, io_->last_beat(m->spec->spec.name, m->incarnation));
-    if (now - last > system_.lease * 2) on_module_lost(m->spec->spec.name, m->incarnation);
+    const auto beat = io_->last_beat(m->spec->spec.name, m->incarnation);
+    const std::chrono::milliseconds allowed = beat == Clock::time_point{}
+                                                  ? std::max(system_.lease * 2, kFirstBeatGrace)
+                                                  : system_.lease * 2;
+    if (now - std::max(m->running_since, beat) > allowed) {
+      on_module_lost(m->spec->spec.name, m->incarnation);
+    }
   }
   if (state_ == "booting") {
     std::vector<std::string> missing;
@@ -160,8 +170,8 @@ bool Registry::configure(const std::string& module, CommandKind kind,
     if (!reply.ok()) spdlog::warn("registry: {}: {}", module, reply.error());
     const auto took = Clock::now() - start;
     if (took > std::chrono::milliseconds(100)) {
-      spdlog::warn("registry: command {} to '{}' took {}", static_cast<int>(kind), module,
-                   format_duration(std::chrono::duration_cast<std::chrono::nanoseconds>(took)));
+      spdlog::warn("registry: command {} to '{}' took {:.0f} ms", static_cast<int>(kind), module,
+                   std::chrono::duration<double, std::milli>(took).count());
     }
     return reply.ok();
   } catch (const std::exception& e) {
