@@ -15,6 +15,7 @@
 #include "oscar/cue_types.hpp"
 #include "oscar/dds_participant.hpp"
 #include "oscar/mcap/reader.hpp"
+#include "oscar/mcap/writer.hpp"
 #include "process.hpp"  // tests/common
 
 namespace oscar {
@@ -263,6 +264,47 @@ TEST(Replay, DeliversTheRecordedBytesAndHeadersInOrderWithTheOriginalTiming) {
     EXPECT_GE(span_replayed[topic] / 1e6, 0.9 * ns / 1e6 - 20) << topic << " in ms";
     EXPECT_LE(span_replayed[topic] / 1e6, 3.0 * ns / 1e6 + 500) << topic << " in ms";
   }
+}
+
+TEST(Replay, LoopsTheRecordingInOrderUntilStopped) {
+  // Five Bools 20 ms apart, written directly: one pass takes 80 ms.
+  const auto file = temp("replay_loop.mcap");
+  {
+    mcap::Writer w(file, {});
+    const auto channel = w.add_channel(0, "oscar/cue/lp/out", "cdr", {{"type", "oscar::Bool"}});
+    Bool b;
+    const std::uint64_t t0 = 1'000'000'000'000;
+    for (std::uint32_t seq = 1; seq <= 5; ++seq) {
+      b.header().seq(seq);
+      b.header().stamps({t0 + seq * 20'000'000ull});
+      const auto bytes = cue_type_info<Bool>().serialize(&b);
+      mcap::MessageView m;
+      m.channel_id = channel;
+      m.sequence = seq;
+      m.log_time = m.publish_time = t0 + seq * 20'000'000ull;
+      m.data = bytes;
+      w.write(m);
+    }
+    w.close();
+  }
+  const auto replayed = temp("replay_loop_replayed.mcap");
+  auto consumer = recorder(replayed, {"--all"});
+  std::this_thread::sleep_for(300ms);
+  Process replay(
+      {test::bin("oscar-replay"), file, "--loop", "--domain", std::to_string(test::test_domain())},
+      temp("replay_loop.log"));
+  std::this_thread::sleep_for(2500ms);  // the replay waits up to 2 s for its reader first
+  kill(replay.pid(), SIGINT);
+  ASSERT_EQ(replay.wait(10s), 0) << replay.output();
+  std::this_thread::sleep_for(300ms);
+  kill(consumer->pid(), SIGINT);
+  ASSERT_EQ(consumer->wait(10s), 0) << consumer->output();
+  const auto got = messages_of(replayed)["oscar/cue/lp/out"];
+  ASSERT_GE(got.size(), 15u) << "at least three passes";
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    EXPECT_EQ(std::get<2>(got[i]), i % 5 + 1) << "message " << i << ": passes in file order";
+  }
+  EXPECT_LE(got.size(), 5u * 40) << "paced (80 ms a pass), not blasted out";
 }
 
 TEST(Replay, OntoATopicOfAnotherTypeIsAClearError) {

@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "oscar/network.hpp"
+#include "oscar/process_util.hpp"
 #include "recorder.hpp"  // topic_of
 #include "replayer.hpp"
 
@@ -53,6 +54,7 @@ int main(int argc, char** argv) {
   app.add_flag("--step", o.step, "publish one message per Enter");
   app.add_option("--domain", o.domain, "DDS domain (default: $OSCAR_DOMAIN or 0)");
   CLI11_PARSE(app, argc, argv);
+  oscar::keep_cue_memory_in_process();
   try {
     if (app.count("--domain") == 0) o.domain = oscar::domain_from_env(0);
     if (!start.empty()) o.start = parse_time("--start", start);

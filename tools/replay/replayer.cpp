@@ -10,6 +10,7 @@
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 
+#include "lanes.hpp"
 #include "oscar/dds_participant.hpp"
 #include "oscar/mcap/reader.hpp"
 #include "raw_cdr_type.hpp"
@@ -117,36 +118,56 @@ ReplayCounters Replayer::run(const std::atomic<bool>& stop) {
   const std::uint64_t first = d.info.statistics.message_start_time;
   const std::uint64_t from = first + (d.o.start ? d.o.start->count() : 0);
   const std::uint64_t to = d.o.end ? first + d.o.end->count() : UINT64_MAX;
-  record::RawSample sample;
+  std::map<dds::DataWriter*, record::RawSample> samples;  // each used by its writer's lane only
+  for (const auto& [id, w] : d.writers) samples[w];
+  std::function<bool(const Pending&)> step;
+  if (d.o.step) {
+    step = [&](const Pending& p) {
+      fmt::print(stderr, "{}; Enter publishes it", p.label);
+      std::string line;
+      return static_cast<bool>(std::getline(std::cin, line));
+    };
+  }
+  // Reading runs up to 64 MB ahead of the publishing (a 1.7 MB chunk of images takes
+  // milliseconds to read and check), and each topic is published by a thread of its own.
+  Lanes lanes(begun, std::size_t{64} << 20, stop, step);
+  const auto scaled = [&](std::uint64_t ns) {
+    return std::chrono::nanoseconds(static_cast<std::int64_t>(static_cast<double>(ns) / d.o.rate));
+  };
+  std::chrono::nanoseconds pass_start{0};  // the replay's clock at the start of this pass
+  std::uint64_t read = 0;
   try {
     do {
-      const auto pass_start = Clock::now();
+      std::uint64_t last = from;
       d.reader.read_messages([&](const mcap::Channel& ch, const mcap::MessageView& m) {
-        if (stop) throw Stopped{};
         const auto w = d.writers.find(ch.id);
         if (w == d.writers.end() || m.log_time < from || m.log_time > to) return;
+        last = m.log_time;
+        Pending p;
+        p.lane = d.o.step ? nullptr : w->second;  // stepping: one lane, in file order
+        p.due = pass_start + scaled(m.log_time - from);
+        p.bytes.assign(m.data.begin(), m.data.end());
+        p.publish = [writer = w->second, sample = &samples[w->second]](auto& bytes) {
+          sample->bytes.swap(bytes);
+          writer->write(sample);
+        };
         if (d.o.step) {
-          fmt::print(stderr, "[{}] {} seq {} at +{:.3f} s; Enter publishes it", c.published + 1,
-                     ch.topic, m.sequence, (m.log_time - first) / 1e9);
-          std::string line;
-          if (!std::getline(std::cin, line)) throw Stopped{};
-        } else {
-          const auto due =
-              pass_start +
-              std::chrono::nanoseconds(static_cast<std::int64_t>((m.log_time - from) / d.o.rate));
-          std::this_thread::sleep_until(due);
+          p.label = fmt::format("[{}] {} seq {} at +{:.3f} s", read + 1, ch.topic, m.sequence,
+                                (m.log_time - first) / 1e9);
         }
-        sample.bytes.assign(m.data.begin(), m.data.end());
-        w->second->write(&sample);
-        ++c.published;
-        if (d.o.progress && c.published % 50 == 0) {
+        if (!lanes.add(std::move(p))) throw Stopped{};
+        if (d.o.progress && ++read % 50 == 0) {
           std::fprintf(stderr, "\r\033[K%llu published  +%.1f s",
-                       static_cast<unsigned long long>(c.published), (m.log_time - first) / 1e9);
+                       static_cast<unsigned long long>(lanes.published()),
+                       std::chrono::duration<double>(Clock::now() - begun).count());
         }
       });
+      pass_start += scaled(last - from);
     } while (d.o.loop && !stop);
   } catch (const Stopped&) {
   }
+  lanes.drain();
+  c.published = lanes.published();
   if (d.o.progress) std::fputs("\n", stderr);
   // Reliable writers: give late acknowledgements a moment before the participant goes.
   for (auto& [id, w] : d.writers) w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(2, 0));

@@ -4,6 +4,8 @@
 // (arrival - log time) against its median over all cues (the replay's start is a free shift).
 #include <algorithm>
 #include <cstdio>
+#include <map>
+#include <memory>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -17,6 +19,7 @@
 #include "idl_texts.hpp"       // tools/record
 #include "oscar/cue_type_info.hpp"
 #include "oscar/mcap/writer.hpp"
+#include "oscar/process_util.hpp"
 #include "process.hpp"  // tests/common
 #include "raw_tap.hpp"  // tools/inspect
 
@@ -103,31 +106,40 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 4));
   app.add_option("-d,--domain", domain, "DDS domain");
   CLI11_PARSE(app, argc, argv);
+  oscar::keep_cue_memory_in_process();  // it receives the images as a module would
   try {
     std::filesystem::create_directories(out_dir);
     const auto file = (std::filesystem::path(out_dir) / "bench_replay.mcap").string();
     const auto schedule = write_file(file, duration_s, cameras);
 
-    oscar::DdsParticipant participant(domain, "oscar-bench-replay");
+    std::set<std::string> topics;
+    for (const auto& [key, t] : schedule) topics.insert(key.first);
     std::mutex mutex;
     std::vector<std::tuple<std::string, std::uint64_t, std::uint64_t>> arrivals;
     arrivals.reserve(schedule.size());
-    oscar::inspect::RawTap tap(participant, [&](const std::string& topic, auto bytes, auto t) {
+    const auto arrived = [&](const std::string& topic, auto bytes, auto t) {
       const auto h = oscar::record::read_cue_header(bytes);
       std::lock_guard lock(mutex);
       arrivals.emplace_back(topic, h ? h->seq : 0, t);
-    });
+    };
+    // One participant per stream, as separate consumers of a real system have: each receives on
+    // its own thread, so the measurement itself does not queue a Bool behind four images.
+    std::vector<std::unique_ptr<oscar::DdsParticipant>> participants;
+    std::map<std::string, std::unique_ptr<oscar::inspect::RawTap>> taps;
+    for (const auto& t : topics) {
+      participants.push_back(
+          std::make_unique<oscar::DdsParticipant>(domain, "oscar-bench-replay " + t));
+      taps[t] = std::make_unique<oscar::inspect::RawTap>(*participants.back(), arrived);
+    }
     oscar::test::Process replay({(oscar::bench::own_dir() / "oscar-replay").string(), file,
                                  "--domain", std::to_string(domain)},
                                 file + ".log");
     // Subscribe as the replayer's writers appear (it waits for readers before it starts).
-    std::set<std::string> topics;
-    for (const auto& [key, t] : schedule) topics.insert(key.first);
     const auto until = std::chrono::steady_clock::now() + 10s;
     std::size_t subscribed = 0;
     while (subscribed < topics.size() && std::chrono::steady_clock::now() < until) {
       subscribed = 0;
-      for (const auto& t : topics) subscribed += tap.subscribe(t).empty() ? 0 : 1;
+      for (const auto& t : topics) subscribed += taps.at(t)->subscribe(t).empty() ? 0 : 1;
       std::this_thread::sleep_for(5ms);
     }
     if (subscribed < topics.size()) {

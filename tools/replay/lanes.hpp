@@ -1,0 +1,65 @@
+#pragma once
+// Lanes: publish replayed messages at their times, one thread per lane (a lane per topic), so
+// that a large image being written never holds back a small cue due meanwhile. The reading
+// thread queues messages up to a byte limit ahead of their publishing.
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace oscar::replay {
+
+/// A message read from the file, due `due` after the replay's start.
+struct Pending {
+  const void* lane = nullptr;  ///< messages with the same lane are published in order
+  std::chrono::nanoseconds due{0};
+  std::vector<std::uint8_t> bytes;
+  std::function<void(std::vector<std::uint8_t>&)> publish;  ///< called at the due time
+  std::string label;                                        ///< what step mode shows before it
+};
+
+class Lanes {
+ public:
+  using Clock = std::chrono::steady_clock;
+  /// `wait` replaces the wait for the due time (e.g. for Enter in step mode); it returns false to
+  /// stop the replay.
+  Lanes(Clock::time_point start, std::size_t ahead_bytes, const std::atomic<bool>& stop,
+        std::function<bool(const Pending&)> wait = {});
+  ~Lanes();  ///< stops every lane, published or not
+  Lanes(const Lanes&) = delete;
+  Lanes& operator=(const Lanes&) = delete;
+
+  /// Queues `p` on its lane; blocks while `ahead_bytes` are queued. False once the replay stops.
+  bool add(Pending p);
+  /// Waits until every lane has published what it was given (or the replay stopped).
+  void drain();
+  std::uint64_t published() const { return published_; }
+
+ private:
+  struct Lane;
+  void run(Lane& lane);
+  bool stopping() const { return stop_ || cancelled_; }
+
+  const Clock::time_point start_;
+  const std::size_t ahead_bytes_;
+  const std::atomic<bool>& stop_;
+  std::function<bool(const Pending&)> wait_;
+  std::mutex mutex_;
+  std::condition_variable space_;  ///< the reader waits for room here
+  std::map<const void*, std::unique_ptr<Lane>> lanes_;
+  std::size_t queued_bytes_ = 0;
+  bool closing_ = false;
+  std::atomic<bool> cancelled_{false};
+  std::atomic<std::uint64_t> published_{0};
+};
+
+}  // namespace oscar::replay
