@@ -14,7 +14,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
-#include "oscar/shared_memory.hpp"
+#include "participant_identity.hpp"
 
 namespace oscar {
 namespace dds = eprosima::fastdds::dds;
@@ -32,7 +32,7 @@ bool is_ipv4(const std::string& s) {
 std::uint32_t metatraffic_unicast_port(int domain, int participant) {
   return static_cast<std::uint32_t>(7400 + 250 * domain + 10 + 2 * participant);
 }
-// ... and the user unicast port (d3 = 11), the one shared memory listens on.
+// ... and the user unicast port (d3 = 11).
 std::uint32_t user_unicast_port(int domain, int participant) {
   return metatraffic_unicast_port(domain, participant) + 1;
 }
@@ -74,6 +74,16 @@ dds::DomainParticipantQos participant_qos(const std::string& name, const Network
   IPLocator::setIPv4(own, net.interfaces.front());
   own.port = metatraffic_unicast_port(domain, participant_id);
   builtin.metatrafficUnicastLocatorList.push_back(own);
+  // User data: UDP on every allowed interface, and shared memory on a port of this participant's
+  // own (participant_identity.hpp).
+  auto& user = qos.wire_protocol().default_unicast_locator_list;
+  for (const auto& address : net.interfaces) {
+    Locator_t l;
+    IPLocator::setIPv4(l, address);
+    l.port = user_unicast_port(domain, participant_id);
+    user.push_back(l);
+  }
+  if (net.shared_memory) user.push_back(internal::unique_shared_memory_locator());
   builtin.initialPeersList.clear();
   for (const auto& peer : net.peers) {
     for (int id = 0; id < net.max_participants_per_host; ++id) {
@@ -206,18 +216,21 @@ DdsParticipant::DdsParticipant(int domain, const std::string& name, const Networ
   if (network.interfaces.empty()) throw std::invalid_argument("network: no interface given");
   auto* factory = dds::DomainParticipantFactory::get_instance();
   dds::StatusMask mask = dds::StatusMask::none();
-  // The lowest free participant id, but not one whose shared-memory port a killed process left
-  // behind while another id is free: the others would keep sending into the dead port for up to
-  // 2 s (see shared_memory.hpp). Such an id is taken only when no other is left.
-  for (const bool avoid_zombies : {network.shared_memory, false}) {
-    for (int id = 0; id < network.max_participants_per_host && !participant_; ++id) {
-      if (!udp_port_free(network.interfaces.front(), metatraffic_unicast_port(domain, id)))
-        continue;
-      if (avoid_zombies && shared_memory_port_is_zombie(user_unicast_port(domain, id))) continue;
+  // The lowest id no other process has claimed (see participant_identity.hpp) and whose port
+  // nobody else (e.g. a plain Fast DDS program) has bound.
+  const auto& address = network.interfaces.front();
+  for (int id = 0; id < network.max_participants_per_host && !participant_; ++id) {
+    const int claim = internal::claim_participant_id(domain, address, id);
+    if (claim < 0) continue;
+    if (udp_port_free(address, metatraffic_unicast_port(domain, id))) {
       participant_ = factory->create_participant(domain, participant_qos(name, network, domain, id),
                                                  listener_.get(), mask);
     }
-    if (participant_) break;
+    if (participant_) {
+      id_claim_ = claim;
+    } else {
+      close(claim);
+    }
   }
   if (!participant_) {
     throw std::runtime_error(fmt::format(
@@ -234,6 +247,7 @@ DdsParticipant::~DdsParticipant() {
     participant_->delete_contained_entities();
     dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
   }
+  if (id_claim_ >= 0) close(id_claim_);
 }
 
 dds::Topic& DdsParticipant::topic(const std::string& name, dds::TopicDataType* type) {

@@ -27,11 +27,6 @@ bool abandoned(const std::filesystem::path& lock_file) {
 
 }  // namespace
 
-bool shared_memory_port_is_zombie(std::uint32_t port, const std::filesystem::path& dir) {
-  return abandoned(
-      dir / (std::string(kPrefix) + "port" + std::to_string(port) + std::string(kLockSuffix)));
-}
-
 DeadSharedMemorySweeper::DeadSharedMemorySweeper(Clock::duration grace, std::filesystem::path dir)
     : grace_(grace), dir_(std::move(dir)) {}
 

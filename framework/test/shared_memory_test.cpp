@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "oscar/dds_participant.hpp"
+#include "participant_identity.hpp"  // framework/src
 
 namespace oscar {
 namespace {
@@ -36,17 +37,6 @@ class SharedMemoryDir : public testing::Test {
   fs::path dir_;
   std::vector<int> held_;
 };
-
-TEST_F(SharedMemoryDir, APortIsAZombieWhenNobodyHoldsItsLock) {
-  touch("fastrtps_port7411");
-  touch("fastrtps_port7411_el");
-  touch("fastrtps_port7413");
-  touch("fastrtps_port7413_el");
-  hold("fastrtps_port7413_el");
-  EXPECT_TRUE(shared_memory_port_is_zombie(7411, dir_));
-  EXPECT_FALSE(shared_memory_port_is_zombie(7413, dir_)) << "its owner holds the lock";
-  EXPECT_FALSE(shared_memory_port_is_zombie(7415, dir_)) << "no such port";
-}
 
 TEST_F(SharedMemoryDir, RemovesOnlyWhatDeadProcessesLeft) {
   for (const auto* name : {"fastrtps_0123456789abcdef", "fastrtps_port7411", "fastrtps_live",
@@ -86,21 +76,45 @@ TEST_F(SharedMemoryDir, TheGraceStartsWhenTheOwnerIsSeenGone) {
   EXPECT_FALSE(fs::exists(dir_ / "fastrtps_port7411_el"));
 }
 
-// A participant does not take over the participant id whose shared-memory port a killed process
-// left behind: the others would send into the dead port (the restart benchmark lost 1-2 s).
-TEST(DdsParticipantId, SkipsAnIdWhoseSharedMemoryPortIsAZombie) {
+TEST(ParticipantIdentity, AnIdIsClaimedOnceUntilReleased) {
   const int domain = 150 + getpid() % 50;
-  const auto user_port = [&](int id) { return 7400 + 250 * domain + 11 + 2 * id; };
-  const fs::path lock = "/dev/shm/fastrtps_port" + std::to_string(user_port(0)) + "_el";
-  if (!fs::is_directory("/dev/shm") || fs::exists(lock)) GTEST_SKIP() << "/dev/shm not usable";
-  std::ofstream(lock) << "";
-  {
-    DdsParticipant p(domain, "zombie-neighbour");
-    EXPECT_EQ(p.get().get_qos().wire_protocol().participant_id, 1);
-  }
-  fs::remove(lock);
-  DdsParticipant p(domain, "clean");
-  EXPECT_EQ(p.get().get_qos().wire_protocol().participant_id, 0);
+  const int first = internal::claim_participant_id(domain, "127.0.0.1", 3);
+  ASSERT_GE(first, 0);
+  EXPECT_LT(internal::claim_participant_id(domain, "127.0.0.1", 3), 0) << "held";
+  const int other = internal::claim_participant_id(domain, "10.77.1.2", 3);
+  EXPECT_GE(other, 0) << "ids are per address (test hosts have their own ports)";
+  close(first);
+  close(other);
+  const int again = internal::claim_participant_id(domain, "127.0.0.1", 3);
+  EXPECT_GE(again, 0) << "released";
+  close(again);
+}
+
+TEST(ParticipantIdentity, SharedMemoryPortsAreNeverReused) {
+  const auto a = internal::unique_shared_memory_locator();
+  const auto b = internal::unique_shared_memory_locator();
+  EXPECT_EQ(a.kind, LOCATOR_KIND_SHM);
+  EXPECT_EQ(a.address[0], 'U');
+  EXPECT_NE(a.port, b.port);
+  EXPECT_GE(a.port, 1u << 24) << "clear of the RTPS well-known ports";
+  EXPECT_EQ((a.port - (1u << 24)) >> 4, static_cast<std::uint32_t>(getpid()));
+}
+
+// Fast DDS takes the locator: the participant listens on its own port, named after this process.
+TEST(ParticipantIdentity, AParticipantListensOnItsOwnSharedMemoryPort) {
+  const auto ours = [] {
+    int n = 0;
+    for (const auto& e : fs::directory_iterator("/dev/shm")) {
+      const auto name = e.path().filename().string();
+      if (!name.starts_with("fastrtps_port") || name.ends_with("_el")) continue;
+      const auto port = std::stoull(name.substr(13));
+      if (port >= (1u << 24) && ((port - (1u << 24)) >> 4) == static_cast<unsigned>(getpid())) ++n;
+    }
+    return n;
+  };
+  const int before = ours();
+  DdsParticipant p(150 + getpid() % 50, "own-port");
+  EXPECT_EQ(ours(), before + 1);
 }
 
 }  // namespace

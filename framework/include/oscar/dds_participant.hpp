@@ -52,6 +52,7 @@ class DdsParticipant {
   int domain_;
   std::unique_ptr<Listener> listener_;
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
+  int id_claim_ = -1;  ///< lock file held while the participant id is ours
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
   std::mutex mutex_;

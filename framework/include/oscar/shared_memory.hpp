@@ -2,13 +2,9 @@
 /// @file Housekeeping of Fast DDS's shared-memory transport files in /dev/shm.
 ///
 /// A process killed with SIGKILL leaves its shared-memory segments and its listening port
-/// behind ("zombies": the lock file beside them is no longer held). Two things follow, and this
-/// file handles both:
-/// - A participant that takes over the dead one's participant id would listen on the same port,
-///   while the other processes still push into their mapping of the old port until Fast DDS's
-///   watchdog notices, 1–2 s later. DdsParticipant therefore avoids ids whose port is a zombie.
-/// - The files stay in /dev/shm (memory) until someone removes them; every monitor sweeps them
-///   a few seconds after their owner died.
+/// behind (the lock file beside them is no longer held). They stay in /dev/shm, in memory, until
+/// someone removes them; every monitor sweeps them a few seconds after their owner died. (No new
+/// participant ever listens on a dead one's port: see framework/src/participant_identity.hpp.)
 
 #include <chrono>
 #include <cstddef>
@@ -18,11 +14,6 @@
 #include <string>
 
 namespace oscar {
-
-/// True if the shared-memory port `port` (a participant's user unicast port) was left behind by
-/// a process that died without closing it.
-bool shared_memory_port_is_zombie(std::uint32_t port,
-                                  const std::filesystem::path& dir = "/dev/shm");
 
 /// Removes the shared-memory segments and ports of Fast DDS processes that are gone (those whose
 /// lock file nobody holds), but only once they have been seen dead for `grace`: other processes

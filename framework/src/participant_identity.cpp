@@ -1,0 +1,63 @@
+#include "participant_identity.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <atomic>
+
+#include <fastrtps/utils/IPFinder.h>
+#include <fastrtps/utils/md5.h>
+#include <fmt/format.h>
+
+namespace oscar::internal {
+using eprosima::fastrtps::rtps::IPFinder;
+using eprosima::fastrtps::rtps::Locator_t;
+using eprosima::fastrtps::rtps::LocatorList_t;
+
+int claim_participant_id(int domain, const std::string& address, int id) {
+  const auto path = fmt::format("/dev/shm/oscar_participant_d{}_{}_{}", domain, address, id);
+  const int fd = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+  if (fd < 0) return -1;
+  if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+namespace {
+
+// Fast DDS sends by shared memory only to locators of its own host, which it recognises by a
+// 16-bit host id in the locator's address: the MD5 digest of the host's IPv4 addresses (in the
+// order its IPFinder lists them), folded into 16 bits; 127, 1 if it has none.
+std::uint16_t fast_dds_host_id() {
+  LocatorList_t addresses;
+  IPFinder::getIP4Address(&addresses);
+  if (addresses.empty()) return 127 | 1 << 8;
+  MD5 md5;
+  for (const auto& a : addresses) md5.update(a.address, sizeof a.address);
+  md5.finalize();
+  std::uint16_t id = 0;
+  for (std::size_t i = 0; i < sizeof md5.digest; i += 2) {
+    id ^= static_cast<std::uint16_t>(md5.digest[i] << 8 | md5.digest[i + 1]);
+  }
+  return id;
+}
+
+}  // namespace
+
+Locator_t unique_shared_memory_locator() {
+  static const std::uint16_t host = fast_dds_host_id();
+  static std::atomic<std::uint32_t> created{0};
+  Locator_t l;
+  l.kind = LOCATOR_KIND_SHM;
+  // Above every RTPS well-known port; pids are below 2^22, 16 participants per process.
+  l.port = (1u << 24) + (static_cast<std::uint32_t>(getpid()) << 4) + created++ % 16;
+  l.address[0] = 'U';  // unicast
+  l.address[1] = static_cast<eprosima::fastrtps::rtps::octet>(host);
+  l.address[2] = static_cast<eprosima::fastrtps::rtps::octet>(host >> 8);
+  return l;
+}
+
+}  // namespace oscar::internal
