@@ -220,17 +220,11 @@ DdsParticipant::DdsParticipant(int domain, const std::string& name, const Networ
   // nobody else (e.g. a plain Fast DDS program) has bound.
   const auto& address = network.interfaces.front();
   for (int id = 0; id < network.max_participants_per_host && !participant_; ++id) {
-    const int claim = internal::claim_participant_id(domain, address, id);
-    if (claim < 0) continue;
-    if (udp_port_free(address, metatraffic_unicast_port(domain, id))) {
-      participant_ = factory->create_participant(domain, participant_qos(name, network, domain, id),
-                                                 listener_.get(), mask);
-    }
-    if (participant_) {
-      id_claim_ = claim;
-    } else {
-      close(claim);
-    }
+    auto claim = std::make_unique<internal::ParticipantIdClaim>(domain, address, id);
+    if (!*claim || !udp_port_free(address, metatraffic_unicast_port(domain, id))) continue;
+    participant_ = factory->create_participant(domain, participant_qos(name, network, domain, id),
+                                               listener_.get(), mask);
+    if (participant_) id_claim_ = std::move(claim);
   }
   if (!participant_) {
     throw std::runtime_error(fmt::format(
@@ -247,7 +241,6 @@ DdsParticipant::~DdsParticipant() {
     participant_->delete_contained_entities();
     dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
   }
-  if (id_claim_ >= 0) close(id_claim_);
 }
 
 dds::Topic& DdsParticipant::topic(const std::string& name, dds::TopicDataType* type) {

@@ -2,9 +2,11 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <utility>
 
 #include <fastrtps/utils/IPFinder.h>
 #include <fastrtps/utils/md5.h>
@@ -15,15 +17,44 @@ using eprosima::fastrtps::rtps::IPFinder;
 using eprosima::fastrtps::rtps::Locator_t;
 using eprosima::fastrtps::rtps::LocatorList_t;
 
-int claim_participant_id(int domain, const std::string& address, int id) {
-  const auto path = fmt::format("/dev/shm/oscar_participant_d{}_{}_{}", domain, address, id);
-  const int fd = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
-  if (fd < 0) return -1;
-  if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+ParticipantIdClaim::ParticipantIdClaim(int domain, const std::string& address, int id)
+    : path_(fmt::format("/dev/shm/oscar_participant_d{}_{}_{}", domain, address, id)) {
+  for (;;) {
+    const int fd = open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+    if (fd < 0) return;
+    if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+      close(fd);
+      return;
+    }
+    // The holder before us may have removed the file between our open and our lock: then the
+    // lock is on a file nobody else will look at, and the claim is tried again.
+    struct stat held {
+    }, named{};
+    if (fstat(fd, &held) == 0 && stat(path_.c_str(), &named) == 0 && held.st_ino == named.st_ino &&
+        held.st_dev == named.st_dev) {
+      fd_ = fd;
+      return;
+    }
     close(fd);
-    return -1;
   }
-  return fd;
+}
+
+ParticipantIdClaim::~ParticipantIdClaim() {
+  if (fd_ < 0) return;
+  unlink(path_.c_str());  // while still holding the lock: see the constructor
+  close(fd_);
+}
+
+ParticipantIdClaim::ParticipantIdClaim(ParticipantIdClaim&& other) noexcept
+    : path_(std::move(other.path_)), fd_(std::exchange(other.fd_, -1)) {}
+
+ParticipantIdClaim& ParticipantIdClaim::operator=(ParticipantIdClaim&& other) noexcept {
+  if (this != &other) {
+    this->~ParticipantIdClaim();
+    path_ = std::move(other.path_);
+    fd_ = std::exchange(other.fd_, -1);
+  }
+  return *this;
 }
 
 namespace {

@@ -17,9 +17,21 @@
 
 namespace oscar::internal {
 
-/// Claims `id` of `domain` on `address` for this process; returns the held lock's file
-/// descriptor, or -1 if another living process holds it. close() releases it.
-int claim_participant_id(int domain, const std::string& address, int id);
+/// `id` of `domain` on `address`, claimed by this process for as long as the object lives (a
+/// lock file that the kernel releases when the process dies; removed on an orderly release).
+class ParticipantIdClaim {
+ public:
+  /// Claims it, or returns a claim that holds nothing if another living process holds it.
+  ParticipantIdClaim(int domain, const std::string& address, int id);
+  ~ParticipantIdClaim();
+  ParticipantIdClaim(ParticipantIdClaim&& other) noexcept;
+  ParticipantIdClaim& operator=(ParticipantIdClaim&& other) noexcept;
+  explicit operator bool() const { return fd_ >= 0; }
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+};
 
 /// A shared-memory locator of this host with a port that no other participant has used.
 eprosima::fastrtps::rtps::Locator_t unique_shared_memory_locator();

@@ -6,6 +6,7 @@
 
 #include <fstream>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "oscar/dds_participant.hpp"
@@ -78,16 +79,29 @@ TEST_F(SharedMemoryDir, TheGraceStartsWhenTheOwnerIsSeenGone) {
 
 TEST(ParticipantIdentity, AnIdIsClaimedOnceUntilReleased) {
   const int domain = 150 + getpid() % 50;
-  const int first = internal::claim_participant_id(domain, "127.0.0.1", 3);
-  ASSERT_GE(first, 0);
-  EXPECT_LT(internal::claim_participant_id(domain, "127.0.0.1", 3), 0) << "held";
-  const int other = internal::claim_participant_id(domain, "10.77.1.2", 3);
-  EXPECT_GE(other, 0) << "ids are per address (test hosts have their own ports)";
-  close(first);
-  close(other);
-  const int again = internal::claim_participant_id(domain, "127.0.0.1", 3);
-  EXPECT_GE(again, 0) << "released";
-  close(again);
+  const auto file = fs::path("/dev/shm") / fmt::format("oscar_participant_d{}_127.0.0.1_3", domain);
+  {
+    internal::ParticipantIdClaim first(domain, "127.0.0.1", 3);
+    ASSERT_TRUE(first);
+    EXPECT_TRUE(fs::exists(file));
+    EXPECT_FALSE(internal::ParticipantIdClaim(domain, "127.0.0.1", 3)) << "held";
+    EXPECT_TRUE(internal::ParticipantIdClaim(domain, "10.77.1.2", 3))
+        << "ids are per address (test hosts have their own ports)";
+  }
+  EXPECT_FALSE(fs::exists(file)) << "an orderly release leaves no file behind";
+  EXPECT_TRUE(internal::ParticipantIdClaim(domain, "127.0.0.1", 3)) << "released";
+}
+
+// What a killed holder leaves: a lock file nobody holds. The next claim takes it over.
+TEST(ParticipantIdentity, TheIdOfAKilledProcessIsFreeAgain) {
+  const int domain = 150 + getpid() % 50;
+  const auto file = fs::path("/dev/shm") / fmt::format("oscar_participant_d{}_127.0.0.1_4", domain);
+  std::ofstream(file) << "";
+  {
+    internal::ParticipantIdClaim claim(domain, "127.0.0.1", 4);
+    EXPECT_TRUE(claim);
+  }
+  EXPECT_FALSE(fs::exists(file));
 }
 
 TEST(ParticipantIdentity, SharedMemoryPortsAreNeverReused) {

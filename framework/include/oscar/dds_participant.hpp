@@ -18,6 +18,9 @@
 #include "oscar/network.hpp"
 
 namespace oscar {
+namespace internal {
+class ParticipantIdClaim;
+}
 
 class DdsParticipant {
  public:
@@ -52,7 +55,7 @@ class DdsParticipant {
   int domain_;
   std::unique_ptr<Listener> listener_;
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
-  int id_claim_ = -1;  ///< lock file held while the participant id is ours
+  std::unique_ptr<internal::ParticipantIdClaim> id_claim_;  ///< released after the participant
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
   std::mutex mutex_;
