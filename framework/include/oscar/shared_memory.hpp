@@ -8,7 +8,6 @@
 
 #include <chrono>
 #include <cstddef>
-#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -16,10 +15,9 @@
 namespace oscar {
 
 /// Removes the shared-memory segments and ports of Fast DDS processes that are gone (those whose
-/// lock file nobody holds), but only once they have been seen dead for `grace`: other processes
-/// still send into a dead port until they have let go of its participant (its discovery lease,
-/// plus Fast DDS's port watchdog), and a new participant must not open a fresh port under that
-/// id before. Call sweep() now and then (the monitor does every second).
+/// lock file nobody holds), but only once they have been seen dead for `grace`: until then other
+/// processes may still send to the dead participant (its discovery lease, plus Fast DDS's port
+/// watchdog). Call sweep() now and then (the monitor does every second).
 class DeadSharedMemorySweeper {
  public:
   using Clock = std::chrono::steady_clock;
