@@ -109,13 +109,17 @@ kernels:
 )");
   auto& in = dynamic_cast<test::CollectImage&>(consumer->kernel("sink").kernel()).in_;
   std::shared_ptr<const GvImage> image;
+  // A prefetch that waited for the producer would hand back an answered future; the answer (an
+  // image, a round trip through DDS) cannot be there the instant a non-blocking prefetch returns.
+  // (Not timed: a time bound failed under TSan.)
+  bool returned_before_answer = false;
   ASSERT_TRUE(eventually([&] {
-    const auto started = std::chrono::steady_clock::now();
     auto future = in.prefetch();
-    EXPECT_LT(std::chrono::steady_clock::now() - started, 5ms) << "prefetch does not block";
+    returned_before_answer = returned_before_answer || !future.ready();
     image = future.get(1s);
     return image != nullptr;
   }));
+  EXPECT_TRUE(returned_before_answer) << "prefetch returns before the producer's answer";
   EXPECT_EQ(image->image().size(), 768u * 576u);
   EXPECT_EQ(image->dx(), 768);
 }
@@ -125,8 +129,10 @@ TEST(CueFlow, RewireMidStreamLosesNothingAfterTheSwitch) {
   auto b = run("b", {"-k", "bench_source:b", "-m", "continuous:3ms"});
   auto consumer = local_module(R"(
 name: consumer
-kernels: [ { type: test_collect, name: sink, inputs: { in: a/out } } ]
+kernels: [ { type: test_collect, name: sink, inputs: { in: { source: a/out, depth: 512 } } } ]
 )");
+  // (depth 512: under TSan the collector fell 16 cues behind b's 3 ms cycle and its reader's
+  // history dropped some; what is checked here is the rewire, not how fast the collector takes.)
   // A second consumer that can ask b's ring afterwards which cue b had published at the switch.
   auto probe = local_module(R"(
 name: probe
