@@ -259,7 +259,7 @@ void Module::rewire(Slot& slot, const std::string& input_name, const std::string
     if (dds_) dds_->disconnect_input(*input);
     output->connect(input);
   } else if (dds_) {
-    dds_->connect_input(*input, source);  // waits until the new source is matched
+    dds_->connect_input(*input, source, /*switching=*/true);  // the new source is matched
   } else {
     throw std::invalid_argument(fmt::format(
         "source '{}' is not in module '{}' and the module runs without DDS", source, spec_.name));

@@ -80,7 +80,10 @@ class Module::Dds::CueReader final : public dds::DataReaderListener {
     for (;;) {
       auto cue = input_.type().make();
       if (reader->take_next_sample(cue.get(), &info) != ReturnCode_t::RETCODE_OK) break;
-      if (info.valid_data) input_.deliver(std::move(cue));
+      if (info.valid_data) {
+        input_.deliver(std::move(cue));
+        received_ = true;
+      }
     }
   }
   void on_subscription_matched(dds::DataReader*,
@@ -94,9 +97,18 @@ class Module::Dds::CueReader final : public dds::DataReaderListener {
     }
     return matched_.load() > 0;
   }
+  /// Waits up to `timeout` for the first cue: once one came, the producer's writer has matched
+  /// this reader too, so every cue it publishes from then on arrives.
+  void wait_first_cue(std::chrono::milliseconds timeout) const {
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    while (!received_.load() && std::chrono::steady_clock::now() < until) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  }
   dds::DataReader* reader_ = nullptr;
 
  private:
+  std::atomic<bool> received_{false};
   InputPort& input_;
   std::atomic<int> matched_{0};
 };
@@ -147,7 +159,7 @@ void Module::Dds::wire_outputs(std::vector<std::unique_ptr<Slot>>& slots) {
   }
 }
 
-void Module::Dds::connect_input(InputPort& input, const std::string& source) {
+void Module::Dds::connect_input(InputPort& input, const std::string& source, bool switching) {
   if (input.transfer() != Transfer::kPush) {
     auto puller = std::make_shared<internal::DdsPullSource>(
         participant_, input, source,
@@ -165,6 +177,11 @@ void Module::Dds::connect_input(InputPort& input, const std::string& source) {
   if (!reader->wait_matched(std::chrono::milliseconds(2000))) {
     module_.log_->warn("input {}/{}: no publisher of {} matched yet; cues arrive once it appears",
                        input.kernel(), input.name(), cue_topic(source));
+  } else if (switching) {
+    // Matching is seen by each side on its own: until the producer's writer has matched this
+    // reader too, what it publishes does not come here. Its first cue shows it has (a producer
+    // slower than this waits the bound, and its next cue may come from before the match).
+    reader->wait_first_cue(std::chrono::milliseconds(200));
   }
   std::unique_ptr<CueReader> old;
   {

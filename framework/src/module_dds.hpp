@@ -33,7 +33,9 @@ class Module::Dds {
   void wire_outputs(std::vector<std::unique_ptr<Slot>>& slots);
   /// Subscribes the input to a remote source, replacing any earlier subscription once the new
   /// one is matched (so nothing the new source publishes after the switch is lost).
-  void connect_input(InputPort& input, const std::string& source);
+  /// Connects `input` to `source` and waits until it is matched; a rewire (`switching`) also
+  /// waits for the source's first cue (at most 200 ms), so nothing published later is lost.
+  void connect_input(InputPort& input, const std::string& source, bool switching = false);
   void disconnect_input(InputPort& input);
   void start_config();
   void stop_config();
