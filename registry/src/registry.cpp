@@ -48,13 +48,7 @@ void Registry::run() {
     wake_.wait_for(lock, std::chrono::milliseconds(10),
                    [&] { return stop_requested_ || !events_.empty(); });
     if (stop_requested_) break;
-    while (!events_.empty()) {
-      auto event = std::move(events_.front());
-      events_.pop_front();
-      lock.unlock();
-      event();
-      lock.lock();
-    }
+    run_events(lock);
     if (shutting_down_) break;
     lock.unlock();
     tick();
@@ -62,6 +56,16 @@ void Registry::run() {
   }
   lock.unlock();
   shutdown();
+}
+
+void Registry::run_events(std::unique_lock<std::mutex>& lock) {
+  while (!events_.empty()) {
+    auto event = std::move(events_.front());
+    events_.pop_front();
+    lock.unlock();
+    event();
+    lock.lock();
+  }
 }
 
 Registry::Tracked* Registry::find(const std::string& name) {

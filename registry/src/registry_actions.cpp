@@ -205,13 +205,7 @@ void Registry::shutdown() {
     std::unique_lock lock(mutex_);
     while (!m.process_gone && mon.alive && Clock::now() < until) {
       wake_.wait_for(lock, std::chrono::milliseconds(10), [&] { return !events_.empty(); });
-      while (!events_.empty()) {
-        auto event = std::move(events_.front());
-        events_.pop_front();
-        lock.unlock();
-        event();
-        lock.lock();
-      }
+      run_events(lock);
     }
     m.status = "stopped";
   }

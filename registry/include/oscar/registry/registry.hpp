@@ -55,6 +55,8 @@ class Registry {
   void on_module_lost(const std::string& module, unsigned incarnation);
   void on_request(const RegistryRequest& request);
   void tick();
+  /// Runs the queued events, each without holding `lock` (on mutex_).
+  void run_events(std::unique_lock<std::mutex>& lock);
 
   void fail(Tracked& m, const std::string& reason, bool process_gone);
   void launch(Tracked& m, unsigned incarnation);
