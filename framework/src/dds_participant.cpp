@@ -14,27 +14,21 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/log/Log.hpp>
 #include "participant_identity.hpp"
 
 namespace oscar {
 namespace dds = eprosima::fastdds::dds;
 using eprosima::fastrtps::rtps::IPLocator;
 using eprosima::fastrtps::rtps::Locator_t;
+using internal::metatraffic_unicast_port;
+using internal::user_unicast_port;
 
 namespace {
 
 bool is_ipv4(const std::string& s) {
   in_addr a{};
   return inet_pton(AF_INET, s.c_str(), &a) == 1;
-}
-
-// RTPS well-known ports (spec 9.6.1.1): PB + DG * domain + d1 + PG * participant.
-std::uint32_t metatraffic_unicast_port(int domain, int participant) {
-  return static_cast<std::uint32_t>(7400 + 250 * domain + 10 + 2 * participant);
-}
-// ... and the user unicast port (d3 = 11).
-std::uint32_t user_unicast_port(int domain, int participant) {
-  return metatraffic_unicast_port(domain, participant) + 1;
 }
 
 // True if nobody on this host has bound the UDP port on that address.
@@ -62,6 +56,11 @@ dds::DomainParticipantQos participant_qos(const std::string& name, const Network
   if (net.shared_memory) {
     auto shm = std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>();
     shm->segment_size(net.shm_segment_bytes);
+    // Fast DDS opens a port while holding the participant's lock on all sending, and waits up to
+    // a third of this for the port's listener to show it is alive (1 s by default: a sender
+    // stalled for up to 333 ms, heartbeats included, whenever it first sent to a quiet port;
+    // `oscar bench restart` saw healthy modules declared hung). 300 ms keeps that below 100 ms.
+    shm->healthy_check_timeout_ms(300);
     transport.user_transports.push_back(shm);
   }
   auto& builtin = qos.wire_protocol().builtin;
@@ -170,6 +169,22 @@ int domain_from_env(int fallback) {
   return static_cast<int>(d);
 }
 
+void dds_log_level_from_env() {
+  using eprosima::fastdds::dds::Log;
+  const char* env = std::getenv("OSCAR_DDS_LOG");
+  const std::string level = env ? env : "error";
+  if (level == "error") {
+    Log::SetVerbosity(Log::Error);
+  } else if (level == "warning") {
+    Log::SetVerbosity(Log::Warning);
+  } else if (level == "info") {
+    Log::SetVerbosity(Log::Info);
+  } else {
+    throw std::invalid_argument(
+        fmt::format("OSCAR_DDS_LOG='{}': expected error, warning or info", level));
+  }
+}
+
 class DdsParticipant::Listener final : public dds::DomainParticipantListener {
  public:
   void on_publisher_discovery(dds::DomainParticipant*,
@@ -215,6 +230,7 @@ DdsParticipant::DdsParticipant(int domain, const std::string& name, const Networ
     : domain_(domain), listener_(std::make_unique<Listener>()) {
   if (network.interfaces.empty()) throw std::invalid_argument("network: no interface given");
   auto* factory = dds::DomainParticipantFactory::get_instance();
+  dds_log_level_from_env();
   dds::StatusMask mask = dds::StatusMask::none();
   // The lowest id no other process has claimed (see participant_identity.hpp) and whose port
   // nobody else (e.g. a plain Fast DDS program) has bound.
@@ -224,7 +240,10 @@ DdsParticipant::DdsParticipant(int domain, const std::string& name, const Networ
     if (!*claim || !udp_port_free(address, metatraffic_unicast_port(domain, id))) continue;
     participant_ = factory->create_participant(domain, participant_qos(name, network, domain, id),
                                                listener_.get(), mask);
-    if (participant_) id_claim_ = std::move(claim);
+    if (participant_) {
+      claim->record(participant_->guid().guidPrefix);
+      id_claim_ = std::move(claim);
+    }
   }
   if (!participant_) {
     throw std::runtime_error(fmt::format(

@@ -33,4 +33,9 @@ struct NetworkConfig {
 /// The domain id from $OSCAR_DOMAIN, else `fallback`.
 int domain_from_env(int fallback);
 
+/// Sets Fast DDS's own log level from $OSCAR_DDS_LOG: `error` (Fast DDS's default), `warning`
+/// or `info` (the latter only in Fast DDS debug builds). Every DdsParticipant applies it.
+/// @throws std::invalid_argument for any other value.
+void dds_log_level_from_env();
+
 }  // namespace oscar
