@@ -45,9 +45,9 @@ std::size_t DeadSharedMemorySweeper::sweep(Clock::time_point now) {
       continue;
     }
     std::error_code ignore;
-    if (std::filesystem::remove(dir_ / name.substr(0, name.size() - kLockSuffix.size()), ignore)) {
-      ++removed;
-    }
+    const auto owned = name.substr(0, name.size() - kLockSuffix.size());
+    if (std::filesystem::remove(dir_ / owned, ignore)) ++removed;
+    std::filesystem::remove(dir_ / ("sem." + owned + "_mutex"), ignore);  // a port's lock
     std::filesystem::remove(entry.path(), ignore);
   }
   dead_since_ = std::move(still_dead);  // a name reused by a living owner is forgotten

@@ -1,8 +1,14 @@
 #include "oscar/shared_memory.hpp"
 
 #include <fcntl.h>
+#include <pthread.h>
+#include <semaphore.h>
 #include <sys/file.h>
+#include <sys/mman.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <ctime>
 
 #include <fstream>
 
@@ -75,6 +81,193 @@ TEST_F(SharedMemoryDir, TheGraceStartsWhenTheOwnerIsSeenGone) {
   EXPECT_EQ(sweeper.sweep(t0 + 10s), 0u) << "its files live on for the grace";
   EXPECT_EQ(sweeper.sweep(t0 + 15s), 1u);
   EXPECT_FALSE(fs::exists(dir_ / "fastrtps_port7411_el"));
+}
+
+// A lock shaped like Fast DDS's port locks (a named POSIX semaphore), under a name of this test.
+class PortLock : public testing::Test {
+ protected:
+  void SetUp() override {
+    prefix_ = fmt::format("oscar_test{}_", getpid());
+    name_ = prefix_ + "port7411_mutex";
+    sem_unlink(("/" + name_).c_str());
+    sem_ = sem_open(("/" + name_).c_str(), O_CREAT | O_EXCL, 0600, 1);
+    ASSERT_NE(sem_, SEM_FAILED);
+  }
+  void TearDown() override {
+    for (const pid_t child : children_) kill(child, SIGKILL), waitpid(child, nullptr, 0);
+    if (sem_ != SEM_FAILED) sem_close(sem_);
+    sem_unlink(("/" + name_).c_str());
+  }
+  // A child that takes the lock and then dies (`die`) or keeps it.
+  pid_t holder(bool die) {
+    const pid_t child = fork();
+    if (child == 0) {
+      sem_wait(sem_);
+      if (die) _exit(0);
+      pause();
+      _exit(0);
+    }
+    if (!die) children_.push_back(child);
+    return child;
+  }
+  // A child that waits up to 10 s for the lock; exits 0 if it got it.
+  pid_t waiter() {
+    const pid_t child = fork();
+    if (child == 0) {
+      timespec deadline{};
+      clock_gettime(CLOCK_REALTIME, &deadline);
+      deadline.tv_sec += 10;
+      _exit(sem_timedwait(sem_, &deadline) == 0 ? 0 : 1);
+    }
+    return child;
+  }
+  // This process lets go of its own mapping: only the children's count.
+  void let_go() {
+    sem_close(sem_);
+    sem_ = SEM_FAILED;
+  }
+  int value() {
+    sem_t* s = sem_open(("/" + name_).c_str(), 0);
+    int v = -1;
+    sem_getvalue(s, &v);
+    sem_close(s);
+    return v;
+  }
+  static void settle() { usleep(50000); }  // a forked child reaches its wait
+  std::string prefix_, name_;
+  sem_t* sem_ = SEM_FAILED;
+  std::vector<pid_t> children_;
+};
+
+TEST_F(PortLock, ALockWhoseHolderDiedIsGivenBack) {
+  waitpid(holder(true), nullptr, 0);
+  let_go();
+  OrphanedPortLocks locks(prefix_);
+  EXPECT_EQ(locks.note_taken(), 1u);
+  EXPECT_EQ(locks.release(), std::vector<std::string>{name_});
+  EXPECT_EQ(value(), 1);
+  EXPECT_TRUE(locks.empty());
+}
+
+TEST_F(PortLock, AWaiterGetsTheLockOfADeadHolder) {
+  waitpid(holder(true), nullptr, 0);
+  const pid_t w = waiter();
+  let_go();
+  settle();
+  OrphanedPortLocks locks(prefix_);
+  ASSERT_EQ(locks.note_taken(), 1u);
+  EXPECT_EQ(locks.release(), std::vector<std::string>{name_});
+  int status = -1;
+  waitpid(w, &status, 0);
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "the waiter got the lock";
+}
+
+TEST_F(PortLock, ALockHeldByALivingProcessIsLeftAlone) {
+  holder(false);
+  settle();  // the holder has it before the waiter comes
+  const pid_t w = waiter();
+  children_.push_back(w);
+  let_go();
+  settle();
+  OrphanedPortLocks locks(prefix_);
+  ASSERT_EQ(locks.note_taken(), 1u);
+  EXPECT_TRUE(locks.release().empty());
+  EXPECT_FALSE(locks.empty()) << "still watched: its holder may die yet";
+  EXPECT_EQ(value(), 0);
+  kill(children_.front(), SIGKILL);  // now it dies holding it
+  waitpid(children_.front(), nullptr, 0);
+  children_.erase(children_.begin());
+  EXPECT_EQ(locks.release(), std::vector<std::string>{name_});
+}
+
+TEST_F(PortLock, AFreeLockIsNotNoted) {
+  OrphanedPortLocks locks(prefix_);
+  EXPECT_EQ(locks.note_taken(), 0u);
+  EXPECT_TRUE(locks.release().empty());
+  EXPECT_EQ(value(), 1);
+}
+
+// A port segment with a process-shared mutex in it, as Boost lays one out.
+class PortSegment : public SharedMemoryDir {
+ protected:
+  void SetUp() override {
+    SharedMemoryDir::SetUp();
+    const auto file = dir_ / "testport7411";
+    fd_ = open(file.c_str(), O_RDWR | O_CREAT, 0600);
+    ASSERT_GE(fd_, 0);
+    ASSERT_EQ(ftruncate(fd_, 4096), 0);
+    map_ = mmap(nullptr, 4096, PROT_READ | PROT_WRITE, MAP_SHARED, fd_, 0);
+    ASSERT_NE(map_, MAP_FAILED);
+    pthread_mutexattr_t attr;
+    pthread_mutexattr_init(&attr);
+    pthread_mutexattr_setpshared(&attr, PTHREAD_PROCESS_SHARED);
+    pthread_mutex_init(mutex(), &attr);
+    pthread_mutexattr_destroy(&attr);
+  }
+  void TearDown() override {
+    munmap(map_, 4096);
+    close(fd_);
+    SharedMemoryDir::TearDown();
+  }
+  pthread_mutex_t* mutex() {
+    return reinterpret_cast<pthread_mutex_t*>(static_cast<char*>(map_) + 64);
+  }
+  // A child that locks the mutex and dies (or lives on, holding it, until killed).
+  pid_t locker(bool die) {
+    const pid_t child = fork();
+    if (child == 0) {
+      pthread_mutex_lock(mutex());
+      if (!die) pause();
+      _exit(0);
+    }
+    usleep(50000);
+    return child;
+  }
+  int fd_ = -1;
+  void* map_ = nullptr;
+};
+
+TEST_F(PortSegment, AMutexWhoseOwnerDiedIsUnlocked) {
+  waitpid(locker(true), nullptr, 0);
+  ASSERT_EQ(pthread_mutex_trylock(mutex()), EBUSY) << "left locked by the dead child";
+  EXPECT_EQ(release_mutexes_of_dead_threads(dir_, "testport"),
+            std::vector<std::string>{"testport7411"});
+  EXPECT_EQ(pthread_mutex_trylock(mutex()), 0);
+  pthread_mutex_unlock(mutex());
+}
+
+TEST_F(PortSegment, AMutexOfALivingThreadIsLeftAlone) {
+  const pid_t child = locker(false);
+  EXPECT_TRUE(release_mutexes_of_dead_threads(dir_, "testport").empty());
+  EXPECT_EQ(pthread_mutex_trylock(mutex()), EBUSY);
+  kill(child, SIGKILL);
+  waitpid(child, nullptr, 0);
+  EXPECT_EQ(release_mutexes_of_dead_threads(dir_, "testport").size(), 1u) << "now it is dead";
+  EXPECT_EQ(pthread_mutex_trylock(mutex()), 0);
+  pthread_mutex_unlock(mutex());
+}
+
+TEST_F(PortSegment, AWaiterInAnotherProcessGetsTheMutex) {
+  waitpid(locker(true), nullptr, 0);
+  const pid_t waiter = fork();
+  if (waiter == 0) {
+    timespec deadline{};
+    clock_gettime(CLOCK_REALTIME, &deadline);
+    deadline.tv_sec += 10;
+    _exit(pthread_mutex_timedlock(mutex(), &deadline) == 0 ? 0 : 1);
+  }
+  usleep(50000);
+  EXPECT_EQ(release_mutexes_of_dead_threads(dir_, "testport").size(), 1u);
+  int status = -1;
+  waitpid(waiter, &status, 0);
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "woken and given the mutex";
+}
+
+TEST_F(PortSegment, OnlyPortSegmentsAreLookedAt) {
+  waitpid(locker(true), nullptr, 0);
+  fs::rename(dir_ / "testport7411", dir_ / "testport7411_el");
+  EXPECT_TRUE(release_mutexes_of_dead_threads(dir_, "testport").empty()) << "a lock file";
+  EXPECT_EQ(pthread_mutex_trylock(mutex()), EBUSY);
 }
 
 TEST(ParticipantIdentity, AnIdIsClaimedOnceUntilReleased) {

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
 namespace oscar {
 
@@ -30,6 +31,46 @@ class DeadSharedMemorySweeper {
   Clock::duration grace_;
   std::filesystem::path dir_;
   std::map<std::string, Clock::time_point> dead_since_;  ///< lock file name -> first seen dead
+};
+
+/// Releases the process-shared mutexes in Fast DDS's port segments (files in `dir` whose names
+/// start with `prefix`) that a killed thread held.
+///
+/// Each port has mutexes of its own (its queue, its allocator), taken for a moment by everyone
+/// who pushes into the port or opens it. A process killed in that moment leaves one locked, and
+/// every later push into that port waits 1 s for it (Boost's lock timeout) with all of the
+/// sender's traffic held up behind it, again and again: `oscar bench restart` saw the registry
+/// and modules stall for seconds. A mutex whose owner thread no longer exists can never be
+/// unlocked by its owner, so the monitor unlocks it in its place, as glibc would, right after
+/// one of its modules died. (The owner is told from the mutex itself, so every process that
+/// uses /dev/shm must share the monitor's pid namespace, as OSCAR's processes do.)
+/// Returns the names of the files in which it released one.
+std::vector<std::string> release_mutexes_of_dead_threads(
+    const std::filesystem::path& dir = "/dev/shm", const std::string& prefix = "fastrtps_port");
+
+/// Gives back the port locks that killed processes left taken.
+///
+/// Fast DDS opens a shared-memory port while holding a named POSIX semaphore
+/// (`sem.fastrtps_port<N>_mutex`), for up to a third of a second while it checks the port's
+/// listeners. A process killed meanwhile leaves it taken, and the next process to open that port
+/// waits 2 s (Boost's lock timeout) before breaking it, sending nothing at all meanwhile. The
+/// monitor notes which locks are taken when one of its modules dies, then calls release() for a
+/// while: a lock that is taken while every process that has it open only waits for it (glibc
+/// counts the waiters in the semaphore) has lost its holder, and is posted once.
+class OrphanedPortLocks {
+ public:
+  /// Watches the semaphores whose names start with `prefix`.
+  explicit OrphanedPortLocks(std::string prefix = "fastrtps_");
+  /// Notes the locks taken now (call it right after a process died); returns how many.
+  std::size_t note_taken();
+  /// Posts the noted locks whose holder is gone and forgets those seen free; returns the names
+  /// of the posted ones. Cheap when nothing is noted.
+  std::vector<std::string> release();
+  bool empty() const { return taken_.empty(); }
+
+ private:
+  std::string prefix_;
+  std::vector<std::string> taken_;  ///< semaphore names (without "sem.")
 };
 
 }  // namespace oscar
