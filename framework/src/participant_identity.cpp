@@ -17,8 +17,10 @@ using eprosima::fastrtps::rtps::IPFinder;
 using eprosima::fastrtps::rtps::Locator_t;
 using eprosima::fastrtps::rtps::LocatorList_t;
 
+std::string claim_prefix(int domain) { return fmt::format("oscar_participant_d{}_", domain); }
+
 ParticipantIdClaim::ParticipantIdClaim(int domain, const std::string& address, int id)
-    : path_(fmt::format("/dev/shm/oscar_participant_d{}_{}_{}", domain, address, id)) {
+    : path_(fmt::format("{}/{}{}_{}", kClaimDir, claim_prefix(domain), address, id)) {
   for (;;) {
     const int fd = open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
     if (fd < 0) return;
@@ -36,6 +38,13 @@ ParticipantIdClaim::ParticipantIdClaim(int domain, const std::string& address, i
       return;
     }
     close(fd);
+  }
+}
+
+void ParticipantIdClaim::record(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) {
+  if (fd_ < 0) return;
+  if (pwrite(fd_, prefix.value, sizeof prefix.value, 0) != sizeof prefix.value) {
+    [[maybe_unused]] const int ignored = ftruncate(fd_, 0);  // no partial prefix is taken for one
   }
 }
 

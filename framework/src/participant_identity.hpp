@@ -14,6 +14,7 @@
 #include <string>
 
 #include <fastdds/rtps/common/Locator.h>
+#include <fastdds/rtps/common/GuidPrefix_t.hpp>
 
 namespace oscar::internal {
 
@@ -27,11 +28,27 @@ class ParticipantIdClaim {
   ParticipantIdClaim(ParticipantIdClaim&& other) noexcept;
   ParticipantIdClaim& operator=(ParticipantIdClaim&& other) noexcept;
   explicit operator bool() const { return fd_ >= 0; }
+  /// Writes the participant's GUID prefix into the claim: if this process is killed, a monitor
+  /// announces the participant's departure in its name (oscar/dead_participants.hpp).
+  void record(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix);
 
  private:
   std::string path_;
   int fd_ = -1;
 };
+
+/// Claims are files in this directory named "<claim_prefix(domain)><address>_<id>".
+inline constexpr const char* kClaimDir = "/dev/shm";
+std::string claim_prefix(int domain);
+
+/// RTPS well-known ports (spec 9.6.1.1): PB + DG * domain + d1 + PG * participant.
+inline std::uint32_t metatraffic_unicast_port(int domain, int participant) {
+  return static_cast<std::uint32_t>(7400 + 250 * domain + 10 + 2 * participant);
+}
+/// ... and the user unicast port (d3 = 11).
+inline std::uint32_t user_unicast_port(int domain, int participant) {
+  return metatraffic_unicast_port(domain, participant) + 1;
+}
 
 /// A shared-memory locator of this host with a port that no other participant has used.
 eprosima::fastrtps::rtps::Locator_t unique_shared_memory_locator();

@@ -1,0 +1,85 @@
+#include "oscar/dead_participants.hpp"
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <condition_variable>
+#include <filesystem>
+#include <mutex>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
+
+#include "oscar/dds_participant.hpp"
+#include "participant_identity.hpp"  // framework/src
+
+namespace oscar {
+namespace {
+using namespace std::chrono_literals;
+using eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
+
+// Notes how other participants came and went.
+class Discovery : public eprosima::fastdds::dds::DomainParticipantListener {
+ public:
+  void on_participant_discovery(eprosima::fastdds::dds::DomainParticipant*,
+                                ParticipantDiscoveryInfo&& info) override {
+    std::lock_guard lock(mutex_);
+    events_.emplace_back(info.info.m_guid.guidPrefix, info.status);
+    changed_.notify_all();
+  }
+  // Waits for the event after the `seen` first ones; returns its status.
+  std::optional<ParticipantDiscoveryInfo::DISCOVERY_STATUS> next(std::size_t& seen,
+                                                                 std::chrono::seconds timeout) {
+    std::unique_lock lock(mutex_);
+    if (!changed_.wait_for(lock, timeout, [&] { return events_.size() > seen; })) return {};
+    return events_[seen++].second;
+  }
+  eprosima::fastrtps::rtps::GuidPrefix_t prefix(std::size_t i) {
+    std::lock_guard lock(mutex_);
+    return events_.at(i).first;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::vector<
+      std::pair<eprosima::fastrtps::rtps::GuidPrefix_t, ParticipantDiscoveryInfo::DISCOVERY_STATUS>>
+      events_;
+};
+
+// A participant in a child process, killed with SIGKILL: the announcement made in its name makes
+// the others remove it as one that left (REMOVED), not drop it when its lease ends (DROPPED).
+TEST(DeadParticipants, TheDepartureOfAKilledParticipantIsAnnouncedInItsName) {
+  const int domain = 100 + getpid() % 50;
+  const pid_t child = fork();  // before this process has any DDS thread
+  if (child == 0) {
+    DdsParticipant doomed(domain, "doomed");
+    pause();
+    _exit(0);
+  }
+  Discovery discovery;
+  DdsParticipant observer(domain, "observer");
+  observer.get().set_listener(&discovery, eprosima::fastdds::dds::StatusMask::none());
+  std::size_t seen = 0;
+  ASSERT_EQ(discovery.next(seen, 20s), ParticipantDiscoveryInfo::DISCOVERED_PARTICIPANT);
+  const auto doomed = discovery.prefix(0);
+  std::ostringstream expected;
+  expected << doomed;
+  EXPECT_TRUE(announce_killed_participants(domain, {}).empty()) << "nobody died yet";
+
+  kill(child, SIGKILL);
+  waitpid(child, nullptr, 0);
+  const auto announced = announce_killed_participants(domain, {});
+  ASSERT_EQ(announced.size(), 1u);
+  EXPECT_EQ(announced[0], expected.str()) << "the killed one's prefix, from its claim";
+  EXPECT_EQ(discovery.next(seen, 20s), ParticipantDiscoveryInfo::REMOVED_PARTICIPANT)
+      << "removed on the announcement, not dropped at the end of its lease";
+  EXPECT_TRUE(announce_killed_participants(domain, {}).empty()) << "announced once";
+  observer.get().set_listener(nullptr);
+}
+
+}  // namespace
+}  // namespace oscar
