@@ -15,6 +15,7 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
+#include "oscar/dead_participants.hpp"
 #include "oscar/process_util.hpp"
 #include "oscar/registry/supervisor.hpp"
 #include "oscar/registry/system_spec.hpp"
@@ -61,8 +62,8 @@ int main(int argc, char** argv) {
       log_dir = fmt::format("/tmp/oscar/{}-{}/{}", system.name, system.domain, host);
     }
     oscar::Supervisor supervisor(log_dir);
-    oscar::DdsParticipant participant(system.domain, "oscar-monitor:" + host,
-                                      oscar::NetworkConfig::for_host(system.root, host));
+    const auto network = oscar::NetworkConfig::for_host(system.root, host);
+    oscar::DdsParticipant participant(system.domain, "oscar-monitor:" + host, network);
     oscar::TopicWriter<oscar::ProcessEvent, oscar::ProcessEventPubSubType> events(
         participant, "oscar/registry/process", oscar::qos::state_writer(256));
     oscar::TopicWriter<oscar::MonitorBeat, oscar::MonitorBeatPubSubType> beats(
@@ -91,6 +92,10 @@ int main(int argc, char** argv) {
     // discovery lease of a participant, plus Fast DDS's 1-2 s port watchdog).
     oscar::DeadSharedMemorySweeper shared_memory(std::chrono::seconds(5));
     auto next_sweep = Clock::now();
+    // A module killed while it opened a shared-memory port leaves that port's lock taken; it is
+    // given back within moments of the death (the next opener would wait 2 s, sending nothing).
+    oscar::OrphanedPortLocks port_locks;
+    auto check_locks_until = Clock::now(), next_lock_check = Clock::now();
     // The heartbeat has a thread of its own: starting processes must not delay it.
     std::jthread beater([&](std::stop_token stop) {
       auto next = Clock::now();
@@ -155,6 +160,22 @@ int main(int argc, char** argv) {
         ev.signal(x.signal);
         ev.detail(x.last_output);
         events.write(ev);
+        for (const auto& port : oscar::release_mutexes_of_dead_threads()) {
+          spdlog::warn("unlocked {}, whose lock a killed process held", port);
+        }
+        for (const auto& p : oscar::announce_killed_participants(system.domain, network)) {
+          spdlog::info("announced the departure of participant {} of {}", p, x.module);
+        }
+        port_locks.note_taken();
+        check_locks_until = Clock::now() + std::chrono::seconds(2);
+      }
+      if (!port_locks.empty() && Clock::now() >= next_lock_check) {
+        next_lock_check = Clock::now() + std::chrono::milliseconds(20);
+        for (const auto& lock : port_locks.release()) {
+          spdlog::warn("gave back {}, which a killed process held (Fast DDS would wait 2 s for it)",
+                       lock);
+        }
+        if (Clock::now() > check_locks_until) port_locks = oscar::OrphanedPortLocks();
       }
       if (Clock::now() >= next_sweep) {
         if (const auto n = shared_memory.sweep(); n > 0) {

@@ -52,16 +52,16 @@ void Registry::tick() {
       publish();
     }
   }
-  // DDS reports a lapsed lease only for a writer it has seen alive; a module that hangs before
-  // its first heartbeat arrives is caught here, by the age of its last heartbeat. Its first
-  // heartbeat may come late although it runs (it announced itself): discovery of a fresh
-  // process's heartbeat writer took up to 2 s here, so the first one gets that long.
+  // The registry keeps its own clock on the heartbeats as well: DDS reports a lapsed lease only
+  // for a writer it has seen alive, and Fast DDS 2.9's liveliness timer now and then misses a
+  // lapse (a hung module was caught only after 2 leases). A module's first heartbeat may come
+  // late although it runs (it announced itself): discovery of a fresh process's heartbeat
+  // writer took up to 2 s here, so the first one gets that long.
   for (auto& m : modules_) {
     if (m->status != "running") continue;
     const auto beat = io_->last_beat(m->spec->spec.name, m->incarnation);
-    const std::chrono::milliseconds allowed = beat == Clock::time_point{}
-                                                  ? std::max(system_.lease * 2, kFirstBeatGrace)
-                                                  : system_.lease * 2;
+    const std::chrono::milliseconds allowed =
+        beat == Clock::time_point{} ? std::max(system_.lease * 2, kFirstBeatGrace) : system_.lease;
     if (now - std::max(m->running_since, beat) > allowed) {
       on_module_lost(m->spec->spec.name, m->incarnation);
     }
