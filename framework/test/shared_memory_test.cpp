@@ -51,6 +51,8 @@ TEST_F(SharedMemoryDir, RemovesOnlyWhatDeadProcessesLeft) {
     touch(name);
     touch(std::string(name) + "_el");
   }
+  touch("sem.fastrtps_port7411_mutex");  // the lock Fast DDS opens a port under
+  touch("sem.fastrtps_port7413_mutex");
   hold("fastrtps_live_el");
   hold("fastrtps_port7413_el");
   using namespace std::chrono_literals;
@@ -63,6 +65,8 @@ TEST_F(SharedMemoryDir, RemovesOnlyWhatDeadProcessesLeft) {
   EXPECT_FALSE(fs::exists(dir_ / "fastrtps_0123456789abcdef"));
   EXPECT_FALSE(fs::exists(dir_ / "fastrtps_0123456789abcdef_el"));
   EXPECT_FALSE(fs::exists(dir_ / "fastrtps_port7411"));
+  EXPECT_FALSE(fs::exists(dir_ / "sem.fastrtps_port7411_mutex"));
+  EXPECT_TRUE(fs::exists(dir_ / "sem.fastrtps_port7413_mutex"));
   EXPECT_TRUE(fs::exists(dir_ / "fastrtps_live"));
   EXPECT_TRUE(fs::exists(dir_ / "fastrtps_port7413_el"));
   EXPECT_TRUE(fs::exists(dir_ / "other")) << "not Fast DDS's";
