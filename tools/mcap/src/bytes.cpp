@@ -117,36 +117,38 @@ std::vector<std::uint8_t> compress(const std::string& compression,
   throw std::invalid_argument("unknown compression '" + compression + "'");
 }
 
-std::optional<std::vector<std::uint8_t>> decompress(const std::string& compression,
-                                                    std::span<const std::uint8_t> data,
-                                                    std::uint64_t size, std::string& error) {
-  std::vector<std::uint8_t> out(size);
+std::optional<std::span<const std::uint8_t>> uncompressed(const std::string& compression,
+                                                          std::span<const std::uint8_t> data,
+                                                          std::uint64_t size,
+                                                          std::vector<std::uint8_t>& buffer,
+                                                          std::string& error) {
   if (compression.empty()) {
     if (data.size() != size) {
       error = "uncompressed chunk holds " + std::to_string(data.size()) + " bytes, not " +
               std::to_string(size);
       return std::nullopt;
     }
-    return std::vector<std::uint8_t>(data.begin(), data.end());
+    return data;
   }
+  buffer.resize(size);
   if (compression == "zstd") {
-    const auto n = ZSTD_decompress(out.data(), out.size(), data.data(), data.size());
+    const auto n = ZSTD_decompress(buffer.data(), buffer.size(), data.data(), data.size());
     if (ZSTD_isError(n) || n != size) {
       error = ZSTD_isError(n) ? std::string("zstd: ") + ZSTD_getErrorName(n)
                               : "zstd data decompresses to " + std::to_string(n) + " bytes, not " +
                                     std::to_string(size);
       return std::nullopt;
     }
-    return out;
+    return std::span<const std::uint8_t>(buffer);
   }
   if (compression == "lz4") {
     LZ4F_dctx* ctx = nullptr;
     LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION);
     std::size_t in_pos = 0, out_pos = 0, hint = 1;
     while (hint != 0 && in_pos < data.size()) {
-      std::size_t in_n = data.size() - in_pos, out_n = out.size() - out_pos;
-      hint =
-          LZ4F_decompress(ctx, out.data() + out_pos, &out_n, data.data() + in_pos, &in_n, nullptr);
+      std::size_t in_n = data.size() - in_pos, out_n = buffer.size() - out_pos;
+      hint = LZ4F_decompress(ctx, buffer.data() + out_pos, &out_n, data.data() + in_pos, &in_n,
+                             nullptr);
       if (LZ4F_isError(hint)) {
         error = std::string("lz4: ") + LZ4F_getErrorName(hint);
         LZ4F_freeDecompressionContext(ctx);
@@ -162,7 +164,7 @@ std::optional<std::vector<std::uint8_t>> decompress(const std::string& compressi
               " bytes, not " + std::to_string(size);
       return std::nullopt;
     }
-    return out;
+    return std::span<const std::uint8_t>(buffer);
   }
   error = "unknown compression '" + compression + "' (known: zstd, lz4, none)";
   return std::nullopt;

@@ -76,9 +76,13 @@ std::uint32_t crc32(std::span<const std::uint8_t> data, std::uint32_t crc = 0);
 /// Compresses `data` with `compression` ("zstd", "lz4" or "").
 std::vector<std::uint8_t> compress(const std::string& compression,
                                    std::span<const std::uint8_t> data);
-/// Decompresses to exactly `size` bytes; nullopt with `error` set if that fails.
-std::optional<std::vector<std::uint8_t>> decompress(const std::string& compression,
-                                                    std::span<const std::uint8_t> data,
-                                                    std::uint64_t size, std::string& error);
+/// A chunk's `size` bytes of records: `data` itself when uncompressed (""; no copy), else `data`
+/// decompressed into `buffer` (one buffer for all chunks of a scan). nullopt with `error` set if
+/// that fails.
+std::optional<std::span<const std::uint8_t>> uncompressed(const std::string& compression,
+                                                          std::span<const std::uint8_t> data,
+                                                          std::uint64_t size,
+                                                          std::vector<std::uint8_t>& buffer,
+                                                          std::string& error);
 
 }  // namespace oscar::mcap::internal

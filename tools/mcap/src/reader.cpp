@@ -46,8 +46,10 @@ Reader::Reader(const std::string& path) : path_(path) {
       throw std::runtime_error("cannot map '" + path + "': " + std::strerror(error));
     }
     data_ = static_cast<const std::uint8_t*>(p);
+    fd_ = fd;
+  } else {
+    ::close(fd);
   }
-  ::close(fd);
   if (size_ < sizeof kMagic || !magic_at(data_)) {
     fail(0, "not an MCAP file: it does not start with the MCAP magic 89 4d 43 41 50 30 0d 0a");
   }
@@ -69,6 +71,17 @@ Reader::Reader(const std::string& path) : path_(path) {
 
 Reader::~Reader() {
   if (data_) munmap(const_cast<std::uint8_t*>(data_), size_);
+  if (fd_ >= 0) ::close(fd_);
+}
+
+bool Reader::read_at(std::uint64_t at, std::uint64_t n, std::vector<std::uint8_t>& out) const {
+  out.resize(n);
+  for (std::uint64_t done = 0; done < n;) {
+    const auto got = ::pread(fd_, out.data() + done, n - done, static_cast<off_t>(at + done));
+    if (got <= 0) return false;  // then the mapping is read instead
+    done += static_cast<std::uint64_t>(got);
+  }
+  return true;
 }
 
 void Reader::read_footer() {
@@ -161,6 +174,7 @@ ScanResult Reader::read_messages(const MessageFn& fn) {
     result.truncation = "data section cut short at byte " + std::to_string(at) + " (" + what +
                         "); read up to there";
   };
+  std::vector<std::uint8_t> chunk_record, chunk_buffer;  // a chunk as read, and decompressed
   // Reads records of a chunk's uncompressed data (base = the chunk's file offset for errors).
   const auto read_records = [&](std::span<const std::uint8_t> records, std::uint64_t chunk_at) {
     In in(records);
@@ -217,7 +231,14 @@ ScanResult Reader::read_messages(const MessageFn& fn) {
                         std::to_string(data_end_ - at - kRecordPrefix) + " are left");
       return result;
     }
-    const std::span<const std::uint8_t> c{data_ + at + kRecordPrefix, n};
+    // A chunk is read into a buffer kept between chunks rather than through the mapping: mapping
+    // in a recording page by page cost a page fault per 4 KB, and on a virtual machine those
+    // delayed every other thread of the process (oscar-replay's timing, docs/benchmarks.md).
+    std::span<const std::uint8_t> record{data_ + at, kRecordPrefix + n};
+    if (op == static_cast<std::uint8_t>(Op::kChunk) && read_at(at, record.size(), chunk_record)) {
+      record = chunk_record;
+    }
+    const auto c = record.subspan(kRecordPrefix);
     if (op == static_cast<std::uint8_t>(Op::kDataEnd)) {
       In in(c);
       std::uint32_t expected = 0;
@@ -233,8 +254,8 @@ ScanResult Reader::read_messages(const MessageFn& fn) {
       internal::ChunkRecord chunk;
       if (!internal::parse_chunk(c, chunk)) fail(at, "Chunk record too short for its fields");
       std::string error;
-      auto records =
-          internal::decompress(chunk.compression, chunk.records, chunk.uncompressed_size, error);
+      const auto records = internal::uncompressed(chunk.compression, chunk.records,
+                                                  chunk.uncompressed_size, chunk_buffer, error);
       if (!records) fail(at, "chunk cannot be decompressed: " + error);
       if (chunk.uncompressed_crc != 0) {
         const auto actual = internal::crc32(*records);
@@ -250,14 +271,13 @@ ScanResult Reader::read_messages(const MessageFn& fn) {
                op == static_cast<std::uint8_t>(Op::kSchema) ||
                op == static_cast<std::uint8_t>(Op::kChannel)) {
       // Records outside chunks: the same rules as inside.
-      std::vector<std::uint8_t> one(data_ + at, data_ + at + kRecordPrefix + n);
-      read_records(one, at);
+      read_records({data_ + at, kRecordPrefix + n}, at);
     } else if (op == 0 || (op > 0x0F && op < 0x80) ||
                op == static_cast<std::uint8_t>(Op::kHeader) ||
                op == static_cast<std::uint8_t>(Op::kFooter)) {
       fail(at, "unexpected " + op_name(op) + " record in the data section");
     }
-    crc = internal::crc32({data_ + at, kRecordPrefix + n}, crc);
+    crc = internal::crc32(record, crc);
     at += kRecordPrefix + n;
   }
   if (has_footer_) fail(data_end_, "the data section has no Data End record");

@@ -68,10 +68,13 @@ class Reader {
   void read_footer();
   void read_summary(std::uint64_t start, std::uint64_t end);
   void fail(std::uint64_t offset, const std::string& what) const;
+  /// Reads `n` bytes at `at` into `out` with pread(); false if that fails.
+  bool read_at(std::uint64_t at, std::uint64_t n, std::vector<std::uint8_t>& out) const;
 
   std::string path_;
   const std::uint8_t* data_ = nullptr;
   std::uint64_t size_ = 0;
+  int fd_ = -1;  ///< chunks are read with pread(), not through the mapping (read_messages)
   std::uint64_t header_end_ = 0;
   std::string profile_, library_;
   bool has_footer_ = false;
