@@ -22,6 +22,7 @@ namespace oscar {
 namespace {
 using namespace std::chrono_literals;
 using test::Process;
+using testing::ContainsRegex;
 using testing::HasSubstr;
 
 std::string temp(const std::string& name) {
@@ -249,6 +250,9 @@ TEST(Replay, DeliversTheRecordedBytesAndHeadersInOrderWithTheOriginalTiming) {
       temp("replay.log"));
   ASSERT_EQ(replay.wait(30s), 0) << replay.output();
   EXPECT_THAT(replay.output(), HasSubstr("published 90 messages on 3 topics"));
+  EXPECT_THAT(replay.output(),
+              ContainsRegex("publishing began late by p50 [0-9]+ us, p99 [0-9]+ us, max [0-9]+ us"))
+      << "its own account of its timing";
   std::this_thread::sleep_for(500ms);
   kill(consumer->pid(), SIGINT);
   ASSERT_EQ(consumer->wait(10s), 0) << consumer->output();

@@ -53,6 +53,19 @@ void Lanes::drain() {
   lanes_.clear();
 }
 
+double Lanes::lateness_us(double quantile) const {
+  std::uint64_t total = 0;
+  for (const auto& n : lateness_) total += n;
+  if (total == 0) return 0;
+  const auto rank = static_cast<std::uint64_t>(quantile * static_cast<double>(total - 1));
+  std::uint64_t seen = 0;
+  for (std::size_t bin = 0; bin < kLatenessBins; ++bin) {
+    seen += lateness_[bin];
+    if (seen > rank) return static_cast<double>(bin) * 10.0;
+  }
+  return static_cast<double>(kLatenessBins - 1) * 10.0;
+}
+
 void Lanes::run(Lane& lane) {
   for (;;) {
     Pending p;
@@ -74,6 +87,12 @@ void Lanes::run(Lane& lane) {
     }
     const auto size = p.bytes.size();
     if (!stopping()) {
+      if (!wait_) {
+        const auto late =
+            std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - (start_ + p.due));
+        const auto bin = static_cast<std::size_t>(std::max<std::int64_t>(late.count(), 0) / 10);
+        ++lateness_[std::min(bin, kLatenessBins - 1)];
+      }
       p.publish(p.bytes);
       ++published_;
     }

@@ -43,6 +43,10 @@ class Lanes {
   /// Waits until every lane has published what it was given (or the replay stopped).
   void drain();
   std::uint64_t published() const { return published_; }
+  /// How late publishing began against the due times, over every message published so far: the
+  /// `quantile` (0..1) in microseconds, to 10 us (100 ms stands for anything later). 0 when
+  /// stepping.
+  double lateness_us(double quantile) const;
 
  private:
   struct Lane;
@@ -60,6 +64,9 @@ class Lanes {
   bool closing_ = false;
   std::atomic<bool> cancelled_{false};
   std::atomic<std::uint64_t> published_{0};
+  static constexpr std::size_t kLatenessBins = 10001;  ///< 10 us each; the last: 100 ms or more
+  std::vector<std::atomic<std::uint64_t>> lateness_ =
+      std::vector<std::atomic<std::uint64_t>>(kLatenessBins);
 };
 
 }  // namespace oscar::replay

@@ -73,6 +73,10 @@ int main(int argc, char** argv) {
     const auto c = replayer.run(g_stop);
     fmt::print("published {} messages on {} topics in {:.3f} s\n", c.published, c.topics,
                c.seconds);
+    if (!o.step && c.published > 0) {
+      fmt::print("publishing began late by p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us\n",
+                 c.late_us_p50, c.late_us_p99, c.late_us_max);
+    }
     return 0;
   } catch (const std::exception& e) {
     fmt::print(stderr, "oscar replay: {}\n", e.what());

@@ -30,6 +30,7 @@ struct ReplayCounters {
   std::uint64_t published = 0;
   std::uint64_t topics = 0;
   double seconds = 0;
+  double late_us_p50 = 0, late_us_p99 = 0, late_us_max = 0;  ///< publishing against the schedule
 };
 
 /// Validates the options and the file, joins the domain and creates a writer per topic.
