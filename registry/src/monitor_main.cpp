@@ -15,11 +15,10 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
-#include "oscar/dead_participants.hpp"
+#include "janitor.hpp"
 #include "oscar/process_util.hpp"
 #include "oscar/registry/supervisor.hpp"
 #include "oscar/registry/system_spec.hpp"
-#include "oscar/shared_memory.hpp"
 #include "oscar/topic_io.hpp"
 
 namespace {
@@ -88,14 +87,7 @@ int main(int argc, char** argv) {
     spdlog::info("watching host '{}' (domain {}), module output in {}", host, system.domain,
                  log_dir);
     std::map<std::string, Clock::time_point> stopping;  // SIGKILL if still there by then
-    // What killed modules leave in /dev/shm goes once the others have let go of them (the 3 s
-    // discovery lease of a participant, plus Fast DDS's 1-2 s port watchdog).
-    oscar::DeadSharedMemorySweeper shared_memory(std::chrono::seconds(5));
-    auto next_sweep = Clock::now();
-    // A module killed while it opened a shared-memory port leaves that port's lock taken; it is
-    // given back within moments of the death (the next opener would wait 2 s, sending nothing).
-    oscar::OrphanedPortLocks port_locks;
-    auto check_locks_until = Clock::now(), next_lock_check = Clock::now();
+    oscar::Janitor janitor(system.domain, network);
     // The heartbeat has a thread of its own: starting processes must not delay it.
     std::jthread beater([&](std::stop_token stop) {
       auto next = Clock::now();
@@ -160,29 +152,9 @@ int main(int argc, char** argv) {
         ev.signal(x.signal);
         ev.detail(x.last_output);
         events.write(ev);
-        for (const auto& port : oscar::release_mutexes_of_dead_threads()) {
-          spdlog::warn("unlocked {}, whose lock a killed process held", port);
-        }
-        for (const auto& p : oscar::announce_killed_participants(system.domain, network)) {
-          spdlog::info("announced the departure of participant {} of {}", p, x.module);
-        }
-        port_locks.note_taken();
-        check_locks_until = Clock::now() + std::chrono::seconds(2);
+        janitor.after_death(x.module);
       }
-      if (!port_locks.empty() && Clock::now() >= next_lock_check) {
-        next_lock_check = Clock::now() + std::chrono::milliseconds(20);
-        for (const auto& lock : port_locks.release()) {
-          spdlog::warn("gave back {}, which a killed process held (Fast DDS would wait 2 s for it)",
-                       lock);
-        }
-        if (Clock::now() > check_locks_until) port_locks = oscar::OrphanedPortLocks();
-      }
-      if (Clock::now() >= next_sweep) {
-        if (const auto n = shared_memory.sweep(); n > 0) {
-          spdlog::info("removed {} shared-memory segments and ports of dead processes", n);
-        }
-        next_sweep = Clock::now() + std::chrono::seconds(1);
-      }
+      janitor.tick();
     }
     beater.request_stop();
     beater.join();
