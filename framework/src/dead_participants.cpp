@@ -33,7 +33,8 @@ class Message {
     bytes({static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(v >> 8)});
   }
   void u32(std::uint32_t v) {
-    u16(static_cast<std::uint16_t>(v)), u16(static_cast<std::uint16_t>(v >> 16));
+    u16(static_cast<std::uint16_t>(v));
+    u16(static_cast<std::uint16_t>(v >> 16));
   }
   const std::vector<std::uint8_t>& data() const { return data_; }
 
