@@ -1,7 +1,4 @@
 #include "replayer.hpp"
-#include <sys/resource.h>
-#include <unistd.h>
-#include <cstdlib>
 
 #include <fnmatch.h>
 
@@ -143,8 +140,6 @@ ReplayCounters Replayer::run(const std::atomic<bool>& stop) {
   // Reading runs up to 64 MB ahead of the publishing (a 1.7 MB chunk of images takes
   // milliseconds to read and check), and each topic is published by a thread of its own.
   Lanes lanes(begun, std::size_t{64} << 20, stop, step);
-  if (getenv("OSCAR_DIAG_NICE"))
-    setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), atoi(getenv("OSCAR_DIAG_NICE")));
   const auto scaled = [&](std::uint64_t ns) {
     return std::chrono::nanoseconds(static_cast<std::int64_t>(static_cast<double>(ns) / d.o.rate));
   };
