@@ -4,6 +4,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <string>
 #include <system_error>
 
@@ -14,6 +15,14 @@ namespace {
 // file "<name>_el" that its owner holds with flock() for as long as it lives.
 constexpr std::string_view kPrefix = "fastrtps_";
 constexpr std::string_view kLockSuffix = "_el";
+// ... and opens a port "fastrtps_port<port>" under the named semaphore "sem.<port file>_mutex".
+const std::string kPort = "fastrtps_port", kSemaphore = "sem.", kMutexSuffix = "_mutex";
+
+bool is_port(const std::string& name) {
+  return name.size() > kPort.size() && name.starts_with(kPort) &&
+         std::all_of(name.begin() + static_cast<std::ptrdiff_t>(kPort.size()), name.end(),
+                     [](char c) { return c >= '0' && c <= '9'; });
+}
 
 // True if `lock_file` exists and nobody holds its lock (its owner is gone).
 bool abandoned(const std::filesystem::path& lock_file) {
@@ -32,23 +41,44 @@ DeadSharedMemorySweeper::DeadSharedMemorySweeper(Clock::duration grace, std::fil
 
 std::size_t DeadSharedMemorySweeper::sweep(Clock::time_point now) {
   std::map<std::string, Clock::time_point> still_dead;
-  std::size_t removed = 0;
-  std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator(dir_, ec)) {
-    const auto name = entry.path().filename().string();
-    if (!name.starts_with(kPrefix) || !name.ends_with(kLockSuffix)) continue;
-    if (!abandoned(entry.path())) continue;
+  // True once `name` has been seen dead for the grace period.
+  const auto due = [&](const std::string& name) {
     const auto seen = dead_since_.find(name);
     const auto since = seen == dead_since_.end() ? now : seen->second;
-    if (now - since < grace_) {
-      still_dead.emplace(name, since);
-      continue;
-    }
+    if (now - since >= grace_) return true;
+    still_dead.emplace(name, since);
+    return false;
+  };
+  const auto exists = [&](const std::string& name) {
     std::error_code ignore;
-    const auto owned = name.substr(0, name.size() - kLockSuffix.size());
-    if (std::filesystem::remove(dir_ / owned, ignore)) ++removed;
-    std::filesystem::remove(dir_ / ("sem." + owned + "_mutex"), ignore);  // a port's lock
-    std::filesystem::remove(entry.path(), ignore);
+    return std::filesystem::exists(dir_ / name, ignore);
+  };
+  std::size_t removed = 0;
+  std::error_code ec, ignore;
+  for (const auto& entry : std::filesystem::directory_iterator(dir_, ec)) {
+    const auto name = entry.path().filename().string();
+    if (name.starts_with(kPrefix) && name.ends_with(kLockSuffix)) {
+      // A segment or port whose owner is gone.
+      if (!abandoned(entry.path()) || !due(name)) continue;
+      const auto owned = name.substr(0, name.size() - kLockSuffix.size());
+      if (std::filesystem::remove(dir_ / owned, ignore)) ++removed;
+      std::filesystem::remove(dir_ / (kSemaphore + owned + kMutexSuffix), ignore);
+      std::filesystem::remove(entry.path(), ignore);
+    } else if (is_port(name)) {
+      // A port that no reader owns, exclusively ("_el") or shared ("_sl", Fast DDS's multicast
+      // ports): a sender created it while sending to a participant that had died.
+      if (exists(name + std::string(kLockSuffix)) || exists(name + "_sl") || !due(name)) continue;
+      if (std::filesystem::remove(entry.path(), ignore)) ++removed;
+      std::filesystem::remove(dir_ / (kSemaphore + name + kMutexSuffix), ignore);
+    } else if (name.starts_with(kSemaphore) && name.ends_with(kMutexSuffix) &&
+               is_port(name.substr(kSemaphore.size(),
+                                   name.size() - kSemaphore.size() - kMutexSuffix.size()))) {
+      // A port's lock, left behind by its port (Fast DDS never removes them).
+      const auto port =
+          name.substr(kSemaphore.size(), name.size() - kSemaphore.size() - kMutexSuffix.size());
+      if (exists(port) || !due(name)) continue;
+      if (std::filesystem::remove(entry.path(), ignore)) ++removed;
+    }
   }
   dead_since_ = std::move(still_dead);  // a name reused by a living owner is forgotten
   return removed;

@@ -72,6 +72,31 @@ TEST_F(SharedMemoryDir, RemovesOnlyWhatDeadProcessesLeft) {
   EXPECT_TRUE(fs::exists(dir_ / "other")) << "not Fast DDS's";
 }
 
+// Fast DDS leaves a port's semaphore behind when the port goes, and a sender that opens the port
+// of a dead participant creates the port anew, with no owner: both would pile up for good.
+TEST_F(SharedMemoryDir, RemovesPortsNobodyOwnsAndLocksOfPortsThatAreGone) {
+  touch("fastrtps_port9001");  // created by a sender: no "_el" beside it
+  touch("sem.fastrtps_port9001_mutex");
+  touch("sem.fastrtps_port9002_mutex");  // its port is gone
+  touch("fastrtps_port9003");            // a living port ...
+  touch("fastrtps_port9003_el");
+  hold("fastrtps_port9003_el");
+  touch("sem.fastrtps_port9003_mutex");  // ... keeps its lock
+  touch("fastrtps_port7400");            // a shared (multicast) port of plain Fast DDS programs
+  touch("fastrtps_port7400_sl");
+  using namespace std::chrono_literals;
+  DeadSharedMemorySweeper sweeper(5s, dir_);
+  const auto t0 = DeadSharedMemorySweeper::Clock::now();
+  EXPECT_EQ(sweeper.sweep(t0), 0u) << "a port being created has no lock file for a moment";
+  EXPECT_EQ(sweeper.sweep(t0 + 5s), 2u);
+  EXPECT_FALSE(fs::exists(dir_ / "fastrtps_port9001"));
+  EXPECT_FALSE(fs::exists(dir_ / "sem.fastrtps_port9001_mutex"));
+  EXPECT_FALSE(fs::exists(dir_ / "sem.fastrtps_port9002_mutex"));
+  EXPECT_TRUE(fs::exists(dir_ / "fastrtps_port9003"));
+  EXPECT_TRUE(fs::exists(dir_ / "sem.fastrtps_port9003_mutex"));
+  EXPECT_TRUE(fs::exists(dir_ / "fastrtps_port7400"));
+}
+
 TEST_F(SharedMemoryDir, TheGraceStartsWhenTheOwnerIsSeenGone) {
   using namespace std::chrono_literals;
   touch("fastrtps_port7411");

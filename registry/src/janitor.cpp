@@ -32,7 +32,7 @@ void Janitor::tick() {
   }
   if (now >= next_sweep_) {
     if (const auto n = files_.sweep(); n > 0) {
-      spdlog::info("removed {} shared-memory segments and ports of dead processes", n);
+      spdlog::info("removed {} shared-memory files of dead processes", n);
     }
     next_sweep_ = now + std::chrono::seconds(1);
   }

@@ -23,8 +23,10 @@ class DeadSharedMemorySweeper {
  public:
   using Clock = std::chrono::steady_clock;
   explicit DeadSharedMemorySweeper(Clock::duration grace, std::filesystem::path dir = "/dev/shm");
-  /// Notes what died since the last call and removes what has been dead for `grace`. Returns how
-  /// many segments and ports it removed.
+  /// Notes what died since the last call and removes what has been dead for `grace`: segments
+  /// and ports of dead owners, ports no reader owns (a sender created them while sending to a
+  /// dead participant), and port semaphores whose port is gone (Fast DDS leaves them). Returns
+  /// how many of these files it removed.
   std::size_t sweep(Clock::time_point now = Clock::now());
 
  private:
