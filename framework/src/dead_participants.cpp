@@ -7,28 +7,28 @@
 #include <netinet/in.h>
 #include <sys/file.h>
 #include <sys/socket.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
-#include <array>
 #include <cstdint>
 #include <filesystem>
+#include <iterator>
 #include <set>
+#include <sstream>
 #include <system_error>
-
-#include <fmt/format.h>
 
 #include "participant_identity.hpp"
 
 namespace oscar {
 namespace {
 
-using Prefix = std::array<std::uint8_t, 12>;
+using eprosima::fastrtps::rtps::GuidPrefix_t;
 
 class Message {
  public:
   void bytes(std::initializer_list<std::uint8_t> b) { data_.insert(data_.end(), b); }
-  void bytes(const Prefix& p) { data_.insert(data_.end(), p.begin(), p.end()); }
+  void bytes(const GuidPrefix_t& p) {
+    data_.insert(data_.end(), std::begin(p.value), std::end(p.value));
+  }
   void u16(std::uint16_t v) {
     bytes({static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(v >> 8)});
   }
@@ -45,7 +45,7 @@ class Message {
 // An RTPS message from `prefix`'s participant: a DATA submessage of its SPDP writer, without
 // payload, whose inline QoS names the participant (key hash) and says it is disposed and
 // unregistered (status info). Little-endian submessage (flag E), inline QoS (flag Q).
-std::vector<std::uint8_t> departure(const Prefix& prefix) {
+std::vector<std::uint8_t> departure(const GuidPrefix_t& prefix) {
   Message m;
   m.bytes({'R', 'T', 'P', 'S', 2, 3, 0x01, 0x0f});  // protocol 2.3, vendor eProsima
   m.bytes(prefix);
@@ -87,12 +87,6 @@ void send_to_all(const std::vector<std::uint8_t>& message, const std::set<std::s
   close(fd);
 }
 
-std::string hex(const Prefix& p) {
-  std::string s;
-  for (std::size_t i = 0; i < p.size(); ++i) s += fmt::format("{}{:02x}", i ? "." : "", p[i]);
-  return s;
-}
-
 }  // namespace
 
 std::vector<std::string> announce_killed_participants(int domain, const NetworkConfig& network) {
@@ -105,23 +99,22 @@ std::vector<std::string> announce_killed_participants(int domain, const NetworkC
     if (!name.starts_with(stem)) continue;
     const int fd = open(entry.path().c_str(), O_RDWR | O_CLOEXEC);
     if (fd < 0) continue;
-    struct stat held {
-    }, named{};
     // A claim is its holder's for as long as the holder lives; one we can lock was left by a
-    // process that died (an orderly release removes the file, perhaps just now: check).
-    if (flock(fd, LOCK_EX | LOCK_NB) != 0 || fstat(fd, &held) != 0 ||
-        stat(entry.path().c_str(), &named) != 0 || held.st_ino != named.st_ino) {
+    // process that died.
+    if (flock(fd, LOCK_EX | LOCK_NB) != 0 || !internal::still_named(fd, entry.path())) {
       close(fd);
       continue;
     }
-    Prefix p{};
-    if (pread(fd, p.data(), p.size(), 0) == static_cast<ssize_t>(p.size())) {
+    GuidPrefix_t p;
+    if (pread(fd, p.value, sizeof p.value, 0) == static_cast<ssize_t>(sizeof p.value)) {
       const auto address = name.substr(stem.size(), name.rfind('_') - stem.size());
       std::set<std::string> to(network.interfaces.begin(), network.interfaces.end());
       to.insert(network.peers.begin(), network.peers.end());
       to.insert(address);
       send_to_all(departure(p), to, domain, network.max_participants_per_host);
-      announced.push_back(hex(p));
+      std::ostringstream text;
+      text << p;  // Fast DDS's notation: 01.0f.…
+      announced.push_back(text.str());
     }
     unlink(entry.path().c_str());  // while holding the lock, as an orderly release does
     close(fd);

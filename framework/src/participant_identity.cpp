@@ -17,6 +17,13 @@ using eprosima::fastrtps::rtps::IPFinder;
 using eprosima::fastrtps::rtps::Locator_t;
 using eprosima::fastrtps::rtps::LocatorList_t;
 
+bool still_named(int fd, const std::string& path) {
+  struct stat held {
+  }, named{};
+  return fstat(fd, &held) == 0 && stat(path.c_str(), &named) == 0 && held.st_ino == named.st_ino &&
+         held.st_dev == named.st_dev;
+}
+
 std::string claim_prefix(int domain) { return fmt::format("oscar_participant_d{}_", domain); }
 
 ParticipantIdClaim::ParticipantIdClaim(int domain, const std::string& address, int id)
@@ -29,11 +36,8 @@ ParticipantIdClaim::ParticipantIdClaim(int domain, const std::string& address, i
       return;
     }
     // The holder before us may have removed the file between our open and our lock: then the
-    // lock is on a file nobody else will look at, and the claim is tried again.
-    struct stat held {
-    }, named{};
-    if (fstat(fd, &held) == 0 && stat(path_.c_str(), &named) == 0 && held.st_ino == named.st_ino &&
-        held.st_dev == named.st_dev) {
+    // claim is tried again.
+    if (still_named(fd, path_)) {
       fd_ = fd;
       return;
     }

@@ -37,6 +37,10 @@ class ParticipantIdClaim {
   int fd_ = -1;
 };
 
+/// True if `path` still names the file open as `fd`: an orderly release unlinks its claim while
+/// holding the lock, so a lock taken just then is on a file nobody else will look at.
+bool still_named(int fd, const std::string& path);
+
 /// Claims are files in this directory named "<claim_prefix(domain)><address>_<id>".
 inline constexpr const char* kClaimDir = "/dev/shm";
 std::string claim_prefix(int domain);
