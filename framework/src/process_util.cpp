@@ -2,6 +2,12 @@
 
 #include <malloc.h>
 #include <pthread.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <limits>
+#include <vector>
 
 namespace oscar {
 
@@ -36,6 +42,25 @@ void keep_cue_memory_in_process() {
   // the threshold (and the trim threshold with it) on its own.
   mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
   mallopt(M_TRIM_THRESHOLD, 64 * 1024 * 1024);
+}
+
+void prefault_heap(std::size_t bytes) {
+  keep_cue_memory_in_process();
+  // Kept at the heap's top once freed: trimmed only beyond this and the usual 64 MB.
+  constexpr std::size_t kTrimAbove = std::size_t{64} << 20;
+  constexpr std::size_t kMaxTrimThreshold = std::numeric_limits<int>::max();
+  mallopt(M_TRIM_THRESHOLD, static_cast<int>(std::min(bytes + kTrimAbove, kMaxTrimThreshold)));
+  // In blocks below the mmap threshold, so that they come from the heap and return to it.
+  constexpr std::size_t kBlock = std::size_t{1} << 20;
+  const auto page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
+  std::vector<void*> blocks;
+  for (std::size_t touched = 0; touched < bytes; touched += kBlock) {
+    auto* block = static_cast<volatile char*>(std::malloc(kBlock));
+    if (block == nullptr) break;
+    for (std::size_t at = 0; at < kBlock; at += page) block[at] = 0;
+    blocks.push_back(const_cast<char*>(block));
+  }
+  for (auto* block : blocks) std::free(block);
 }
 
 }  // namespace oscar

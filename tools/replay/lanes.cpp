@@ -4,9 +4,13 @@
 
 namespace oscar::replay {
 
+// Each lane has a lock of its own: the reading thread and the other lanes never hold up a lane
+// that is about to publish.
 struct Lanes::Lane {
-  std::deque<Pending> queue;
+  std::mutex mutex;
   std::condition_variable ready;
+  std::deque<Pending> queue;
+  bool closing = false;  ///< no more messages come: publish the queue, then end
   std::thread thread;
 };
 
@@ -15,43 +19,58 @@ Lanes::Lanes(Clock::time_point start, std::size_t ahead_bytes, const std::atomic
     : start_(start), ahead_bytes_(ahead_bytes), stop_(stop), wait_(std::move(wait)) {}
 
 Lanes::~Lanes() {
+  cancelled_ = true;
+  space_.notify_all();
+  close_lanes();
+}
+
+void Lanes::close_lanes() {
+  // Joined without holding mutex_: a lane takes it to wake the reader.
+  std::map<const void*, std::unique_ptr<Lane>> lanes;
   {
     std::lock_guard lock(mutex_);
-    cancelled_ = true;
-    closing_ = true;
-    for (auto& [key, lane] : lanes_) lane->ready.notify_all();
+    lanes.swap(lanes_);
   }
-  space_.notify_all();
-  for (auto& [key, lane] : lanes_) lane->thread.join();
+  for (auto& [key, lane] : lanes) {
+    {
+      std::lock_guard lane_lock(lane->mutex);
+      lane->closing = true;
+    }
+    lane->ready.notify_all();
+  }
+  for (auto& [key, lane] : lanes) lane->thread.join();
 }
 
 bool Lanes::add(Pending p) {
-  std::unique_lock lock(mutex_);
-  // Room is checked in slices: `stop` is set by a signal handler, which cannot notify.
-  while (queued_bytes_ >= ahead_bytes_ && !stopping()) {
-    space_.wait_for(lock, std::chrono::milliseconds(100));
-  }
-  if (stopping()) return false;
-  auto& lane = lanes_[p.lane];
-  if (!lane) {
-    lane = std::make_unique<Lane>();
-    lane->thread = std::thread([this, l = lane.get()] { run(*l); });
+  Lane* lane = nullptr;
+  {
+    std::unique_lock lock(mutex_);
+    // Once full, wait until half is published: waking the reader after every message cost a
+    // context switch per message (1000 a second for a 1 kHz topic). In slices: `stop` is set by
+    // a signal handler, which cannot notify.
+    if (queued_bytes_ >= ahead_bytes_) {
+      while (queued_bytes_ > ahead_bytes_ / 2 && !stopping()) {
+        space_.wait_for(lock, std::chrono::milliseconds(100));
+      }
+    }
+    if (stopping()) return false;
+    auto& slot = lanes_[p.lane];
+    if (!slot) {
+      slot = std::make_unique<Lane>();
+      slot->thread = std::thread([this, l = slot.get()] { run(*l); });
+    }
+    lane = slot.get();
   }
   queued_bytes_ += p.bytes.size();
-  lane->queue.push_back(std::move(p));
+  {
+    std::lock_guard lock(lane->mutex);
+    lane->queue.push_back(std::move(p));
+  }
   lane->ready.notify_one();
   return true;
 }
 
-void Lanes::drain() {
-  {
-    std::lock_guard lock(mutex_);
-    closing_ = true;
-    for (auto& [key, lane] : lanes_) lane->ready.notify_all();
-  }
-  for (auto& [key, lane] : lanes_) lane->thread.join();
-  lanes_.clear();
-}
+void Lanes::drain() { close_lanes(); }
 
 double Lanes::lateness_us(double quantile) const {
   std::uint64_t total = 0;
@@ -70,8 +89,8 @@ void Lanes::run(Lane& lane) {
   for (;;) {
     Pending p;
     {
-      std::unique_lock lock(mutex_);
-      lane.ready.wait(lock, [&] { return cancelled_ || !lane.queue.empty() || closing_; });
+      std::unique_lock lock(lane.mutex);
+      lane.ready.wait(lock, [&] { return cancelled_ || !lane.queue.empty() || lane.closing; });
       if (cancelled_ || lane.queue.empty()) return;
       p = std::move(lane.queue.front());
       lane.queue.pop_front();
@@ -96,12 +115,12 @@ void Lanes::run(Lane& lane) {
       p.publish(p.bytes);
       ++published_;
     }
-    {
+    // The reader waits for the queue to fall to half: wake it when this message crosses that.
+    const auto before = queued_bytes_.fetch_sub(size);
+    if (stopping() || (before > ahead_bytes_ / 2 && before - size <= ahead_bytes_ / 2)) {
       std::lock_guard lock(mutex_);
-      queued_bytes_ -= size;
+      space_.notify_all();
     }
-    space_.notify_one();
-    if (stopping()) space_.notify_all();
   }
 }
 

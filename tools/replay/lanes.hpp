@@ -38,7 +38,8 @@ class Lanes {
   Lanes(const Lanes&) = delete;
   Lanes& operator=(const Lanes&) = delete;
 
-  /// Queues `p` on its lane; blocks while `ahead_bytes` are queued. False once the replay stops.
+  /// Queues `p` on its lane. Once `ahead_bytes` are queued it blocks until the lanes have
+  /// published half of them. False once the replay stops.
   bool add(Pending p);
   /// Waits until every lane has published what it was given (or the replay stopped).
   void drain();
@@ -51,17 +52,17 @@ class Lanes {
  private:
   struct Lane;
   void run(Lane& lane);
+  void close_lanes();
   bool stopping() const { return stop_ || cancelled_; }
 
   const Clock::time_point start_;
   const std::size_t ahead_bytes_;
   const std::atomic<bool>& stop_;
   std::function<bool(const Pending&)> wait_;
-  std::mutex mutex_;
+  std::mutex mutex_;               ///< guards lanes_; the reader waits for room under it
   std::condition_variable space_;  ///< the reader waits for room here
   std::map<const void*, std::unique_ptr<Lane>> lanes_;
-  std::size_t queued_bytes_ = 0;
-  bool closing_ = false;
+  std::atomic<std::size_t> queued_bytes_{0};
   std::atomic<bool> cancelled_{false};
   std::atomic<std::uint64_t> published_{0};
   static constexpr std::size_t kLatenessBins = 10001;  ///< 10 us each; the last: 100 ms or more

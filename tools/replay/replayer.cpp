@@ -13,6 +13,8 @@
 #include "lanes.hpp"
 #include "oscar/dds_participant.hpp"
 #include "oscar/mcap/reader.hpp"
+#include "oscar/output.hpp"
+#include "oscar/process_util.hpp"
 #include "raw_cdr_type.hpp"
 #include "recorder.hpp"  // topic_of
 
@@ -23,6 +25,10 @@ using Clock = std::chrono::steady_clock;
 namespace {
 struct Stopped {};                               // ends a scan early
 constexpr std::size_t kMaxLaneParticipants = 8;  // topics beyond share them
+// Reading runs this far ahead of the publishing (a 1.7 MB chunk of images takes milliseconds to
+// read and check); once full, it waits until half of it is published.
+constexpr std::size_t kReadAheadBytes = std::size_t{16} << 20;
+constexpr std::size_t kMaxPrefaultBytes = std::size_t{1} << 30;
 }  // namespace
 
 struct Replayer::Impl {
@@ -34,6 +40,7 @@ struct Replayer::Impl {
   // and a 45-byte cue waited up to 5 ms behind the fragments of four images.
   std::vector<std::unique_ptr<DdsParticipant>> lanes;
   std::map<std::uint16_t, std::pair<DdsParticipant*, dds::DataWriter*>> writers;  // by channel
+  static constexpr std::size_t kHistoryDepth = OutputOptions{}.depth;
 
   explicit Impl(ReplayOptions options)
       : o(std::move(options)), reader(o.file), info(reader.info()) {
@@ -78,7 +85,7 @@ struct Replayer::Impl {
       dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
       q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
       q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-      q.history().depth = 64;
+      q.history().depth = static_cast<std::int32_t>(kHistoryDepth);  // as a module's output
       q.publish_mode().kind = dds::SYNCHRONOUS_PUBLISH_MODE;
       auto* w = lane.publisher().create_datawriter(&topic, q);
       if (!w) throw std::runtime_error("cannot create a writer for " + tt.first);
@@ -90,6 +97,24 @@ struct Replayer::Impl {
 
   ~Impl() {
     for (auto& [id, w] : writers) w.first->publisher().delete_datawriter(w.second);
+  }
+
+  // The memory publishing will use: the read-ahead and each writer's history (depth + 1
+  // messages of the largest size among the first messages of its topic).
+  std::size_t memory_needed() {
+    std::map<std::uint16_t, std::size_t> largest;
+    try {
+      reader.read_messages([&](const mcap::Channel& ch, const mcap::MessageView& m) {
+        if (!writers.count(ch.id)) return;
+        auto& size = largest[ch.id];
+        size = std::max(size, m.data.size());
+        if (largest.size() == writers.size()) throw Stopped{};
+      });
+    } catch (const Stopped&) {
+    }
+    std::size_t bytes = kReadAheadBytes;
+    for (const auto& [id, size] : largest) bytes += (kHistoryDepth + 1) * size;
+    return std::min(bytes, kMaxPrefaultBytes);
   }
 
   bool wanted(const std::string& topic) const {
@@ -118,6 +143,9 @@ Replayer::~Replayer() = default;
 
 ReplayCounters Replayer::run(const std::atomic<bool>& stop) {
   auto& d = *impl_;
+  // Fresh memory costs a page fault per 4 KB when first written (about 1 ms for a 442 KB image
+  // on a virtual machine): touch it now, so that the first images are not published late.
+  if (!d.o.step) prefault_heap(d.memory_needed());
   d.wait_for_readers();
   ReplayCounters c;
   c.topics = d.writers.size();
@@ -137,9 +165,8 @@ ReplayCounters Replayer::run(const std::atomic<bool>& stop) {
       return static_cast<bool>(std::getline(std::cin, line));
     };
   }
-  // Reading runs up to 64 MB ahead of the publishing (a 1.7 MB chunk of images takes
-  // milliseconds to read and check), and each topic is published by a thread of its own.
-  Lanes lanes(begun, std::size_t{64} << 20, stop, step);
+  // Each topic is published by a thread of its own.
+  Lanes lanes(begun, kReadAheadBytes, stop, step);
   const auto scaled = [&](std::uint64_t ns) {
     return std::chrono::nanoseconds(static_cast<std::int64_t>(static_cast<double>(ns) / d.o.rate));
   };

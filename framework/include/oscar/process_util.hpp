@@ -5,6 +5,7 @@
 #include <signal.h>
 
 #include <chrono>
+#include <cstddef>
 #include <filesystem>
 #include <string>
 
@@ -27,5 +28,12 @@ bool wait_for_stop(const sigset_t& signals, std::chrono::milliseconds timeout);
 /// otherwise cost a page fault per 4 KB of every received image (442 KB: +40 µs per cue, see
 /// docs/benchmarks.md). Call once at start-up in processes that carry cues.
 void keep_cue_memory_in_process();
+
+/// Touches `bytes` of heap now and keeps them for later allocations (the real-time recipe of
+/// "pre-faulting the heap"): the first write to fresh memory costs a page fault per 4 KB, about
+/// 1 ms for a 442 KB image on the 2-core virtual machine of docs/benchmarks.md. Call from the
+/// main thread before the time-critical part: blocks it allocates later, and those of threads
+/// reallocating them, come from this memory. Implies keep_cue_memory_in_process().
+void prefault_heap(std::size_t bytes);
 
 }  // namespace oscar

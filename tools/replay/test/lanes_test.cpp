@@ -1,0 +1,111 @@
+#include "lanes.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace oscar::replay {
+namespace {
+using namespace std::chrono_literals;
+using Clock = Lanes::Clock;
+
+// What the lanes published: per lane, the payload's first byte and when it was published.
+struct Published {
+  std::mutex mutex;
+  std::map<const void*, std::vector<std::pair<int, Clock::time_point>>> by_lane;
+};
+
+Pending message(const void* lane, std::chrono::nanoseconds due, int id, std::size_t size,
+                Published& out) {
+  Pending p;
+  p.lane = lane;
+  p.due = due;
+  p.bytes.assign(size, static_cast<std::uint8_t>(id));
+  p.publish = [&out, lane](std::vector<std::uint8_t>& bytes) {
+    std::lock_guard lock(out.mutex);
+    out.by_lane[lane].emplace_back(bytes.front(), Clock::now());
+  };
+  return p;
+}
+
+TEST(Lanes, PublishEachLaneInOrderNeverBeforeItsDueTime) {
+  const std::atomic<bool> stop{false};
+  Published out;
+  const int a = 0, b = 0;
+  const auto start = Clock::now() + 20ms;
+  {
+    Lanes lanes(start, 1 << 20, stop);
+    for (int i = 0; i < 20; ++i) {
+      ASSERT_TRUE(lanes.add(message(&a, i * 2ms, i, 8, out)));
+      ASSERT_TRUE(lanes.add(message(&b, i * 2ms + 1ms, 100 + i, 8, out)));
+    }
+    lanes.drain();
+    EXPECT_EQ(lanes.published(), 40u);
+  }
+  for (const auto* lane : {&a, &b}) {
+    const auto& got = out.by_lane[lane];
+    ASSERT_EQ(got.size(), 20u);
+    for (int i = 0; i < 20; ++i) {
+      const int first = lane == &a ? 0 : 100;
+      EXPECT_EQ(got[i].first, first + i);
+      const auto due = start + i * 2ms + (lane == &a ? 0ms : 1ms);
+      EXPECT_GE(got[i].second, due) << "message " << i << " was published early";
+    }
+  }
+}
+
+TEST(Lanes, AFullReaderWaitsUntilHalfOfWhatIsAheadIsPublished) {
+  // 10 messages of 10 bytes fill 100 bytes of read-ahead; the 11th waits until the lane has
+  // published at least half (waking the reader after every message cost a context switch each).
+  const std::atomic<bool> stop{false};
+  Published out;
+  const int lane = 0;
+  Lanes lanes(Clock::now() + 50ms, 100, stop);  // nothing is due before the 11th is read
+  for (int i = 0; i < 10; ++i) ASSERT_TRUE(lanes.add(message(&lane, i * 5ms, i, 10, out)));
+  ASSERT_TRUE(lanes.add(message(&lane, 50ms, 10, 10, out)));
+  EXPECT_GE(lanes.published(), 5u);
+  lanes.drain();
+  EXPECT_EQ(lanes.published(), 11u);
+}
+
+TEST(Lanes, AStopEndsTheWaitsForRoomAndForDueTimes) {
+  std::atomic<bool> stop{false};
+  Published out;
+  const int lane = 0;
+  Lanes lanes(Clock::now(), 10, stop);
+  ASSERT_TRUE(lanes.add(message(&lane, 1h, 0, 10, out)));  // fills the read-ahead
+  const auto t0 = Clock::now();
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(50ms);
+    stop = true;
+  });
+  EXPECT_FALSE(lanes.add(message(&lane, 1h, 1, 10, out)));
+  lanes.drain();
+  stopper.join();
+  EXPECT_LT(Clock::now() - t0, 1s);
+  EXPECT_EQ(lanes.published(), 0u);
+}
+
+TEST(Lanes, DestroyingThemDropsWhatIsNotDueYet) {
+  const std::atomic<bool> stop{false};
+  Published out;
+  const int lane = 0;
+  const auto t0 = Clock::now();
+  {
+    Lanes lanes(Clock::now(), 1 << 20, stop);
+    ASSERT_TRUE(lanes.add(message(&lane, 0ms, 0, 8, out)));
+    ASSERT_TRUE(lanes.add(message(&lane, 1h, 1, 8, out)));
+    std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_LT(Clock::now() - t0, 1s);
+  ASSERT_EQ(out.by_lane[&lane].size(), 1u);
+  EXPECT_EQ(out.by_lane[&lane][0].first, 0);
+}
+
+}  // namespace
+}  // namespace oscar::replay
