@@ -1,0 +1,147 @@
+// oscar-bench-replay-raw: the floor for `oscar bench replay`. A plain Fast DDS publisher of the
+// same schedule that reads no file: the typed cues are built beforehand, each topic has its own
+// participant and thread (as oscar replay's lanes), the QoS of a module's output (reliable, keep
+// last 16, volatile, synchronous) and OSCAR's loopback transport profile. Whatever timing error
+// the bench measures for it is the machine's and Fast DDS's, not the replayer's.
+//   oscar-bench-replay-raw SCHEDULE --domain D
+// SCHEDULE has a line "topic type seq offset_ns" per cue (type oscar::GvImage or oscar::Bool).
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <thread>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+
+#include "bench_common.hpp"
+#include "oscar/cue_type_info.hpp"
+#include "oscar/dds_participant.hpp"
+#include "oscar/output.hpp"
+#include "oscar/process_util.hpp"
+
+namespace fdds = eprosima::fastdds::dds;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+fdds::DataWriterQos writer_qos() {
+  fdds::DataWriterQos q = fdds::DATAWRITER_QOS_DEFAULT;
+  q.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
+  q.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = static_cast<std::int32_t>(oscar::OutputOptions{}.depth);
+  q.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
+  q.publish_mode().kind = fdds::SYNCHRONOUS_PUBLISH_MODE;
+  return q;
+}
+
+struct Lane {
+  std::string topic;
+  bool image = false;
+  std::vector<std::pair<std::uint64_t, std::chrono::nanoseconds>> due;  ///< seq, offset
+  std::unique_ptr<oscar::DdsParticipant> participant;
+  fdds::DataWriter* writer = nullptr;
+};
+
+// Publishes the lane's cues at their times; returns how late each write began (us).
+template <class T>
+std::vector<double> publish(const Lane& lane, T cue, Clock::time_point start) {
+  cue.header().source(lane.topic);
+  std::vector<double> late_us;
+  late_us.reserve(lane.due.size());
+  for (const auto& [seq, offset] : lane.due) {
+    std::this_thread::sleep_until(start + offset);
+    late_us.push_back(
+        std::chrono::duration<double, std::micro>(Clock::now() - (start + offset)).count());
+    cue.header().seq(seq);
+    cue.header().stamps({oscar::bench::wall_ns()});
+    lane.writer->write(&cue);
+  }
+  return late_us;
+}
+
+std::map<std::string, Lane> read_schedule(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot read " + path);
+  std::map<std::string, Lane> lanes;
+  std::string topic, type;
+  std::uint64_t seq = 0, offset = 0;
+  while (in >> topic >> type >> seq >> offset) {
+    if (type != "oscar::GvImage" && type != "oscar::Bool") {
+      throw std::runtime_error(path + ": type '" + type +
+                               "' is neither oscar::GvImage nor oscar::Bool");
+    }
+    auto& lane = lanes[topic];
+    lane.topic = topic;
+    lane.image = type == "oscar::GvImage";
+    lane.due.emplace_back(seq, std::chrono::nanoseconds(offset));
+  }
+  if (lanes.empty()) throw std::runtime_error(path + " holds no cues");
+  return lanes;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "oscar-bench-replay-raw: plain Fast DDS publishing of oscar bench replay's schedule"};
+  std::string schedule;
+  int domain = 0;
+  app.add_option("SCHEDULE", schedule, "a 'topic type seq offset_ns' line per cue")->required();
+  app.add_option("--domain", domain);
+  CLI11_PARSE(app, argc, argv);
+  try {
+    auto lanes = read_schedule(schedule);
+    std::size_t history_bytes = 0;
+    for (auto& [topic, lane] : lanes) {
+      lane.participant = std::make_unique<oscar::DdsParticipant>(domain, "oscar-bench-replay-raw");
+      auto& t = lane.participant->topic(
+          topic, lane.image ? oscar::cue_type_info<oscar::GvImage>().new_topic_type()
+                            : oscar::cue_type_info<oscar::Bool>().new_topic_type());
+      lane.writer = lane.participant->publisher().create_datawriter(&t, writer_qos());
+      if (!lane.writer) throw std::runtime_error("cannot create a writer for " + topic);
+      if (lane.image) history_bytes += (oscar::OutputOptions{}.depth + 1) * 768 * 576;
+    }
+    oscar::prefault_heap(history_bytes);  // as oscar replay does
+    const auto until = Clock::now() + std::chrono::seconds(10);
+    for (auto& [topic, lane] : lanes) {
+      fdds::PublicationMatchedStatus matched;
+      while (lane.writer->get_publication_matched_status(matched), matched.current_count == 0) {
+        if (Clock::now() > until) throw std::runtime_error("no reader for " + topic);
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+    }
+    const auto start = Clock::now() + std::chrono::milliseconds(100);
+    const auto image = oscar::bench::pal_image();
+    std::vector<std::vector<double>> late_us(lanes.size());
+    std::vector<std::thread> threads;
+    for (auto& [topic, lane] : lanes) {
+      threads.emplace_back([&lane, &image, start, &late = late_us[threads.size()]] {
+        late = lane.image ? publish(lane, image, start) : publish(lane, oscar::Bool{}, start);
+      });
+    }
+    for (auto& t : threads) t.join();
+    std::vector<double> all;
+    for (const auto& l : late_us) all.insert(all.end(), l.begin(), l.end());
+    std::sort(all.begin(), all.end());
+    const auto at = [&](double q) {
+      return all[std::min(all.size() - 1,
+                          static_cast<std::size_t>(q * static_cast<double>(all.size())))];
+    };
+    // The line oscar replay prints too.
+    std::printf("publishing began late by p50 %.0f us, p99 %.0f us, max %.0f us\n", at(0.5),
+                at(0.99), all.back());
+    for (auto& [topic, lane] : lanes) {
+      lane.writer->wait_for_acknowledgments({2, 0});
+      lane.participant->publisher().delete_datawriter(lane.writer);
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "oscar-bench-replay-raw: %s\n", e.what());
+    return 1;
+  }
+}
