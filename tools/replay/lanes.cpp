@@ -1,6 +1,7 @@
 #include "lanes.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 namespace oscar::replay {
 
@@ -14,9 +15,23 @@ struct Lanes::Lane {
   std::thread thread;
 };
 
-Lanes::Lanes(Clock::time_point start, std::size_t ahead_bytes, const std::atomic<bool>& stop,
-             std::function<bool(const Pending&)> wait)
-    : start_(start), ahead_bytes_(ahead_bytes), stop_(stop), wait_(std::move(wait)) {}
+Lanes::Lanes(const std::vector<const void*>& keys, Clock::time_point start, std::size_t ahead_bytes,
+             const std::atomic<bool>& stop, std::function<bool(const Pending&)> wait,
+             ReadingPace pace)
+    : start_(start),
+      ahead_bytes_(ahead_bytes),
+      stop_(stop),
+      wait_(std::move(wait)),
+      pace_(std::move(pace)) {
+  // Started here, by the caller: the reading thread may lower its priority later, and threads
+  // it started would inherit that.
+  for (const auto* key : keys) {
+    auto& lane = lanes_[key];
+    if (lane) continue;
+    lane = std::make_unique<Lane>();
+    lane->thread = std::thread([this, l = lane.get()] { run(*l); });
+  }
+}
 
 Lanes::~Lanes() {
   cancelled_ = true;
@@ -25,48 +40,40 @@ Lanes::~Lanes() {
 }
 
 void Lanes::close_lanes() {
-  // Joined without holding mutex_: a lane takes it to wake the reader.
-  std::map<const void*, std::unique_ptr<Lane>> lanes;
-  {
-    std::lock_guard lock(mutex_);
-    lanes.swap(lanes_);
-  }
-  for (auto& [key, lane] : lanes) {
+  reading_ = false;
+  for (auto& [key, lane] : lanes_) {
     {
-      std::lock_guard lane_lock(lane->mutex);
+      std::lock_guard lock(lane->mutex);
       lane->closing = true;
     }
     lane->ready.notify_all();
   }
-  for (auto& [key, lane] : lanes) lane->thread.join();
+  for (auto& [key, lane] : lanes_) {
+    if (lane->thread.joinable()) lane->thread.join();
+  }
 }
 
 bool Lanes::add(Pending p) {
-  Lane* lane = nullptr;
-  {
+  const auto it = lanes_.find(p.lane);
+  if (it == lanes_.end()) throw std::invalid_argument("Lanes::add: a lane it was not given");
+  auto& lane = *it->second;
+  if (queued_bytes_ >= ahead_bytes_) {
+    if (pace_.ahead) pace_.ahead();
+    // Wait until half is published: waking the reader after every message cost a context switch
+    // per message (1000 a second for a 1 kHz topic). In slices: `stop` is set by a signal
+    // handler, which cannot notify.
     std::unique_lock lock(mutex_);
-    // Once full, wait until half is published: waking the reader after every message cost a
-    // context switch per message (1000 a second for a 1 kHz topic). In slices: `stop` is set by
-    // a signal handler, which cannot notify.
-    if (queued_bytes_ >= ahead_bytes_) {
-      while (queued_bytes_ > ahead_bytes_ / 2 && !stopping()) {
-        space_.wait_for(lock, std::chrono::milliseconds(100));
-      }
+    while (queued_bytes_ > ahead_bytes_ / 2 && !stopping()) {
+      space_.wait_for(lock, std::chrono::milliseconds(100));
     }
-    if (stopping()) return false;
-    auto& slot = lanes_[p.lane];
-    if (!slot) {
-      slot = std::make_unique<Lane>();
-      slot->thread = std::thread([this, l = slot.get()] { run(*l); });
-    }
-    lane = slot.get();
   }
+  if (stopping()) return false;
   queued_bytes_ += p.bytes.size();
   {
-    std::lock_guard lock(lane->mutex);
-    lane->queue.push_back(std::move(p));
+    std::lock_guard lock(lane.mutex);
+    lane.queue.push_back(std::move(p));
   }
-  lane->ready.notify_one();
+  lane.ready.notify_one();
   return true;
 }
 
@@ -117,10 +124,12 @@ void Lanes::run(Lane& lane) {
     }
     // The reader waits for the queue to fall to half: wake it when this message crosses that.
     const auto before = queued_bytes_.fetch_sub(size);
-    if (stopping() || (before > ahead_bytes_ / 2 && before - size <= ahead_bytes_ / 2)) {
+    const auto crossed = [&](std::size_t mark) { return before > mark && before - size <= mark; };
+    if (stopping() || crossed(ahead_bytes_ / 2)) {
       std::lock_guard lock(mutex_);
       space_.notify_all();
     }
+    if (crossed(ahead_bytes_ / 4) && reading_ && pace_.behind) pace_.behind();
   }
 }
 

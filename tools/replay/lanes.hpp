@@ -27,19 +27,28 @@ struct Pending {
   std::string label;                                        ///< what step mode shows before it
 };
 
+/// What the lanes tell the reading thread about its pace (both optional).
+struct ReadingPace {
+  std::function<void()> ahead;   ///< in the reader, before it waits for room: it is far ahead
+  std::function<void()> behind;  ///< in a lane: less than a quarter is queued, reading goes on
+};
+
 class Lanes {
  public:
   using Clock = std::chrono::steady_clock;
-  /// `wait` replaces the wait for the due time (e.g. for Enter in step mode); it returns false to
-  /// stop the replay.
-  Lanes(Clock::time_point start, std::size_t ahead_bytes, const std::atomic<bool>& stop,
-        std::function<bool(const Pending&)> wait = {});
+  /// Starts a thread per lane in `keys` (the `Pending::lane` values it will be given). `wait`
+  /// replaces the wait for the due time (e.g. for Enter in step mode); it returns false to stop
+  /// the replay.
+  Lanes(const std::vector<const void*>& keys, Clock::time_point start, std::size_t ahead_bytes,
+        const std::atomic<bool>& stop, std::function<bool(const Pending&)> wait = {},
+        ReadingPace pace = {});
   ~Lanes();  ///< stops every lane, published or not
   Lanes(const Lanes&) = delete;
   Lanes& operator=(const Lanes&) = delete;
 
   /// Queues `p` on its lane. Once `ahead_bytes` are queued it blocks until the lanes have
   /// published half of them. False once the replay stops.
+  /// @throws std::invalid_argument for a lane not given at construction.
   bool add(Pending p);
   /// Waits until every lane has published what it was given (or the replay stopped).
   void drain();
@@ -59,10 +68,12 @@ class Lanes {
   const std::size_t ahead_bytes_;
   const std::atomic<bool>& stop_;
   std::function<bool(const Pending&)> wait_;
-  std::mutex mutex_;               ///< guards lanes_; the reader waits for room under it
-  std::condition_variable space_;  ///< the reader waits for room here
-  std::map<const void*, std::unique_ptr<Lane>> lanes_;
+  ReadingPace pace_;
+  std::map<const void*, std::unique_ptr<Lane>> lanes_;  ///< fixed at construction
+  std::mutex mutex_;                                    ///< the reader waits for room under it
+  std::condition_variable space_;
   std::atomic<std::size_t> queued_bytes_{0};
+  std::atomic<bool> reading_{true};  ///< until drain(): more messages may come
   std::atomic<bool> cancelled_{false};
   std::atomic<std::uint64_t> published_{0};
   static constexpr std::size_t kLatenessBins = 10001;  ///< 10 us each; the last: 100 ms or more

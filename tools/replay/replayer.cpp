@@ -16,6 +16,7 @@
 #include "oscar/output.hpp"
 #include "oscar/process_util.hpp"
 #include "raw_cdr_type.hpp"
+#include "reading_priority.hpp"
 #include "recorder.hpp"  // topic_of
 
 namespace oscar::replay {
@@ -165,8 +166,18 @@ ReplayCounters Replayer::run(const std::atomic<bool>& stop) {
       return static_cast<bool>(std::getline(std::cin, line));
     };
   }
-  // Each topic is published by a thread of its own.
-  Lanes lanes(begun, kReadAheadBytes, stop, step);
+  // Each topic is published by a thread of its own, started before this thread's priority is
+  // lowered; this thread reads, in the background while it is far ahead.
+  std::vector<const void*> keys;
+  for (const auto& [id, w] : d.writers) keys.push_back(d.o.step ? nullptr : w.second);
+  std::optional<ReadingPriority> priority;
+  if (!d.o.step) priority.emplace();
+  ReadingPace pace;
+  if (priority && priority->available()) {
+    pace.ahead = [&] { priority->background(); };
+    pace.behind = [&] { priority->normal(); };
+  }
+  Lanes lanes(keys, begun, kReadAheadBytes, stop, step, pace);
   const auto scaled = [&](std::uint64_t ns) {
     return std::chrono::nanoseconds(static_cast<std::int64_t>(static_cast<double>(ns) / d.o.rate));
   };

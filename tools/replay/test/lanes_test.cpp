@@ -39,7 +39,7 @@ TEST(Lanes, PublishEachLaneInOrderNeverBeforeItsDueTime) {
   const int a = 0, b = 0;
   const auto start = Clock::now() + 20ms;
   {
-    Lanes lanes(start, 1 << 20, stop);
+    Lanes lanes({&a, &b}, start, 1 << 20, stop);
     for (int i = 0; i < 20; ++i) {
       ASSERT_TRUE(lanes.add(message(&a, i * 2ms, i, 8, out)));
       ASSERT_TRUE(lanes.add(message(&b, i * 2ms + 1ms, 100 + i, 8, out)));
@@ -65,7 +65,7 @@ TEST(Lanes, AFullReaderWaitsUntilHalfOfWhatIsAheadIsPublished) {
   const std::atomic<bool> stop{false};
   Published out;
   const int lane = 0;
-  Lanes lanes(Clock::now() + 50ms, 100, stop);  // nothing is due before the 11th is read
+  Lanes lanes({&lane}, Clock::now() + 50ms, 100, stop);  // nothing due before the 11th is read
   for (int i = 0; i < 10; ++i) ASSERT_TRUE(lanes.add(message(&lane, i * 5ms, i, 10, out)));
   ASSERT_TRUE(lanes.add(message(&lane, 50ms, 10, 10, out)));
   EXPECT_GE(lanes.published(), 5u);
@@ -77,7 +77,7 @@ TEST(Lanes, AStopEndsTheWaitsForRoomAndForDueTimes) {
   std::atomic<bool> stop{false};
   Published out;
   const int lane = 0;
-  Lanes lanes(Clock::now(), 10, stop);
+  Lanes lanes({&lane}, Clock::now(), 10, stop);
   ASSERT_TRUE(lanes.add(message(&lane, 1h, 0, 10, out)));  // fills the read-ahead
   const auto t0 = Clock::now();
   std::thread stopper([&] {
@@ -97,7 +97,7 @@ TEST(Lanes, DestroyingThemDropsWhatIsNotDueYet) {
   const int lane = 0;
   const auto t0 = Clock::now();
   {
-    Lanes lanes(Clock::now(), 1 << 20, stop);
+    Lanes lanes({&lane}, Clock::now(), 1 << 20, stop);
     ASSERT_TRUE(lanes.add(message(&lane, 0ms, 0, 8, out)));
     ASSERT_TRUE(lanes.add(message(&lane, 1h, 1, 8, out)));
     std::this_thread::sleep_for(50ms);
@@ -105,6 +105,33 @@ TEST(Lanes, DestroyingThemDropsWhatIsNotDueYet) {
   EXPECT_LT(Clock::now() - t0, 1s);
   ASSERT_EQ(out.by_lane[&lane].size(), 1u);
   EXPECT_EQ(out.by_lane[&lane][0].first, 0);
+}
+
+TEST(Lanes, TellTheReaderWhenItIsFarAheadAndWhenItFallsBehind) {
+  const std::atomic<bool> stop{false};
+  Published out;
+  const int lane = 0;
+  std::atomic<int> ahead{0}, behind{0};
+  Lanes lanes({&lane}, Clock::now() + 50ms, 100, stop, {},
+              ReadingPace{[&] { ++ahead; }, [&] { ++behind; }});
+  for (int i = 0; i < 10; ++i) ASSERT_TRUE(lanes.add(message(&lane, i * 5ms, i, 10, out)));
+  EXPECT_EQ(ahead, 0);
+  ASSERT_TRUE(lanes.add(message(&lane, 50ms, 10, 10, out)));  // full: waits for half
+  EXPECT_EQ(ahead, 1);
+  EXPECT_EQ(behind, 0);
+  // Nothing more is read: the queue falls below a quarter (25 bytes) while reading goes on.
+  const auto until = Clock::now() + 2s;
+  while (behind == 0 && Clock::now() < until) std::this_thread::sleep_for(5ms);
+  EXPECT_EQ(behind, 1);
+  lanes.drain();
+}
+
+TEST(Lanes, AMessageForALaneNotGivenIsAnError) {
+  const std::atomic<bool> stop{false};
+  Published out;
+  const int lane = 0, other = 0;
+  Lanes lanes({&lane}, Clock::now(), 100, stop);
+  EXPECT_THROW(lanes.add(message(&other, 0ms, 0, 1, out)), std::invalid_argument);
 }
 
 }  // namespace
