@@ -101,15 +101,19 @@ struct Replayer::Impl {
   }
 
   // The memory publishing will use: the read-ahead and each writer's history (depth + 1
-  // messages of the largest size among the first messages of its topic).
+  // messages of the largest size among the first messages of its topic). The scan ends once
+  // every topic was seen or a read-ahead's worth was read (a topic not seen by then is small).
   std::size_t memory_needed() {
     std::map<std::uint16_t, std::size_t> largest;
+    std::size_t scanned = 0;
     try {
       reader.read_messages([&](const mcap::Channel& ch, const mcap::MessageView& m) {
-        if (!writers.count(ch.id)) return;
-        auto& size = largest[ch.id];
-        size = std::max(size, m.data.size());
-        if (largest.size() == writers.size()) throw Stopped{};
+        scanned += m.data.size();
+        if (writers.count(ch.id)) {
+          auto& size = largest[ch.id];
+          size = std::max(size, m.data.size());
+        }
+        if (largest.size() == writers.size() || scanned >= kReadAheadBytes) throw Stopped{};
       });
     } catch (const Stopped&) {
     }
