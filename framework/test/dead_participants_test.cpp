@@ -54,12 +54,17 @@ class Discovery : public eprosima::fastdds::dds::DomainParticipantListener {
 // the others remove it as one that left (REMOVED), not drop it when its lease ends (DROPPED).
 TEST(DeadParticipants, TheDepartureOfAKilledParticipantIsAnnouncedInItsName) {
   const int domain = 100 + getpid() % 50;
+  int ready[2];
+  ASSERT_EQ(pipe(ready), 0);
   const pid_t child = fork();  // before this process has any DDS thread
   if (child == 0) {
     DdsParticipant doomed(domain, "doomed");
+    // Its prefix is in its claim once the constructor returns; discovery can see it before.
+    if (write(ready[1], "r", 1) != 1) _exit(1);
     pause();
     _exit(0);
   }
+  close(ready[1]);
   Discovery discovery;
   DdsParticipant observer(domain, "observer");
   observer.get().set_listener(&discovery, eprosima::fastdds::dds::StatusMask::none());
@@ -69,6 +74,9 @@ TEST(DeadParticipants, TheDepartureOfAKilledParticipantIsAnnouncedInItsName) {
   std::ostringstream expected;
   expected << doomed;
   EXPECT_TRUE(announce_killed_participants(domain, {}).empty()) << "nobody died yet";
+  char byte = 0;
+  ASSERT_EQ(read(ready[0], &byte, 1), 1) << "the child's participant was not made";
+  close(ready[0]);
 
   kill(child, SIGKILL);
   waitpid(child, nullptr, 0);

@@ -39,9 +39,11 @@ struct Schedule {
   };
   std::vector<Cue> cues;                                                    ///< in time order
   std::map<std::pair<std::string, std::uint64_t>, std::uint64_t> log_time;  ///< (topic, seq)
+  std::set<std::string> image_topics;
 
   void add(Cue c) {
     log_time[{c.topic, c.seq}] = c.log_time;
+    if (c.type == "oscar::GvImage") image_topics.insert(c.topic);
     cues.push_back(std::move(c));
   }
   // For oscar-bench-replay-raw: "topic type seq offset_ns" lines, the offset from the first cue.
@@ -197,7 +199,7 @@ Run measure(const std::vector<std::string>& publisher, const Schedule& schedule,
     const auto s = schedule.log_time.find({topic, seq});
     if (s == schedule.log_time.end()) continue;
     offsets.push_back(static_cast<double>(t) - static_cast<double>(s->second));
-    is_image.push_back(topic.find("/cam") != std::string::npos);
+    is_image.push_back(schedule.image_topics.count(topic) > 0);
   }
   const double shift = percentile(offsets, 0.5);
   Run run;
