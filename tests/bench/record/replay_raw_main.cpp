@@ -4,7 +4,8 @@
 // last 16, volatile, synchronous) and OSCAR's loopback transport profile. Whatever timing error
 // the bench measures for it is the machine's and Fast DDS's, not the replayer's.
 //   oscar-bench-replay-raw SCHEDULE --domain D
-// SCHEDULE has a line "topic type seq offset_ns" per cue (type oscar::GvImage or oscar::Bool).
+// SCHEDULE has a line "topic type seq offset_ns" per cue (type oscar::GvImage or oscar::Bool);
+// every GvImage cue is the bench's 768x576 frame.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>

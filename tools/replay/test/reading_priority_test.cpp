@@ -36,5 +36,26 @@ TEST(ReadingPriority, TheThreadIsNormalAgainWhenItEnds) {
   reading.join();
 }
 
+TEST(ReadingPriority, ItReturnsToTheSchedulingTheThreadHad) {
+  std::thread reading([] {
+    sched_param fifo{};
+    fifo.sched_priority = 1;
+    if (sched_setscheduler(0, SCHED_FIFO, &fifo) != 0) {
+      GTEST_SKIP() << "this process may not use SCHED_FIFO";
+    }
+    {
+      const ReadingPriority priority;
+      ASSERT_TRUE(priority.available());
+      priority.background();
+      EXPECT_EQ(sched_getscheduler(0), SCHED_IDLE);
+      priority.normal();
+      EXPECT_EQ(sched_getscheduler(0), SCHED_FIFO);
+      priority.background();
+    }
+    EXPECT_EQ(sched_getscheduler(0), SCHED_FIFO);
+  });
+  reading.join();
+}
+
 }  // namespace
 }  // namespace oscar::replay
