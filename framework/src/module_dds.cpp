@@ -17,18 +17,6 @@ namespace oscar {
 namespace dds = eprosima::fastdds::dds;
 
 namespace {
-dds::DataWriterQos cue_writer_qos(const OutputOptions& o) {
-  dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
-  q.reliability().kind =
-      o.reliable ? dds::RELIABLE_RELIABILITY_QOS : dds::BEST_EFFORT_RELIABILITY_QOS;
-  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-  q.history().depth = static_cast<std::int32_t>(o.depth);
-  q.durability().kind =
-      o.transient_local ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
-  q.publish_mode().kind = dds::SYNCHRONOUS_PUBLISH_MODE;
-  return q;
-}
-
 dds::DataReaderQos cue_reader_qos(std::size_t depth) {
   dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
   q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
@@ -44,7 +32,7 @@ class Module::Dds::OutputWriter final : public dds::DataWriterListener {
  public:
   OutputWriter(DdsParticipant& p, OutputPort& out) : out_(out) {
     auto& topic = p.topic(cue_topic(out.address()), out.type().new_topic_type());
-    writer_ = p.publisher().create_datawriter(&topic, cue_writer_qos(out.options()), this,
+    writer_ = p.publisher().create_datawriter(&topic, qos::cue_writer(out.options()), this,
                                               dds::StatusMask::publication_matched());
     if (!writer_) throw std::runtime_error("cannot create a writer for " + out.address());
     const bool keep_history = out.options().transient_local;

@@ -1,5 +1,7 @@
 #include "oscar/topic_io.hpp"
 
+#include "oscar/output.hpp"
+
 namespace oscar::qos {
 namespace dds = eprosima::fastdds::dds;
 
@@ -64,6 +66,18 @@ dds::DataReaderQos beat_reader(std::chrono::milliseconds lease) {
   q.endpoint().history_memory_policy = kDynamic;
   q.liveliness().kind = dds::MANUAL_BY_TOPIC_LIVELINESS_QOS;
   q.liveliness().lease_duration = seconds(lease);
+  return q;
+}
+
+dds::DataWriterQos cue_writer(const OutputOptions& o) {
+  dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
+  q.reliability().kind =
+      o.reliable ? dds::RELIABLE_RELIABILITY_QOS : dds::BEST_EFFORT_RELIABILITY_QOS;
+  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = static_cast<std::int32_t>(o.depth);
+  q.durability().kind =
+      o.transient_local ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
+  q.publish_mode().kind = dds::SYNCHRONOUS_PUBLISH_MODE;
   return q;
 }
 

@@ -8,13 +8,13 @@
 
 #include <fmt/format.h>
 #include <fastdds/dds/publisher/DataWriter.hpp>
-#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 
 #include "lanes.hpp"
 #include "oscar/dds_participant.hpp"
 #include "oscar/mcap/reader.hpp"
 #include "oscar/output.hpp"
 #include "oscar/process_util.hpp"
+#include "oscar/topic_io.hpp"
 #include "raw_cdr_type.hpp"
 #include "reading_priority.hpp"
 #include "recorder.hpp"  // topic_of
@@ -83,12 +83,7 @@ struct Replayer::Impl {
       }
       auto& lane = *lanes[writers.size() % lanes.size()];
       auto& topic = lane.topic(tt.first, new record::RawCdrType(tt.second));
-      dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
-      q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-      q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-      q.history().depth = static_cast<std::int32_t>(kHistoryDepth);  // as a module's output
-      q.publish_mode().kind = dds::SYNCHRONOUS_PUBLISH_MODE;
-      auto* w = lane.publisher().create_datawriter(&topic, q);
+      auto* w = lane.publisher().create_datawriter(&topic, qos::cue_writer(OutputOptions{}));
       if (!w) throw std::runtime_error("cannot create a writer for " + tt.first);
       writers[id] = {&lane, w};
       fmt::print(stderr, "replaying {} as {} ({})\n", info.channels.at(id).topic, tt.first,

@@ -18,6 +18,8 @@
 
 namespace oscar {
 
+struct OutputOptions;
+
 /// QoS of the system topics; all allocate samples as large as they are (no preallocation).
 namespace qos {
 /// Reliable, transient-local, keep last `depth`: late joiners get the recent history.
@@ -28,6 +30,9 @@ eprosima::fastdds::dds::DataReaderQos stream_reader(int depth);
 /// Reliable, keep last 1, manual-by-topic liveliness with `lease`.
 eprosima::fastdds::dds::DataWriterQos beat_writer(std::chrono::milliseconds lease);
 eprosima::fastdds::dds::DataReaderQos beat_reader(std::chrono::milliseconds lease);
+/// A kernel output's cue writer: keep last `depth`, reliable or best effort, volatile or
+/// transient-local as the options say, written synchronously.
+eprosima::fastdds::dds::DataWriterQos cue_writer(const OutputOptions& o);
 }  // namespace qos
 
 /// Calls `on_sample` for every valid sample (on a DDS thread) and `on_lost` when a writer's

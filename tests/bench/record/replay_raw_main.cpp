@@ -17,28 +17,18 @@
 
 #include <CLI/CLI.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
-#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 
 #include "bench_common.hpp"
 #include "oscar/cue_type_info.hpp"
 #include "oscar/dds_participant.hpp"
 #include "oscar/output.hpp"
 #include "oscar/process_util.hpp"
+#include "oscar/topic_io.hpp"
 
 namespace fdds = eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-
-fdds::DataWriterQos writer_qos() {
-  fdds::DataWriterQos q = fdds::DATAWRITER_QOS_DEFAULT;
-  q.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
-  q.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
-  q.history().depth = static_cast<std::int32_t>(oscar::OutputOptions{}.depth);
-  q.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
-  q.publish_mode().kind = fdds::SYNCHRONOUS_PUBLISH_MODE;
-  return q;
-}
 
 struct Lane {
   std::string topic;
@@ -103,7 +93,8 @@ int main(int argc, char** argv) {
       auto& t = lane.participant->topic(
           topic, lane.image ? oscar::cue_type_info<oscar::GvImage>().new_topic_type()
                             : oscar::cue_type_info<oscar::Bool>().new_topic_type());
-      lane.writer = lane.participant->publisher().create_datawriter(&t, writer_qos());
+      lane.writer = lane.participant->publisher().create_datawriter(
+          &t, oscar::qos::cue_writer(oscar::OutputOptions{}));
       if (!lane.writer) throw std::runtime_error("cannot create a writer for " + topic);
       if (lane.image) history_bytes += (oscar::OutputOptions{}.depth + 1) * 768 * 576;
     }
