@@ -36,4 +36,9 @@ void keep_cue_memory_in_process();
 /// reallocating them, come from this memory. Implies keep_cue_memory_in_process().
 void prefault_heap(std::size_t bytes);
 
+/// Asks the kernel to wake the calling thread when its sleep ends, not up to 50 us later: timer
+/// slack 1 ns instead of Linux's default 50 us, which lets the kernel batch wake-ups (real-time
+/// threads have none). For threads that publish on a schedule, e.g. oscar replay's lanes.
+void wake_on_time();
+
 }  // namespace oscar

@@ -42,6 +42,7 @@ struct Lane {
 template <class T>
 std::vector<double> publish(const Lane& lane, T cue, Clock::time_point start) {
   cue.header().source(lane.topic);
+  oscar::wake_on_time();  // as oscar replay's lanes
   std::vector<double> late_us;
   late_us.reserve(lane.due.size());
   for (const auto& [seq, offset] : lane.due) {

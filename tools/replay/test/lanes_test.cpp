@@ -1,6 +1,7 @@
 #include "lanes.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/prctl.h>
 
 #include <atomic>
 #include <chrono>
@@ -57,6 +58,25 @@ TEST(Lanes, PublishEachLaneInOrderNeverBeforeItsDueTime) {
       EXPECT_GE(got[i].second, due) << "message " << i << " was published early";
     }
   }
+}
+
+TEST(Lanes, PublishWithoutTimerSlack) {
+  // Linux may wake a sleeping thread up to its timer slack late (50 us by default).
+  const std::atomic<bool> stop{false};
+  const int lane = 0;
+  std::atomic<long> slack_ns{-1};
+  {
+    Lanes lanes({&lane}, Clock::now(), 1 << 20, stop);
+    Pending p;
+    p.lane = &lane;
+    p.bytes.assign(1, 0);
+    p.publish = [&](std::vector<std::uint8_t>&) {
+      slack_ns = prctl(PR_GET_TIMERSLACK, 0, 0, 0, 0);
+    };
+    ASSERT_TRUE(lanes.add(std::move(p)));
+    lanes.drain();
+  }
+  EXPECT_EQ(slack_ns, 1);
 }
 
 TEST(Lanes, AFullReaderWaitsUntilHalfOfWhatIsAheadIsPublished) {
