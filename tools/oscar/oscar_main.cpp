@@ -33,7 +33,8 @@ const char* const kUsage =
     "  hz TOPIC              a topic's rate and the min/max/std of its period\n"
     "  graph [-o FILE.svg]   the running system as a graph (modules, kernels, channels)\n"
     "  new-module NAME ...   generate a module: kernel, CMake, README, unit test\n"
-    "  bench <what> ...      benchmarks: cueflow, restart, applets, swarm, record, replay,\n"
+    "  bench <what> ...      benchmarks: cueflow, restart, applets, swarm, record, replay, "
+    "stalls,\n"
     "                        landmarks\n"
     "\n"
     "`oscar <command> --help` shows a command's options.\n";
@@ -55,8 +56,10 @@ int main(int argc, char** argv) {
   int first_arg = 2;
   if (program == "oscar-bench") {
     if (argc < 3) {
-      std::fputs("usage: oscar bench <cueflow|restart|applets|swarm|record|replay|landmarks> [args...]\n",
-                 stderr);
+      std::fputs(
+          "usage: oscar bench <cueflow|restart|applets|swarm|record|replay|landmarks|stalls> "
+          "[args...]\n",
+          stderr);
       return 2;
     }
     program += std::string("-") + argv[2];

@@ -320,9 +320,10 @@ int main(int argc, char** argv) {
           "p99 {:.1f} us; p99 ratio {:.2f}\n"
           "  write began:  oscar replay p50 {:.0f} us, p99 {:.0f} us; raw Fast DDS p50 {:.0f} us, "
           "p99 {:.0f} us\n"
-          "oscar replay's last run:\n{}",
+          "raw Fast DDS's last run:\n{}oscar replay's last run:\n{}",
           ours.p50, ours.p99, floor.p50, floor.p99, floor.p99 > 0 ? ours.p99 / floor.p99 : 0.0,
-          ours.late_p50, ours.late_p99, floor.late_p50, floor.late_p99, replays.back().output);
+          ours.late_p50, ours.late_p99, floor.late_p50, floor.late_p99, raws.back().output,
+          replays.back().output);
     }
     return 0;
   } catch (const std::exception& e) {

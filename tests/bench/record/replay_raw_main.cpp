@@ -38,22 +38,38 @@ struct Lane {
   fdds::DataWriter* writer = nullptr;
 };
 
-// Publishes the lane's cues at their times; returns how late each write began (us).
+// How late each write began and how long it took (us).
+struct Writes {
+  std::vector<double> late_us, took_us;
+};
+
+// Publishes the lane's cues at their times.
 template <class T>
-std::vector<double> publish(const Lane& lane, T cue, Clock::time_point start) {
-  cue.header().source(lane.topic);
+Writes publish(const Lane& lane, T cue, Clock::time_point start) {
   oscar::wake_on_time();  // as oscar replay's lanes
-  std::vector<double> late_us;
-  late_us.reserve(lane.due.size());
+  cue.header().source(lane.topic);
+  const auto us = [](Clock::duration d) {
+    return std::chrono::duration<double, std::micro>(d).count();
+  };
+  Writes w;
+  w.late_us.reserve(lane.due.size());
+  w.took_us.reserve(lane.due.size());
   for (const auto& [seq, offset] : lane.due) {
     std::this_thread::sleep_until(start + offset);
-    late_us.push_back(
-        std::chrono::duration<double, std::micro>(Clock::now() - (start + offset)).count());
+    const auto began = Clock::now();
+    w.late_us.push_back(us(began - (start + offset)));
     cue.header().seq(seq);
     cue.header().stamps({oscar::bench::wall_ns()});
     lane.writer->write(&cue);
+    w.took_us.push_back(us(Clock::now() - began));
   }
-  return late_us;
+  return w;
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))];
 }
 
 std::map<std::string, Lane> read_schedule(const std::string& path) {
@@ -110,24 +126,29 @@ int main(int argc, char** argv) {
     }
     const auto start = Clock::now() + std::chrono::milliseconds(100);
     const auto image = oscar::bench::pal_image();
-    std::vector<std::vector<double>> late_us(lanes.size());
+    std::vector<Writes> writes(lanes.size());
     std::vector<std::thread> threads;
     for (auto& [topic, lane] : lanes) {
-      threads.emplace_back([&lane, &image, start, &late = late_us[threads.size()]] {
-        late = lane.image ? publish(lane, image, start) : publish(lane, oscar::Bool{}, start);
+      threads.emplace_back([&lane, &image, start, &w = writes[threads.size()]] {
+        w = lane.image ? publish(lane, image, start) : publish(lane, oscar::Bool{}, start);
       });
     }
     for (auto& t : threads) t.join();
-    std::vector<double> all;
-    for (const auto& l : late_us) all.insert(all.end(), l.begin(), l.end());
-    std::sort(all.begin(), all.end());
-    const auto at = [&](double q) {
-      return all[std::min(all.size() - 1,
-                          static_cast<std::size_t>(q * static_cast<double>(all.size())))];
-    };
+    std::vector<double> late, image_took;
+    std::size_t i = 0;
+    for (const auto& [topic, lane] : lanes) {
+      const auto& w = writes[i++];
+      late.insert(late.end(), w.late_us.begin(), w.late_us.end());
+      if (lane.image) image_took.insert(image_took.end(), w.took_us.begin(), w.took_us.end());
+    }
     // The line oscar replay prints too.
-    std::printf("publishing began late by p50 %.0f us, p99 %.0f us, max %.0f us\n", at(0.5),
-                at(0.99), all.back());
+    std::printf("publishing began late by p50 %.0f us, p99 %.0f us, max %.0f us\n",
+                percentile(late, 0.5), percentile(late, 0.99), percentile(late, 1.0));
+    if (!image_took.empty()) {
+      std::printf("an image's write took p50 %.0f us, p90 %.0f us, p99 %.0f us\n",
+                  percentile(image_took, 0.5), percentile(image_took, 0.9),
+                  percentile(image_took, 0.99));
+    }
     for (auto& [topic, lane] : lanes) {
       lane.writer->wait_for_acknowledgments({2, 0});
       lane.participant->publisher().delete_datawriter(lane.writer);
