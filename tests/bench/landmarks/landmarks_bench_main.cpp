@@ -22,6 +22,7 @@
 #include "oscar/network.hpp"
 #include "oscar/perception_types.hpp"
 #include "oscar/topic_io.hpp"
+#include "percentile.hpp"  // tests/common
 #include "process.hpp"     // tests/common
 #include "test_hosts.hpp"  // tests/netns
 
@@ -35,11 +36,7 @@ std::string own_bin(const std::string& program) {
 std::string temp(const std::string& name) {
   return (fs::temp_directory_path() / fmt::format("{}_{}", name, getpid())).string();
 }
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))];
-}
+using oscar::test::percentile;
 
 // --watch: subscribes to the fused pose (on the network of `host` in `system`) and writes one
 // latency per pose that used both cameras: its last stamp minus the earlier of the two grabs.

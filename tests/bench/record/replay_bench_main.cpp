@@ -25,8 +25,9 @@
 #include "oscar/mcap/reader.hpp"
 #include "oscar/mcap/writer.hpp"
 #include "oscar/process_util.hpp"
-#include "process.hpp"  // tests/common
-#include "raw_tap.hpp"  // tools/inspect
+#include "percentile.hpp"  // tests/common
+#include "process.hpp"     // tests/common
+#include "raw_tap.hpp"     // tools/inspect
 
 namespace {
 using namespace std::chrono_literals;
@@ -140,11 +141,7 @@ Schedule schedule_of(const std::string& path) {
   return schedule;
 }
 
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(p * static_cast<double>(v.size())))];
-}
+using oscar::test::percentile;
 
 // One publisher's run as the consumers saw it: each cue's error against the schedule (us).
 struct Run {

@@ -24,6 +24,7 @@
 #include "oscar/output.hpp"
 #include "oscar/process_util.hpp"
 #include "oscar/topic_io.hpp"
+#include "percentile.hpp"  // tests/common
 
 namespace fdds = eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
@@ -66,11 +67,7 @@ Writes publish(const Lane& lane, T cue, Clock::time_point start) {
   return w;
 }
 
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))];
-}
+using oscar::test::percentile;
 
 std::map<std::string, Lane> read_schedule(const std::string& path) {
   std::ifstream in(path);

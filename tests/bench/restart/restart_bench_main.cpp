@@ -16,6 +16,7 @@
 #include "oscar/process_util.hpp"
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/time.hpp"
+#include "percentile.hpp"  // tests/common
 #include "process.hpp"     // tests/common
 #include "test_hosts.hpp"  // tests/netns
 
@@ -26,11 +27,7 @@ std::string temp(const std::string& name) {
   return (std::filesystem::temp_directory_path() / fmt::format("{}_{}", name, getpid())).string();
 }
 
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))];
-}
+using oscar::test::percentile;
 
 const oscar::ModuleEntry* find(const oscar::SystemState& s, const std::string& name) {
   for (const auto& m : s.modules()) {
