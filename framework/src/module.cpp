@@ -16,6 +16,7 @@
 #include "dds_log_sink.hpp"
 #include "module_dds.hpp"
 #include "module_slot.hpp"
+#include "repeat_filter_sink.hpp"
 #include "ring_pull_source.hpp"
 #include "sequence_store.hpp"
 
@@ -32,12 +33,14 @@ std::string source_channel(const std::string& source) {
 
 Module::Module(ModuleSpec spec, const std::vector<std::string>& plugin_path)
     : spec_(std::move(spec)) {
-  // Every line goes to stdout and, once the module is on DDS, to oscar/log.
+  // Every line goes to stdout and, once the module is on DDS, to oscar/log; a line repeated
+  // within a second is held back and counted.
   log_sink_ = std::make_shared<internal::DdsLogSink>(spec_.name);
-  const spdlog::sinks_init_list sinks{std::make_shared<spdlog::sinks::stdout_color_sink_mt>(),
-                                      log_sink_};
+  auto repeats = std::make_shared<internal::RepeatFilterSink>(std::chrono::seconds(1));
+  repeats->add_sink(std::make_shared<spdlog::sinks::stdout_color_sink_st>());
+  repeats->add_sink(log_sink_);
   const auto make_logger = [&](const std::string& name) {
-    auto logger = std::make_shared<spdlog::logger>(name, sinks);
+    auto logger = std::make_shared<spdlog::logger>(name, repeats);
     logger->set_pattern("%H:%M:%S.%e %^%-5l%$ [%n] %v");
     return logger;
   };
@@ -237,19 +240,72 @@ void Module::stop() {
 
 // Runs on the processing thread without the lock; `stub` was read under it.
 void Module::run_slot(Slot& slot, Trigger trigger, bool stub) {
+  const char* call = "on_activate()";
   try {
     if (!slot.active) {
       slot.instance->kernel().on_activate();
       slot.active = true;
     }
+    call = stub ? "stub()" : "process()";
     busy_since_ns_.store(Clock::now().time_since_epoch().count(), std::memory_order_relaxed);
     slot.instance->run(wall_now(), trigger, stub);
     busy_since_ns_.store(0, std::memory_order_relaxed);
+    slot.failures_in_a_row = 0;
   } catch (const std::exception& e) {
     busy_since_ns_.store(0, std::memory_order_relaxed);
-    slot.failure = e.what();
-    log_->error("kernel '{}' failed in {}: {}", slot.instance->name(),
-                stub ? "stub()" : "process()", e.what());
+    kernel_failed(slot, fmt::format("{}: {}", call, e.what()));
+  }
+}
+
+// Counts the failure (oscar ps shows it) and acts once when the policy's count in a row is
+// reached (DESIGN: failures are reported and acted on, not logged and forgotten).
+void Module::kernel_failed(Slot& slot, std::string failure) {
+  const auto& policy = spec_.on_kernel_error;
+  const auto& name = slot.instance->name();
+  {
+    std::lock_guard lock(mutex_);
+    ++slot.failures;
+    ++slot.failures_in_a_row;
+    slot.failure = std::move(failure);
+  }
+  log_->error("kernel '{}' failed in {}", name, slot.failure);
+  if (slot.failures_in_a_row != policy.after) return;
+  switch (policy.action) {
+    case KernelErrorPolicy::Action::kContinue:
+      return;
+    case KernelErrorPolicy::Action::kDeactivate: {
+      std::string transition;
+      {
+        std::lock_guard lock(mutex_);
+        transition = fmt::format(
+            "{}: {} -> deactivated (failed {} times in a row; "
+            "on_kernel_error: deactivate)",
+            name, slot.mode.describe(), slot.failures_in_a_row);
+        slot.mode.kind = ModeSpec::Kind::kDeactivated;
+        slot.pending = false;
+      }
+      if (slot.active) {
+        slot.active = false;
+        try {
+          slot.instance->kernel().on_deactivate();
+        } catch (const std::exception& e) {
+          log_->error("kernel '{}' failed in on_deactivate(): {}", name, e.what());
+        }
+      }
+      report(transition);
+      return;
+    }
+    case KernelErrorPolicy::Action::kRestart: {
+      std::lock_guard lock(mutex_);
+      exit_reason_ = fmt::format(
+          "kernel '{}' failed {} times in a row (on_kernel_error: "
+          "restart); last: {}",
+          name, slot.failures_in_a_row, slot.failure);
+      log_->error("stopping the module: {}", exit_reason_);
+      stop_requested_ = true;
+      stopped_.notify_all();
+      return;
+    }
   }
 }
 
@@ -353,6 +409,11 @@ void Module::report(const std::string& transition) {
   if (dds_) dds_->publish_state(state());
 }
 
+std::string Module::exit_reason() const {
+  std::lock_guard lock(mutex_);
+  return exit_reason_;
+}
+
 bool Module::hung() const {
   const auto since = busy_since_ns_.load(std::memory_order_relaxed);
   return since != 0 && Clock::now().time_since_epoch().count() - since >
@@ -382,6 +443,8 @@ ModuleState Module::state_locked() const {
     k.stub(s->stub);
     k.cycles(s->instance->cycles());
     k.overruns(s->overruns);
+    k.failures(s->failures);
+    k.last_failure(s->failure);
     std::uint64_t published = 0;
     for (const auto& out : s->instance->ports().outputs) published += out->published();
     k.published(published);

@@ -22,7 +22,9 @@ struct Module::Slot {
   bool pending = false;             // a trigger arrived and the kernel has not run since
   std::chrono::steady_clock::time_point next_due{};
   std::uint64_t overruns = 0;
-  std::string failure;                         // the last exception from process()/stub(), if any
+  std::uint64_t failures = 0;  // calls of on_activate()/process()/stub() that threw
+  int failures_in_a_row = 0;   // since the last call that returned (KernelErrorPolicy)
+  std::string failure;         // the last one: "process(): <what>"
   std::map<std::string, std::string> sources;  // input -> "<kernel>/<channel>", after rewires
 
   bool continuous() const { return mode.kind == ModeSpec::Kind::kContinuous; }

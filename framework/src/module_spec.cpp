@@ -204,11 +204,56 @@ ModeSpec ModeSpec::parse(const YAML::Node& node) {
       "expected single_step, deactivated, {continuous: <cycle>} or {single_step: {trigger: X}}");
 }
 
+const char* to_string(KernelErrorPolicy::Action action) {
+  switch (action) {
+    case KernelErrorPolicy::Action::kContinue:
+      return "continue";
+    case KernelErrorPolicy::Action::kDeactivate:
+      return "deactivate";
+    case KernelErrorPolicy::Action::kRestart:
+      return "restart";
+  }
+  return "?";
+}
+
+KernelErrorPolicy KernelErrorPolicy::parse(const YAML::Node& node) {
+  KernelErrorPolicy p;
+  const auto action = [](const std::string& text) {
+    for (auto a : {Action::kContinue, Action::kDeactivate, Action::kRestart}) {
+      if (text == to_string(a)) return a;
+    }
+    throw std::invalid_argument(
+        fmt::format("unknown action '{}' (allowed: continue, deactivate, restart)", text));
+  };
+  if (node.IsScalar()) {
+    p.action = action(node.as<std::string>());
+    return p;
+  }
+  if (!node.IsMap()) {
+    throw std::invalid_argument("expected continue, deactivate, restart or {action: A, after: N}");
+  }
+  for (const auto& kv : node) {
+    const auto key = kv.first.as<std::string>();
+    if (key == "action") {
+      p.action = action(kv.second.as<std::string>());
+    } else if (key == "after") {
+      p.after = kv.second.as<int>();
+      if (p.after < 1) {
+        throw std::invalid_argument(fmt::format(
+            "after: {} must be at least 1 (the number of failures in a row to act on)", p.after));
+      }
+    } else {
+      throw std::invalid_argument(fmt::format("unknown key '{}' (allowed: action, after)", key));
+    }
+  }
+  return p;
+}
+
 ModuleSpec ModuleSpec::from_yaml(const YAML::Node& node, const std::string& file) {
   if (!node || !node.IsMap()) fail(file, "a module must be a map with name and kernels");
   check_yaml_keys(node, file, "module",
                   {"name", "host", "domain", "kernels", "mode", "stub", "network", "restart",
-                   "debug", "watchdog", "standby"});
+                   "debug", "watchdog", "standby", "on_kernel_error"});
   ModuleSpec m;
   m.where = yaml_where(file, node);
   m.name = scalar(node["name"], m.where, "module name");
@@ -247,6 +292,13 @@ ModuleSpec ModuleSpec::from_yaml(const YAML::Node& node, const std::string& file
       fail(yaml_where(file, node["watchdog"]), std::string("watchdog: ") + e.what());
     }
     if (m.watchdog.count() <= 0) fail(yaml_where(file, node["watchdog"]), "watchdog must be > 0");
+  }
+  if (node["on_kernel_error"]) {
+    try {
+      m.on_kernel_error = KernelErrorPolicy::parse(node["on_kernel_error"]);
+    } catch (const std::exception& e) {
+      fail(yaml_where(file, node["on_kernel_error"]), std::string("on_kernel_error: ") + e.what());
+    }
   }
   try {
     m.network = NetworkConfig::from_yaml(node["network"]);

@@ -139,6 +139,11 @@ int run_main(int argc, char** argv) {
     // Wake the signal waiter if the module stopped on a shutdown command.
     pthread_kill(signal_waiter.native_handle(), SIGTERM);
     signal_waiter.join();
+    if (const auto reason = module.exit_reason(); !reason.empty()) {
+      std::fprintf(stderr, "oscar-run: module '%s' stopped: %s\n", module.spec().name.c_str(),
+                   reason.c_str());
+      return kKernelFailureExit;
+    }
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "oscar-run: %s\n", e.what());

@@ -3,6 +3,8 @@
 
 #include <atomic>
 #include <mutex>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "oscar/cue_types.hpp"
@@ -100,4 +102,34 @@ class CollectImage final : public Kernel {
   void stub(Cycle&) override {}
   Input<GvImage>& in_;
 };
+/// Fails as told: in on_activate() or in process() (every call, or all but every `succeed_every`
+/// -th), with "sensor unplugged"; for the kernel-error policy's tests.
+class Failing final : public Kernel {
+ public:
+  struct Params {
+    std::string fail_in = "process";  // process | on_activate
+    int succeed_every = 0;            // 0: never
+    void describe(ParamSpec& spec) {
+      spec.field("fail_in", fail_in, "process or on_activate");
+      spec.field("succeed_every", succeed_every, "every n-th process() returns (0: none)")
+          .at_least(0);
+    }
+  };
+  explicit Failing(KernelSetup& setup) { setup.params(params_); }
+  void process(Cycle&) override {
+    const int call = ++calls_;
+    if (params_.succeed_every > 0 && call % params_.succeed_every == 0) return;
+    throw std::runtime_error("sensor unplugged");
+  }
+  void stub(Cycle& c) override { process(c); }
+  void on_activate() override {
+    ++activations_;
+    if (params_.fail_in == "on_activate") throw std::runtime_error("sensor unplugged");
+  }
+  std::atomic<int> calls_{0}, activations_{0};
+
+ private:
+  Params params_;
+};
+
 }  // namespace oscar::test

@@ -37,6 +37,8 @@ nlohmann::json to_json(const oscar::SystemState& s) {
                          {"params", k.params()},
                          {"inputs", k.inputs()},
                          {"published", k.published()},
+                         {"failures", k.failures()},
+                         {"last_failure", k.last_failure()},
                          {"cycles", k.cycles()}});
     }
     j["modules"].push_back({{"name", m.name()},
@@ -92,6 +94,11 @@ int main(int argc, char** argv) {
           (m.state().suspended() && m.status() == "running" ? "suspended" : m.status().c_str()),
           m.restarts(), m.cues_per_s(), modes(m.state()).c_str(),
           m.last_failure().empty() ? "" : ("  last failure: " + m.last_failure()).c_str());
+      for (const auto& k : m.state().kernels()) {
+        if (k.failures() == 0) continue;
+        std::printf("  kernel %s: %llu failures, last in %s\n", k.name().c_str(),
+                    static_cast<unsigned long long>(k.failures()), k.last_failure().c_str());
+      }
     }
     return 0;
   } catch (const std::exception& e) {

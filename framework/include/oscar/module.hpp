@@ -50,6 +50,8 @@ class Module {
   ModuleState state() const;
   /// True while one kernel call has run longer than the watchdog limit (the heartbeat stops).
   bool hung() const;
+  /// Why the module asked to be stopped on its own (on_kernel_error: restart); empty otherwise.
+  std::string exit_reason() const;
 
   const ModuleSpec& spec() const { return spec_; }
   KernelInstance& kernel(const std::string& name);
@@ -62,6 +64,7 @@ class Module {
   void wire_in_process();
   void processing_loop();
   void run_slot(Slot& slot, Trigger trigger, bool stub);
+  void kernel_failed(Slot& slot, std::string failure);
   void mark_pending(Slot& slot);
   void post_and_wait(const std::function<void()>& task);
   void report(const std::string& transition);
@@ -83,6 +86,7 @@ class Module {
   bool stop_requested_ = false;
   std::condition_variable stopped_;
   std::string last_transition_;
+  std::string exit_reason_;
   std::atomic<std::int64_t> busy_since_ns_{0};  // steady clock; 0 while no kernel runs
   std::thread processing_;
   std::unique_ptr<internal::SequenceStore> sequences_;  // declared before dds_: outlives it

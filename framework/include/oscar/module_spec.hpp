@@ -48,6 +48,27 @@ struct KernelSpec {
   std::string where;         ///< "file:line" of its YAML entry, for messages
 };
 
+/// What the frame does when a kernel's on_activate(), process() or stub() throws `after` times
+/// in a row (a call that returns starts the count again). Every failure is counted and shown by
+/// `oscar ps` whatever the action.
+struct KernelErrorPolicy {
+  enum class Action {
+    kContinue,    ///< keep calling it (the log holds repeats back, with a count)
+    kDeactivate,  ///< deactivate the kernel; the coordinator may activate it again
+    kRestart,     ///< end the process (exit code kKernelFailureExit): the registry restarts it
+  };
+  Action action = Action::kRestart;
+  int after = 3;
+
+  /// Parses `restart`, `continue`, `deactivate` or `{action: A, after: N}`.
+  /// @throws std::invalid_argument naming the rule.
+  static KernelErrorPolicy parse(const YAML::Node& node);
+};
+const char* to_string(KernelErrorPolicy::Action action);
+
+/// oscar-run's exit code when the kernel-error policy ends the process.
+inline constexpr int kKernelFailureExit = 3;
+
 struct ModuleSpec {
   std::string name;
   std::string host;
@@ -65,6 +86,8 @@ struct ModuleSpec {
   std::chrono::milliseconds lease{300};
   /// A kernel call running longer than this stops the heartbeat: the registry sees a hang.
   std::chrono::milliseconds watchdog{2000};
+  /// What a kernel that keeps throwing leads to (default: restart the module after 3).
+  KernelErrorPolicy on_kernel_error;
 
   /// Parses one module map. `file` names the source in messages ("file:line: ...").
   /// @throws std::invalid_argument for unknown keys, missing names, duplicate kernel names,
