@@ -195,21 +195,27 @@ void Registry::started(Tracked& m, const ModuleState& now) {
   publish();
 }
 
-void Registry::fail(Tracked& m, const std::string& reason, bool process_gone) {
-  const auto& name = m.spec->spec.name;
+// Ends the module's current incarnation (killing its process unless it is gone), keeps its
+// configuration for the next one and suspends the others.
+void Registry::take_down(Tracked& m, bool process_gone) {
   const auto& mon = monitors_[m.spec->spec.host];
-  const auto failed_at = Clock::now();  // the backoff runs while the others are suspended
-  m.status = "failed";
-  m.last_failure = reason;
   // A module whose monitor has been replaced died with its monitor.
   m.process_gone = process_gone || (mon.pid != m.launched_by && mon.alive);
   if (m.has_state) m.config = m.state;  // what the next incarnation gets back
-  spdlog::error("registry: module '{}' failed: {}", name, reason);
-  publish();  // the failure is known now; suspending the others comes next
+  publish();  // what happened is known now; suspending the others comes next
   if (!m.process_gone && mon.alive) {
-    io_->send(LAUNCH_KILL, m.spec->spec.host, mon.pid, name, m.incarnation, {}, {});
+    io_->send(LAUNCH_KILL, m.spec->spec.host, mon.pid, m.spec->spec.name, m.incarnation, {}, {});
   }
   suspend_all();
+}
+
+void Registry::fail(Tracked& m, const std::string& reason, bool process_gone) {
+  const auto& name = m.spec->spec.name;
+  const auto failed_at = Clock::now();  // the backoff runs while the others are suspended
+  m.status = "failed";
+  m.last_failure = reason;
+  spdlog::error("registry: module '{}' failed: {}", name, reason);
+  take_down(m, process_gone);
   const auto& policy = m.spec->restart;
   switch (policy.kind) {
     case RestartPolicy::Kind::kAuto:
@@ -260,14 +266,18 @@ void Registry::on_request(const RegistryRequest& r) {
     for (const auto& t : modules_) names.push_back(t->spec->spec.name);
     error = fmt::format("no module '{}' in system '{}' (modules: {})", r.module_name(),
                         system_.name, fmt::join(names, ", "));
-  } else if (m->status == "running") {
-    fail(*m, "restart requested by " + r.sender(), false);
-    m->restart_at = Clock::now();
-    m->status = "restarting";
-  } else if (m->status == "failed") {
-    m->status = "restarting";
-    m->restart_at = Clock::now();
+  } else if (m->status == "running" || m->status == "failed") {
+    // Not a failure: it neither counts against the restart limit nor becomes the last failure.
     spdlog::info("registry: restart of '{}' requested by {}", r.module_name(), r.sender());
+    const bool was_running = m->status == "running";
+    m->status = "restarting";
+    m->restart_at = Clock::now();
+    m->restart_requested = true;
+    if (was_running) {
+      take_down(*m, false);
+      set_system("suspended",
+                 fmt::format("restarting '{}' (requested by {})", r.module_name(), r.sender()));
+    }
   } else {
     error = fmt::format("module '{}' is {}; only a running or failed module can be restarted",
                         r.module_name(), m->status);

@@ -47,7 +47,8 @@ void Registry::tick() {
       launch(*m, 1);
       publish();
     } else if (m->status == "restarting" && m->process_gone && now >= m->restart_at) {
-      if (m->incarnation > 0) ++m->restarts;
+      if (m->incarnation > 0 && !m->restart_requested) ++m->restarts;
+      m->restart_requested = false;
       launch(*m, m->incarnation + 1);
       publish();
     }

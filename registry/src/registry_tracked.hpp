@@ -13,12 +13,12 @@ struct Registry::Tracked {
   std::string status;
   unsigned incarnation = 0;  // 0: never started
   long pid = 0;
-  long launched_by = 0;  // pid of the monitor that started the current incarnation
-  unsigned restarts = 0;
+  long launched_by = 0;            // pid of the monitor that started the current incarnation
+  unsigned restarts = 0;           // after failures (what the restart limit counts)
+  bool restart_requested = false;  // the pending restart is an operator's, not a failure's
   std::string last_failure;
-  bool process_gone = true;
-  bool suspended = false;  // the registry suspended it and has not resumed it yet  // the current
-                           // incarnation's process is known to have ended
+  bool process_gone = true;  // the current incarnation's process is known to have ended
+  bool suspended = false;    // the registry suspended it and has not resumed it yet
   Clock::time_point restart_at{};
   Clock::time_point running_since{};
   std::string replaced_by;  // set when a replacement takes over

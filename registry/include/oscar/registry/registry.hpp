@@ -59,6 +59,7 @@ class Registry {
   void run_events(std::unique_lock<std::mutex>& lock);
 
   void fail(Tracked& m, const std::string& reason, bool process_gone);
+  void take_down(Tracked& m, bool process_gone);
   void launch(Tracked& m, unsigned incarnation);
   void started(Tracked& m, const ModuleState& state);
   static std::string restore_text(const ModuleState& last);
