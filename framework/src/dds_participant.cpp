@@ -187,6 +187,23 @@ void dds_log_level_from_env() {
 
 class DdsParticipant::Listener final : public dds::DomainParticipantListener {
  public:
+  void on_participant_discovery(
+      dds::DomainParticipant*, eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+    using Status = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo::DISCOVERY_STATUS;
+    std::lock_guard lock(mutex_);
+    if (info.status == Status::DISCOVERED_PARTICIPANT) {
+      participants_[info.info.m_guid.guidPrefix] = info.info.m_participantName.to_string();
+    } else if (info.status == Status::REMOVED_PARTICIPANT ||
+               info.status == Status::DROPPED_PARTICIPANT) {
+      participants_.erase(info.info.m_guid.guidPrefix);
+    }
+  }
+  std::vector<std::string> participants() const {
+    std::lock_guard lock(mutex_);
+    std::vector<std::string> names;
+    for (const auto& [prefix, name] : participants_) names.push_back(name);
+    return names;
+  }
   void on_publisher_discovery(dds::DomainParticipant*,
                               eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
     note(info.info.topicName().to_string(), info.info.typeName().to_string());
@@ -224,6 +241,7 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
   mutable std::mutex mutex_;
   std::map<std::string, std::string> types_;
   std::map<std::string, DdsParticipant::DiscoveredWriter> writers_;
+  std::map<eprosima::fastrtps::rtps::GuidPrefix_t, std::string> participants_;
 };
 
 DdsParticipant::DdsParticipant(int domain, const std::string& name, const NetworkConfig& network)
@@ -295,6 +313,10 @@ std::optional<std::string> DdsParticipant::discovered_type(const std::string& to
 
 std::map<std::string, DdsParticipant::DiscoveredWriter> DdsParticipant::discovered_writers() const {
   return listener_->writers();
+}
+
+std::vector<std::string> DdsParticipant::discovered_participants() const {
+  return listener_->participants();
 }
 
 }  // namespace oscar

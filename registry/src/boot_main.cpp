@@ -5,9 +5,12 @@
 
 #include <csignal>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
+#include <functional>
 #include <mutex>
 #include <set>
+#include <thread>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -20,6 +23,7 @@
 #include "oscar/registry/launch_command.hpp"
 #include "oscar/registry/log_printer.hpp"
 #include "oscar/registry/registry_client.hpp"
+#include "oscar/registry/running_systems.hpp"
 #include "oscar/registry/supervisor.hpp"
 #include "oscar/registry/system_spec.hpp"
 #include "oscar/time.hpp"
@@ -49,6 +53,66 @@ std::string summary(const oscar::SystemState& s) {
   return parts.empty() ? std::string() : " [" + fmt::format("{}", fmt::join(parts, ", ")) + "]";
 }
 
+// How long discovery gets to show what already runs on the domain. On the development machine a
+// new participant saw the first of a running five-module system's eight participants after
+// 2-23 ms and all of them after 18-191 ms (docs/boot.md); one is enough to refuse.
+constexpr std::chrono::milliseconds kDiscoveryWindow{400};
+
+// Refuses to boot onto a domain where processes of a system already run (a registry, monitors
+// or modules, also ones a killed boot left behind): both systems would run every module and
+// one's shutdown would stop the other.
+void check_domain_free(oscar::DdsParticipant& participant, oscar::RegistryClient& registry) {
+  std::this_thread::sleep_for(kDiscoveryWindow);
+  std::set<std::string> members;
+  for (const auto& name : participant.discovered_participants()) {
+    if (oscar::is_system_member(name)) members.insert(name);
+  }
+  if (members.empty()) return;
+  // The other registry's state names the system; it may come a moment after its participant.
+  const auto state = registry.wait_for([](const auto&) { return true; }, kDiscoveryWindow);
+  throw std::runtime_error(fmt::format(
+      "domain {} is in use by {}: {}; stop it (oscar shutdown -d {}) or boot on another domain "
+      "(--domain N)",
+      participant.domain(),
+      state ? fmt::format("the running system '{}' ({})", state->system(), state->state())
+            : std::string("processes of another system"),
+      fmt::join(members, ", "), participant.domain()));
+}
+
+// Ctrl-C (SIGINT) and SIGTERM, counted: the first stops the system in order, the second aborts.
+class StopRequests {
+ public:
+  explicit StopRequests(sigset_t signals) : signals_(signals) {}
+  /// Sleeps up to `timeout`, or until a stop request comes (counted).
+  void wait(std::chrono::milliseconds timeout) {
+    if (oscar::wait_for_stop(signals_, timeout)) ++count_;
+  }
+  int count() const { return count_; }
+
+ private:
+  sigset_t signals_;
+  int count_ = 0;
+};
+
+// Waits until `done()`, `timeout` or one more stop request than `requests` had at the start,
+// printing the merged log meanwhile. True if `done()` came true.
+bool wait_until(const std::function<bool()>& done, Clock::duration timeout, StopRequests& requests,
+                oscar::LogPrinter& log) {
+  const int before = requests.count();
+  const auto until =
+      timeout == Clock::duration::max() ? Clock::time_point::max() : Clock::now() + timeout;
+  while (!done()) {
+    if (requests.count() > before || Clock::now() >= until) return false;
+    requests.wait(std::chrono::milliseconds(50));
+    log.flush();
+  }
+  return true;
+}
+
+std::chrono::milliseconds seconds(double s) {
+  return std::chrono::milliseconds(static_cast<long>(s * 1000));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -57,7 +121,7 @@ int main(int argc, char** argv) {
   int domain = -1;
   double timeout_s = 30, duration_s = 0;
   bool check = false;
-  app.add_option("system", file, "the system file (DESIGN §7; docs/boot.md)")->required();
+  app.add_option("system", file, "the system file (docs/boot.md)")->required();
   app.add_option("-d,--domain", domain, "DDS domain (default: the file's)");
   app.add_option("--timeout", timeout_s, "seconds to wait until every module is announced");
   app.add_option("--duration", duration_s, "stop after this many seconds (default: Ctrl-C)");
@@ -65,7 +129,7 @@ int main(int argc, char** argv) {
   app.add_flag("--check", check, "check the system file and its modules, start nothing");
   CLI11_PARSE(app, argc, argv);
 
-  const auto signals = oscar::block_stop_signals();
+  StopRequests stop(oscar::block_stop_signals());
 
   oscar::LogPrinter log(stdout, isatty(1) != 0);
   try {
@@ -81,28 +145,42 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (log_dir.empty()) log_dir = fmt::format("/tmp/oscar/{}-{}", system.name, system.domain);
+    const auto started = Clock::now();
+    // This machine's record of the domain first (at once, and exact), then what discovery sees.
+    const oscar::RunningSystemRecord record(
+        {.domain = system.domain,
+         .system = system.name,
+         .file = file,
+         .log_dir = log_dir,
+         .boot_pid = getpid(),
+         .started = static_cast<long long>(std::time(nullptr))});
+    oscar::DdsParticipant participant(system.domain, "oscar-boot",
+                                      oscar::NetworkConfig::for_host(system.root, local.name));
+    std::mutex last_line_mutex;  // DDS may call back from its UDP and shared-memory threads
+    std::string last_line;
+    bool booted = false;  // states before are another system's, which check_domain_free names
+    oscar::RegistryClient registry(participant, "boot", [&](const oscar::SystemState& s) {
+      auto line = fmt::format("system {}: {}{}", s.state(), s.message(), summary(s));
+      std::lock_guard lock(last_line_mutex);
+      if (booted && line != last_line) {
+        log.note("registry", line, s.state() == "suspended" ? oscar::LOG_WARN : oscar::LOG_INFO);
+        last_line = std::move(line);
+      }
+    });
+    check_domain_free(participant, registry);
     // A new boot numbers cues from 1 again; only restarts within it continue the numbering.
     std::error_code ec;
     for (const auto& e : std::filesystem::recursive_directory_iterator(log_dir, ec)) {
       if (e.path().extension() == ".seq") std::filesystem::remove(e.path(), ec);
     }
-    const auto started = Clock::now();
     log.note("boot", fmt::format("booting '{}' from {}: {} modules on {} hosts, domain {}, logs "
                                  "in {}",
                                  system.name, file, system.modules.size(), system.hosts.size(),
                                  system.domain, log_dir));
-    oscar::DdsParticipant participant(system.domain, "oscar-boot",
-                                      oscar::NetworkConfig::for_host(system.root, local.name));
-    std::mutex last_line_mutex;  // DDS may call back from its UDP and shared-memory threads
-    std::string last_line;
-    oscar::RegistryClient registry(participant, "boot", [&](const oscar::SystemState& s) {
-      auto line = fmt::format("system {}: {}{}", s.state(), s.message(), summary(s));
+    {
       std::lock_guard lock(last_line_mutex);
-      if (line != last_line) {
-        log.note("registry", line, s.state() == "suspended" ? oscar::LOG_WARN : oscar::LOG_INFO);
-        last_line = std::move(line);
-      }
-    });
+      booted = true;
+    }
     oscar::TopicReader<oscar::LogRecord, oscar::LogRecordPubSubType> logs(
         participant, "oscar/log", oscar::qos::stream_reader(100),
         [&](const oscar::LogRecord& r, const auto&) { log.add(r); });
@@ -119,11 +197,28 @@ int main(int argc, char** argv) {
           oscar::on_host(h, {oscar::sibling_program("oscar-monitor"), "--system", file, "--host",
                              h.name, "--domain", dom, "--log-dir", log_dir + "/" + h.name}));
     }
-    const auto running =
-        registry.wait_for([](const oscar::SystemState& s) { return s.state() == "running"; },
-                          std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));
+    const auto state_is = [&](const char* state) {
+      const auto s = registry.latest();
+      return s && s->state() == state;
+    };
+    bool registry_gone = false;
+    const auto registry_exited = [&] {
+      for (const auto& x : children.reap()) {
+        if (x.exit_code != 0 || !state_is("stopped")) {
+          log.note("boot", fmt::format("{} {}", x.module, x.describe()), oscar::LOG_ERROR);
+        }
+        registry_gone = registry_gone || x.module == "registry";
+      }
+      return registry_gone;
+    };
+
     int code = 0;
-    if (!running) {
+    const bool running =
+        wait_until([&] { return state_is("running") || state_is("stopped") || registry_exited(); },
+                   seconds(timeout_s), stop, log);
+    if (stop.count() > 0) {
+      log.note("boot", "Ctrl-C during boot: stopping what has started", oscar::LOG_WARN);
+    } else if (!running) {
       const auto last = registry.latest();
       log.note("boot",
                fmt::format("not every module was announced within {} s: {} (their output is in "
@@ -131,28 +226,33 @@ int main(int argc, char** argv) {
                            timeout_s, last ? last->message() : "no registry answered", log_dir),
                oscar::LOG_ERROR);
       code = 1;
-    } else {
+    } else if (state_is("running")) {
       log.note(
           "boot",
           fmt::format("system '{}' running after {} ms (Ctrl-C stops it)", system.name,
                       std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - started)
                           .count()));
-      const auto until =
-          duration_s > 0
-              ? Clock::now() + std::chrono::milliseconds(static_cast<long>(duration_s * 1000))
-              : Clock::time_point::max();
-      while (Clock::now() < until &&
-             !oscar::wait_for_stop(signals, std::chrono::milliseconds(50))) {
-        log.flush();
-      }
+      wait_until([&] { return state_is("stopped") || registry_exited(); },
+                 duration_s > 0 ? Clock::duration(seconds(duration_s)) : Clock::duration::max(),
+                 stop, log);
     }
-    log.note("boot", "shutting down");
-    try {
-      registry.request(oscar::REG_SHUTDOWN, "", std::chrono::milliseconds(3000));
-      registry.wait_for([](const oscar::SystemState& s) { return s.state() == "stopped"; },
-                        std::chrono::seconds(20));
-    } catch (const std::exception& e) {
-      log.note("boot", std::string("registry: ") + e.what(), oscar::LOG_WARN);
+    const int stops_before = stop.count();
+    if (state_is("stopped")) {
+      log.note("boot", "the system was shut down (oscar shutdown)");
+    } else if (!registry_gone) {
+      // SIGTERM asks the registry for what `oscar shutdown` asks: stop the modules in reverse
+      // boot order, tell the monitors to exit, exit. Boot need not reach it over DDS for that.
+      log.note("boot", "shutting down (Ctrl-C aborts)");
+      children.signal("registry", SIGTERM);
+      wait_until(registry_exited, std::chrono::seconds(30), stop, log);
+    }
+    stop.wait(std::chrono::milliseconds(0));
+    if (stop.count() > stops_before) {
+      // Ctrl-C while shutting down: no more waiting for anyone. Modules die with their monitors.
+      log.note("boot", "aborted: killing every process of the system", oscar::LOG_WARN);
+      children.stop_all(std::chrono::milliseconds(0));
+      log.flush(true);
+      return 130;
     }
     // Monitors exit when the registry tells them; what is left is stopped here.
     for (const auto& x : children.stop_all(std::chrono::milliseconds(5000))) {

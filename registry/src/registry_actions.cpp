@@ -194,6 +194,7 @@ std::vector<bool> Registry::configure_all(const std::vector<Tracked*>& targets, 
 }
 
 void Registry::shutdown() {
+  shutting_down_ = true;  // also when stop() asked: modules ending now are not failures
   set_system("stopping", "shutting down in reverse boot order");
   for (auto it = modules_.rbegin(); it != modules_.rend(); ++it) {
     auto& m = **it;

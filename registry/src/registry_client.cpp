@@ -2,10 +2,12 @@
 
 #include <unistd.h>
 
+#include <filesystem>
 #include <stdexcept>
 #include <thread>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <oscar/registryPubSubTypes.h>
 
 #include "oscar/registry/system_spec.hpp"
@@ -83,12 +85,40 @@ void RegistryClient::request(RegistryRequestKind kind, const std::string& module
   if (!reply.ok()) throw std::runtime_error(reply.error());
 }
 
-std::unique_ptr<DdsParticipant> tool_participant(const std::string& name,
-                                                 const std::string& system_file,
-                                                 const std::string& host, int domain) {
-  if (system_file.empty()) {
-    return std::make_unique<DdsParticipant>(domain >= 0 ? domain : domain_from_env(0), name);
+std::optional<RunningSystem> default_system() {
+  const auto systems = running_systems();
+  if (systems.size() <= 1) return systems.empty() ? std::nullopt : std::optional(systems.front());
+  std::string list;
+  for (const auto& s : systems) list += "\n  " + s.describe();
+  throw std::invalid_argument(fmt::format(
+      "{} systems are running on this machine; name one with -d DOMAIN:{}", systems.size(), list));
+}
+
+std::string where_systems_run(int domain) {
+  std::vector<std::string> others;
+  for (const auto& s : running_systems()) {
+    if (s.domain != domain) others.push_back(s.describe());
   }
+  if (!others.empty()) {
+    return fmt::format(" (running on this machine: {}; name one with -d DOMAIN)",
+                       fmt::join(others, "; "));
+  }
+  return " (no system was booted on this machine with `oscar boot`; name the domain of one with "
+         "-d DOMAIN, $OSCAR_DOMAIN or --system FILE)";
+}
+
+std::unique_ptr<DdsParticipant> tool_participant(const std::string& name, std::string system_file,
+                                                 const std::string& host, int domain) {
+  if (system_file.empty() && domain < 0) {
+    domain = domain_from_env(-1);
+    if (domain < 0) {
+      // The system booted on this machine, with its own network profile.
+      const auto running = default_system();
+      domain = running ? running->domain : 0;
+      if (running && std::filesystem::exists(running->file)) system_file = running->file;
+    }
+  }
+  if (system_file.empty()) return std::make_unique<DdsParticipant>(domain, name);
   const auto system = SystemSpec::load(system_file);
   const auto& h = host.empty() ? system.local_host() : system.host(host);
   return std::make_unique<DdsParticipant>(domain >= 0 ? domain : system.domain, name,

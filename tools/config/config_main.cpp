@@ -10,7 +10,7 @@
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "oscar config: send a configuration command to a module (DESIGN §6).\n"
+      "oscar config: send a configuration command to a module (docs/kernels.md).\n"
       "Commands: activate KERNEL|* [MODE], deactivate KERNEL|*, trigger KERNEL|*,\n"
       "set-cycle KERNEL CYCLE, set-param KERNEL NAME VALUE, rewire KERNEL INPUT SOURCE,\n"
       "suspend, resume, stub KERNEL|* on|off, shutdown.\n"
@@ -25,12 +25,14 @@ int main(int argc, char** argv) {
   app.add_option("--as", as, "sender authority: coordinator, registry, boot (default: operator)");
   app.add_option("--system", system_file, "system file (its domain and network)");
   app.add_option("--host", host, "the host this runs on (with --system)");
-  app.add_option("-d,--domain", domain, "DDS domain (default: the system's, $OSCAR_DOMAIN or 0)");
+  app.add_option("-d,--domain", domain,
+                 "DDS domain (default: the system file's, $OSCAR_DOMAIN, the system booted on this "
+                 "machine, or 0)");
   app.add_option("--timeout-ms", timeout_ms, "how long to wait for the module");
   CLI11_PARSE(app, argc, argv);
   try {
     const auto kind = oscar::parse_command_kind(command);
-    auto participant = oscar::tool_participant("oscar:config", system_file, host, domain);
+    auto participant = oscar::tool_participant("oscar-config", system_file, host, domain);
     oscar::ConfigClient client(*participant, as);
     const auto reply = client.send(module, kind, args, std::chrono::milliseconds(timeout_ms));
     if (!reply.ok()) {

@@ -20,7 +20,9 @@ int main(int argc, char** argv) {
   bool no_colour = false;
   app.add_option("--system", system_file, "system file (its domain and network)");
   app.add_option("--host", host, "the host this runs on (with --system)");
-  app.add_option("-d,--domain", domain, "DDS domain (default: the system's, $OSCAR_DOMAIN or 0)");
+  app.add_option("-d,--domain", domain,
+                 "DDS domain (default: the system file's, $OSCAR_DOMAIN, the system booted on this "
+                 "machine, or 0)");
   app.add_option("--duration", duration_s, "stop after this many seconds");
   app.add_flag("--no-colour", no_colour, "plain text even on a terminal");
   CLI11_PARSE(app, argc, argv);

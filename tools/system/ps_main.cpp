@@ -65,7 +65,9 @@ int main(int argc, char** argv) {
   bool json = false;
   app.add_option("--system", system_file, "system file (its domain and network)");
   app.add_option("--host", host, "the host this runs on (with --system)");
-  app.add_option("-d,--domain", domain, "DDS domain (default: the system's, $OSCAR_DOMAIN or 0)");
+  app.add_option("-d,--domain", domain,
+                 "DDS domain (default: the system file's, $OSCAR_DOMAIN, the system booted on this "
+                 "machine, or 0)");
   app.add_option("--timeout", timeout_s, "seconds to wait for the registry");
   app.add_flag("--json", json, "print the system state as JSON");
   CLI11_PARSE(app, argc, argv);
@@ -75,8 +77,9 @@ int main(int argc, char** argv) {
     const auto s = client.wait_for([](const oscar::SystemState&) { return true; },
                                    std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));
     if (!s) {
-      std::fprintf(stderr, "oscar ps: no registry answered on domain %d within %.1f s\n",
-                   participant->domain(), timeout_s);
+      std::fprintf(stderr, "oscar ps: no registry answered on domain %d within %.1f s%s\n",
+                   participant->domain(), timeout_s,
+                   oscar::where_systems_run(participant->domain()).c_str());
       return 1;
     }
     if (json) {

@@ -16,7 +16,9 @@ int main(int argc, char** argv) {
   if (restart) app.add_option("module", module, "the module to restart")->required();
   app.add_option("--system", system_file, "system file (its domain and network)");
   app.add_option("--host", host, "the host this runs on (with --system)");
-  app.add_option("-d,--domain", domain, "DDS domain (default: the system's, $OSCAR_DOMAIN or 0)");
+  app.add_option("-d,--domain", domain,
+                 "DDS domain (default: the system file's, $OSCAR_DOMAIN, the system booted on this "
+                 "machine, or 0)");
   CLI11_PARSE(app, argc, argv);
   try {
     auto participant = oscar::tool_participant(argv[0], system_file, host, domain);

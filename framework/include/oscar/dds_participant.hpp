@@ -7,6 +7,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
@@ -49,6 +50,9 @@ class DdsParticipant {
   };
   /// Every topic with a remote writer, by name (what `oscar record` subscribes to).
   std::map<std::string, DiscoveredWriter> discovered_writers() const;
+  /// The names of the other participants on the domain that discovery sees now (a module's is
+  /// "oscar:<module>").
+  std::vector<std::string> discovered_participants() const;
 
  private:
   class Listener;

@@ -107,8 +107,8 @@ int main(int argc, char** argv) {
     const auto s = client.wait_for([](const oscar::SystemState&) { return true; },
                                    std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));
     if (!s) {
-      fmt::print(stderr, "oscar graph: no registry answered on domain {} within {} s\n",
-                 participant->domain(), timeout_s);
+      fmt::print(stderr, "oscar graph: no registry answered on domain {} within {} s{}\n",
+                 participant->domain(), timeout_s, oscar::where_systems_run(participant->domain()));
       return 1;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<long>(discovery_s * 1000)));

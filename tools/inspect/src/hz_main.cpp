@@ -67,8 +67,9 @@ int main(int argc, char** argv) {
     if (oscar::inspect::wait_for_writer(
             *participant, topic, std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)))
             .empty()) {
-      fmt::print(stderr, "oscar hz: no writer of topic '{}' appeared on domain {} within {} s\n",
-                 topic, participant->domain(), timeout_s);
+      fmt::print(stderr, "oscar hz: no writer of topic '{}' appeared on domain {} within {} s{}\n",
+                 topic, participant->domain(), timeout_s,
+                 oscar::where_systems_run(participant->domain()));
       return 1;
     }
     std::mutex mutex;

@@ -13,7 +13,9 @@ struct ToolOptions {
   void add_to(CLI::App& app) {
     app.add_option("--system", system_file, "system file (its domain and network)");
     app.add_option("--host", host, "the host this runs on (with --system)");
-    app.add_option("-d,--domain", domain, "DDS domain (default: the system's, $OSCAR_DOMAIN or 0)");
+    app.add_option("-d,--domain", domain,
+                   "DDS domain (default: the system file's, $OSCAR_DOMAIN, the system booted on "
+                   "this machine, or 0)");
   }
 };
 

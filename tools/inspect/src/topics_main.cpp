@@ -1,4 +1,5 @@
 // oscar topics: every topic with a writer on the domain, its type, QoS and measured rate.
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <map>
@@ -69,6 +70,13 @@ int main(int argc, char** argv) {
       }
     }
     if (json) fmt::print("{}\n", out.dump(2));
+    if (std::none_of(writers.begin(), writers.end(),
+                     [&](const auto& w) { return wanted(w.first); })) {
+      fmt::print(stderr, "oscar topics: no {}topic has a writer on domain {} (listened {} s){}\n",
+                 all ? "" : "cue ", participant->domain(), duration_s,
+                 oscar::where_systems_run(participant->domain()));
+      return 1;
+    }
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "oscar topics: %s\n", e.what());

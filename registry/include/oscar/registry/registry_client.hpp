@@ -14,6 +14,7 @@
 #include <oscar/registry.h>
 
 #include "oscar/dds_participant.hpp"
+#include "oscar/registry/running_systems.hpp"
 
 namespace oscar {
 
@@ -46,11 +47,20 @@ class RegistryClient {
   std::unique_ptr<Endpoints> io_;  // last: its callbacks use the members above
 };
 
+/// The system a tool looks at when told nothing: the one `oscar boot` runs on this machine.
+/// @throws std::invalid_argument if several run (listing them: the user must choose).
+std::optional<RunningSystem> default_system();
+
+/// What to add when a tool found no system on `domain`: the systems booted on this machine and
+/// how to name one, or that none was, e.g. " (running on this machine: ...; name one with -d)".
+std::string where_systems_run(int domain);
+
 /// The participant of a command-line tool: with `system_file`, that system's domain and the
-/// network of its host `host` (default: its local host); otherwise loopback and $OSCAR_DOMAIN
-/// (default 0). `domain` >= 0 overrides either.
-std::unique_ptr<DdsParticipant> tool_participant(const std::string& name,
-                                                 const std::string& system_file,
+/// network of its host `host` (default: its local host); `domain` >= 0 overrides the domain.
+/// Told neither, it takes $OSCAR_DOMAIN, else the system booted on this machine (its domain and
+/// file; see default_system()), else domain 0 on loopback.
+/// @throws std::invalid_argument if several systems run and none was named.
+std::unique_ptr<DdsParticipant> tool_participant(const std::string& name, std::string system_file,
                                                  const std::string& host, int domain);
 
 }  // namespace oscar

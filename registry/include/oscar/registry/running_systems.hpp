@@ -1,0 +1,57 @@
+#pragma once
+/// @file Where `oscar boot` leaves word of the systems it runs on this machine, so that the
+/// tools (`oscar ps`, `topics`, `shutdown`, ...) find a running system without being told its
+/// domain, and a second boot on a busy domain is refused. One small JSON file per domain in
+/// $OSCAR_SYSTEMS_DIR (default /tmp/oscar/systems), removed when boot ends; a record whose boot
+/// process is gone (killed with -9) is ignored and cleaned away by the next reader.
+
+#include <sys/types.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace oscar {
+
+struct RunningSystem {
+  int domain = 0;
+  std::string system;                 ///< the system's name
+  std::string file;                   ///< the system file, absolute
+  std::string log_dir;                ///< where its processes write their output
+  pid_t boot_pid = 0;                 ///< the `oscar boot` that runs it
+  long long started = 0;              ///< seconds since the epoch
+  long long boot_started_ticks = -1;  ///< when boot_pid started (pids are reused); set on record
+
+  /// "landmarks (domain 43, config/landmarks-1host.yaml, boot pid 1234)".
+  std::string describe() const;
+};
+
+/// The folder of the records: $OSCAR_SYSTEMS_DIR, else /tmp/oscar/systems.
+std::string running_systems_dir();
+
+/// The systems booted on this machine whose boot still runs, by domain.
+std::vector<RunningSystem> running_systems();
+
+/// The running system on `domain`, if this machine has one.
+std::optional<RunningSystem> running_system(int domain);
+
+/// True for the participant name of a process that belongs to a running system: the registry
+/// ("oscar-registry"), a monitor ("oscar-monitor:<host>") or a module ("oscar:<module>"). Tools
+/// and boot have names of their own ("oscar-ps", "oscar-boot", ...).
+bool is_system_member(const std::string& participant_name);
+
+/// Holds the record of one booted system while it lives (boot keeps one for its run).
+class RunningSystemRecord {
+ public:
+  /// @throws std::runtime_error if another live boot holds the domain (naming it), or if the
+  ///         record cannot be written.
+  explicit RunningSystemRecord(const RunningSystem& system);
+  ~RunningSystemRecord();
+  RunningSystemRecord(const RunningSystemRecord&) = delete;
+  RunningSystemRecord& operator=(const RunningSystemRecord&) = delete;
+
+ private:
+  std::string path_;
+};
+
+}  // namespace oscar

@@ -1,0 +1,261 @@
+// oscar boot's life cycle with real processes on loopback: a busy domain is refused, `oscar
+// shutdown` and Ctrl-C (during boot too) end boot, a second Ctrl-C aborts, an operator's restart
+// is no failure, and the tools find the system booted on this machine without flags.
+#include <signal.h>
+#include <stdlib.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "booted_system.hpp"
+#include "oscar/registry/running_systems.hpp"
+
+namespace oscar {
+namespace {
+using namespace std::chrono_literals;
+using test::BootedSystem;
+using test::entry;
+using testing::HasSubstr;
+
+constexpr const char* kTwoSources = R"(
+system: NAME
+lease: 1s
+modules:
+  - name: src
+    kernels: [ { type: bench_source, name: src, params: { type: Bool } } ]
+    mode: { continuous: 20ms }
+    restart: { policy: auto, max: 1, backoff: 50ms }
+  - name: sink
+    kernels: [ { type: bench_sink, name: sink, params: { type: Bool }, inputs: { in: src/out } } ]
+    mode: single_step
+)";
+
+std::string two_sources(const std::string& name) {
+  std::string yaml = kTwoSources;
+  yaml.replace(yaml.find("NAME"), 4, name);
+  return yaml;
+}
+
+// Sets an environment variable for the test's children while it lives.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const std::string& value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    setenv(name, value.c_str(), 1);
+  }
+  ~ScopedEnv() {
+    if (old_) {
+      setenv(name_, old_->c_str(), 1);
+    } else {
+      unsetenv(name_);
+    }
+  }
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
+// A second boot of another file on the same domain.
+std::optional<int> boot_again(const std::string& name, std::string& output) {
+  const auto file = test::temp_path(name) + ".yaml";
+  std::ofstream(file) << two_sources(name);
+  test::Process boot(
+      {test::bin("oscar-boot"), file, "--domain", std::to_string(test::test_domain()), "--log-dir",
+       test::temp_path(name) + "_logs"},
+      test::temp_path(name) + "_boot.log");
+  const auto code = boot.wait(30s);
+  output = boot.output();
+  return code;
+}
+
+std::vector<long> pids(const SystemState& s) {
+  std::vector<long> out;
+  for (const auto& m : s.modules()) out.push_back(m.pid());
+  return out;
+}
+
+TEST(Boot, RefusesADomainWhereASystemRunsAndLeavesThatSystemAlone) {
+  BootedSystem first("busy", two_sources("busy"));
+  const auto before = first.running();
+  std::string output;
+  // Found by this machine's record of the domain...
+  EXPECT_EQ(boot_again("intruder", output), 2) << output;
+  EXPECT_THAT(output, HasSubstr(fmt::format("domain {} is in use by the running system busy",
+                                            test::test_domain())));
+  EXPECT_THAT(output, HasSubstr("--domain"));
+  // ...and, where there is no record (booted elsewhere), by discovery.
+  {
+    ScopedEnv elsewhere("OSCAR_SYSTEMS_DIR", test::temp_path("no_records"));
+    EXPECT_EQ(boot_again("intruder2", output), 2) << output;
+    EXPECT_THAT(output, HasSubstr("is in use by the running system 'busy' (running)"));
+    EXPECT_THAT(output, HasSubstr("oscar-registry"));
+    EXPECT_THAT(output, HasSubstr("oscar:src"));
+  }
+  EXPECT_TRUE(test::processes_mentioning(test::temp_path("intruder")).empty());
+  const auto after = first.running();
+  EXPECT_EQ(pids(after), pids(before)) << "the running system's modules were touched";
+  for (const auto& m : after.modules()) EXPECT_EQ(m.incarnation(), 1u) << m.name();
+  EXPECT_EQ(first.shut_down(), 0) << first.boot().output();
+}
+
+TEST(Boot, ExitsWhenTheSystemIsShutDownFromAnotherTerminal) {
+  BootedSystem sys("shutdown", two_sources("shutdown"));
+  const auto s = sys.running();
+  test::Process shutdown(
+      {test::bin("oscar-shutdown"), "--domain", std::to_string(test::test_domain())},
+      test::temp_path("shutdown_cmd.log"));
+  EXPECT_EQ(shutdown.wait(20s), 0) << shutdown.output();
+  EXPECT_EQ(sys.boot().wait(20s), 0) << sys.boot().output();
+  EXPECT_THAT(sys.boot().output(), HasSubstr("the system was shut down (oscar shutdown)"));
+  EXPECT_THAT(sys.boot().output(), HasSubstr("all processes stopped"));
+  for (const auto pid : pids(s)) EXPECT_FALSE(test::alive(pid)) << "module pid " << pid;
+  EXPECT_TRUE(test::processes_mentioning(sys.file()).empty()) << "a process of the system is left";
+}
+
+// `src` runs on this host; `far`'s host never answers (its ssh hangs), so boot cannot finish.
+constexpr const char* kUnreachableHost = R"(
+system: unreachable
+lease: 1s
+hosts: { here: { local: true }, far: { ssh: oscar@far.invalid } }
+modules:
+  - name: src
+    host: here
+    kernels: [ { type: bench_source, name: src, params: { type: Bool } } ]
+    mode: { continuous: 20ms }
+  - name: faraway
+    host: far
+    kernels: [ { type: bench_sink, name: faraway, params: { type: Bool }, inputs: { in: src/out } } ]
+    mode: single_step
+)";
+
+// An `ssh` first on boot's PATH that connects to nothing and never returns, as to a host that
+// does not answer.
+std::string hanging_ssh() {
+  const auto dir = test::temp_path("hanging_ssh");
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/ssh") << "#!/bin/sh\nexec sleep 120\n";
+  std::filesystem::permissions(dir + "/ssh", std::filesystem::perms::owner_all);
+  return dir + ":" + std::getenv("PATH");
+}
+
+SystemState src_running_while_booting(BootedSystem& sys) {
+  return sys.wait_for([](const SystemState& st) {
+    const auto* src = entry(st, "src");
+    return st.state() == "booting" && src && src->status() == "running";
+  });
+}
+
+TEST(Boot, CtrlCDuringBootIsAcknowledgedAtOnceAndStopsWhatHasStarted) {
+  ScopedEnv path("PATH", hanging_ssh());
+  BootedSystem sys("ctrlc_boot", kUnreachableHost);
+  const auto s = src_running_while_booting(sys);
+  const long src = entry(s, "src")->pid();
+  ASSERT_EQ(kill(sys.boot().pid(), SIGINT), 0);
+  EXPECT_EQ(sys.boot().wait(10s), 0) << sys.boot().output();
+  EXPECT_THAT(sys.boot().output(), HasSubstr("Ctrl-C during boot: stopping what has started"));
+  EXPECT_THAT(sys.boot().output(), HasSubstr("all processes stopped"));
+  EXPECT_FALSE(test::alive(src)) << "the module that had started was left running";
+  EXPECT_TRUE(test::processes_mentioning(sys.file()).empty()) << "a process of the system is left";
+}
+
+TEST(Boot, ASecondCtrlCAbortsAShutdownThatHangs) {
+  ScopedEnv path("PATH", hanging_ssh());
+  BootedSystem sys("ctrlc_twice", kUnreachableHost);
+  const auto s = src_running_while_booting(sys);
+  const long src = entry(s, "src")->pid();
+  // A registry that does not react: the orderly shutdown would wait for it.
+  std::vector<long> registry;
+  for (const auto pid : test::processes_mentioning(sys.file())) {
+    std::ifstream in("/proc/" + std::to_string(pid) + "/cmdline");
+    const std::string cmd((std::istreambuf_iterator<char>(in)), {});
+    if (cmd.find("oscar-registry") != std::string::npos) registry.push_back(pid);
+  }
+  ASSERT_EQ(registry.size(), 1u);
+  ASSERT_EQ(kill(static_cast<pid_t>(registry[0]), SIGSTOP), 0);
+  ASSERT_EQ(kill(sys.boot().pid(), SIGINT), 0);
+  std::this_thread::sleep_for(300ms);
+  EXPECT_FALSE(sys.boot().wait(0ms)) << "boot did not wait for the registry";
+  ASSERT_EQ(kill(sys.boot().pid(), SIGINT), 0);
+  EXPECT_EQ(sys.boot().wait(5s), 130) << sys.boot().output();
+  EXPECT_THAT(sys.boot().output(), HasSubstr("aborted: killing every process of the system"));
+  for (int i = 0; i < 100 && test::alive(src); ++i) std::this_thread::sleep_for(20ms);
+  EXPECT_FALSE(test::alive(src)) << "the module outlived the abort";
+  EXPECT_TRUE(test::processes_mentioning(sys.file()).empty()) << "a process of the system is left";
+}
+
+TEST(Registry, AnOperatorRestartIsNoFailureAndCountsNothingAgainstTheLimit) {
+  BootedSystem sys("operator_restart", two_sources("operator_restart"));
+  auto s = sys.running();
+  const long old_pid = entry(s, "src")->pid();
+  sys.registry().request(REG_RESTART, "src");
+  s = sys.wait_for([](const SystemState& st) {
+    return entry(st, "src")->incarnation() == 2 && st.state() == "running";
+  });
+  EXPECT_NE(entry(s, "src")->pid(), old_pid);
+  EXPECT_EQ(entry(s, "src")->restarts(), 0u);
+  EXPECT_EQ(entry(s, "src")->last_failure(), "");
+  // The one failure its limit allows still gets a restart.
+  ASSERT_EQ(kill(static_cast<pid_t>(entry(s, "src")->pid()), SIGKILL), 0);
+  s = sys.wait_for([](const SystemState& st) {
+    return entry(st, "src")->incarnation() == 3 && st.state() == "running";
+  });
+  EXPECT_EQ(entry(s, "src")->restarts(), 1u);
+  EXPECT_THAT(entry(s, "src")->last_failure(), HasSubstr("killed by signal 9"));
+}
+
+TEST(Registry, AKernelThatKeepsFailingRestartsItsModuleLikeACrash) {
+  // A camera that is not there: on_activate() throws every cycle; the default policy ends the
+  // process after 3 failures in a row and the registry restarts it.
+  BootedSystem sys("kernel_failure", R"(
+system: kernel_failure
+lease: 1s
+modules:
+  - name: cam
+    kernels: [ { type: framegrabber, name: cam, params: { source: "v4l2:/dev/oscar_no_camera" } } ]
+    mode: { continuous: 20ms }
+    restart: { policy: auto, max: 1, backoff: 50ms, on_limit: continue }
+)");
+  const auto s = sys.wait_for([](const SystemState& st) {
+    const auto* cam = entry(st, "cam");
+    return cam && cam->restarts() == 1 && cam->incarnation() == 2 &&
+           cam->last_failure().find("failed 3 times in a row") != std::string::npos;
+  });
+  EXPECT_THAT(entry(s, "cam")->last_failure(),
+              HasSubstr("exited with code 3 (last output: oscar-run: module 'cam' stopped: "
+                        "kernel 'cam' failed 3 times in a row (on_kernel_error: restart); last: "
+                        "on_activate(): framegrabber 'cam'"));
+}
+
+std::optional<int> ps(std::string& output) {
+  test::Process p({test::bin("oscar-ps"), "--json"}, test::temp_path("ps_no_flags.log"));
+  const auto code = p.wait(20s);
+  output = p.output();
+  return code;
+}
+
+TEST(Tools, FindTheSystemBootedOnThisMachineWithoutFlagsAndAskWhenThereAreSeveral) {
+  ScopedEnv records("OSCAR_SYSTEMS_DIR", test::temp_path("records"));
+  unsetenv("OSCAR_DOMAIN");
+  std::filesystem::remove_all(test::temp_path("records"));
+  std::string output;
+  BootedSystem one("found", two_sources("found"));
+  one.running();
+  ASSERT_EQ(ps(output), 0) << output;
+  EXPECT_EQ(nlohmann::json::parse(output)["system"], "found");
+  const auto other_domain = std::to_string(1 + (test::test_domain() + 100) % 200);
+  BootedSystem two("found_too", two_sources("found_too"), other_domain);
+  for (int i = 0; i < 500 && running_systems().size() < 2; ++i) std::this_thread::sleep_for(10ms);
+  EXPECT_EQ(ps(output), 2) << output;
+  EXPECT_THAT(output, HasSubstr("2 systems are running on this machine; name one with -d DOMAIN"));
+  EXPECT_THAT(output, HasSubstr("found (domain " + std::to_string(test::test_domain())));
+  EXPECT_THAT(output, HasSubstr("found_too (domain " + other_domain));
+}
+
+}  // namespace
+}  // namespace oscar
