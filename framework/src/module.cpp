@@ -258,7 +258,7 @@ void Module::run_slot(Slot& slot, Trigger trigger, bool stub) {
 }
 
 // Counts the failure (oscar ps shows it) and acts once when the policy's count in a row is
-// reached (DESIGN: failures are reported and acted on, not logged and forgotten).
+// reached: a failure is reported and acted on, not logged and forgotten.
 void Module::kernel_failed(Slot& slot, std::string failure) {
   const auto& policy = spec_.on_kernel_error;
   const auto& name = slot.instance->name();
@@ -296,12 +296,13 @@ void Module::kernel_failed(Slot& slot, std::string failure) {
       return;
     }
     case KernelErrorPolicy::Action::kRestart: {
-      std::lock_guard lock(mutex_);
-      exit_reason_ = fmt::format(
-          "kernel '{}' failed {} times in a row (on_kernel_error: "
-          "restart); last: {}",
+      auto reason = fmt::format(
+          "kernel '{}' failed {} times in a row (on_kernel_error: restart); "
+          "last: {}",
           name, slot.failures_in_a_row, slot.failure);
-      log_->error("stopping the module: {}", exit_reason_);
+      log_->error("stopping the module: {}", reason);  // not under mutex_: it writes to DDS
+      std::lock_guard lock(mutex_);
+      exit_reason_ = std::move(reason);
       stop_requested_ = true;
       stopped_.notify_all();
       return;
