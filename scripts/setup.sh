@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake ninja-build pkg-config clang-format git
+  build-essential cmake ninja-build pkg-config clang-format git ccache
   libfastrtps-dev fastddsgen fastdds-tools
   libeigen3-dev libopencv-dev libapriltag-dev libompl-dev libboost-dev libboost-graph-dev
   libgtest-dev libgmock-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
