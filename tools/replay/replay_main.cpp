@@ -1,5 +1,5 @@
 // `oscar replay FILE [--rate R] [--loop] [--start T] [--end T] [--topics ...] [--remap a:=b]
-//  [--step]`: republishes a recording with its original relative timing (DESIGN §8).
+//  [--step]`: republishes a recording with its original relative timing; docs/recording.md.
 #include <unistd.h>
 
 #include <csignal>

@@ -1,7 +1,7 @@
 #pragma once
 // Replayer: publishes the messages of an MCAP recording on their topics with the original
 // relative timing (scaled by a rate), as the raw CDR they were recorded as, so the cues keep
-// their original headers (DESIGN §8).
+// their original headers; docs/recording.md.
 
 #include <atomic>
 #include <chrono>

@@ -1,7 +1,7 @@
 #pragma once
 // Reads the CueHeader at the start of a serialized cue without knowing the cue's type: every
-// cue type's first member is `CueHeader header` (DESIGN §4), so after the 4-byte encapsulation
-// header come the stamps sequence, the source string and the sequence number.
+// cue type's first member is `CueHeader header` (docs/architecture.md, wire types), so after the
+// 4-byte encapsulation header come the stamps sequence, the source string and the sequence number.
 
 #include <cstdint>
 #include <optional>

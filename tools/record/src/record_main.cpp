@@ -1,5 +1,5 @@
 // `oscar record [-o FILE] [TOPIC|GLOB ...|--all] [--compression zstd|lz4|none]
-//  [--split-size N] [--split-duration D]`: records cue topics to MCAP (DESIGN §8).
+//  [--split-size N] [--split-duration D]`: records cue topics to MCAP; docs/recording.md.
 #include <unistd.h>
 
 #include <csignal>

@@ -1,6 +1,7 @@
 #pragma once
 // Recorder: subscribes to cue topics as discovery finds their writers, keeps each sample's
-// serialized bytes and writes them to MCAP files (DESIGN §8), splitting by size or duration.
+// serialized bytes and writes them to MCAP files (docs/recording.md), splitting by size or
+// duration.
 
 #include <atomic>
 #include <chrono>
