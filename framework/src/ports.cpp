@@ -33,6 +33,7 @@ InputPort::InputPort(std::string kernel, std::string name, const CueTypeInfo& ty
       name_(std::move(name)),
       type_(type),
       transfer_(options.transfer),
+      reliability_(options.reliability),
       buffer_(options.depth) {}
 
 void InputPort::deliver(std::shared_ptr<const void> cue) {
@@ -106,10 +107,22 @@ void OutputPort::connect(InputPort* input) {
         fmt::format("cannot wire {} ({}) to input {}/{} ({}): the types differ", address(),
                     type_.name, input->kernel(), input->name(), input->type().name));
   }
+  // In process every cue arrives anyway; refused all the same, so a module file means the same
+  // whether its kernels share a process or not.
+  check_reliability(*input, address(), options_);
   std::lock_guard lock(mutex_);
   if (std::find(consumers_.begin(), consumers_.end(), input) == consumers_.end()) {
     consumers_.push_back(input);
   }
+}
+
+void check_reliability(const InputPort& input, const std::string& source,
+                       const OutputOptions& declared) {
+  if (input.reliability() != Reliability::kReliable || declared.reliable) return;
+  throw std::invalid_argument(fmt::format(
+      "input '{}.{}' (reliable) is wired to '{}', which is best effort: a reliable reader never "
+      "matches a best-effort writer; declare the input best effort or make the output reliable",
+      input.kernel(), input.name(), source));
 }
 
 void OutputPort::disconnect(InputPort* input) {

@@ -304,6 +304,23 @@ kernels:
           HasSubstr("cannot wire lines/out (oscar::LineSeg3DSeq) to input sink/in (oscar::Bool)")));
 }
 
+TEST(ModuleBadInput, AReliableInputWiredToABestEffortOutputIsRefusedNamingBoth) {
+  EXPECT_THAT(
+      [] {
+        Module m(spec(R"(
+name: m
+kernels:
+  - { type: test_emitter, name: src, params: { reliable: false } }
+  - { type: test_reliable_collect, name: sink, inputs: { in: src/out } }
+)"),
+                 {});
+      },
+      ThrowsMessage<std::invalid_argument>(HasSubstr(
+          "input 'sink.in' (reliable) is wired to 'src/out', which is best effort: a reliable "
+          "reader never matches a best-effort writer; declare the input best effort or make the "
+          "output reliable")));
+}
+
 TEST(ModuleBadInput, DuplicateKernelNames) {
   EXPECT_THAT(
       [] {

@@ -64,6 +64,51 @@ class Collect final : public Kernel {
   int runs_ = 0;
 };
 
+/// Publishes Bool cues on an output of the QoS class its parameters declare, `count` of them
+/// (0 = no end): a producer for the cue QoS tests.
+class Emitter final : public Kernel {
+ public:
+  struct Params {
+    bool reliable = true;
+    bool transient_local = false;
+    int depth = 16;
+    int count = 0;
+    void describe(ParamSpec& spec) {
+      spec.field("reliable", reliable, "reliable output (else best effort)").fixed();
+      spec.field("transient_local", transient_local, "late joiners get the history").fixed();
+      spec.field("depth", depth, "output ring and history").at_least(1).fixed();
+      spec.field("count", count, "cues to publish; 0 = unlimited").at_least(0);
+    }
+  };
+  explicit Emitter(KernelSetup& setup) {
+    setup.params(params_);
+    out_ = &setup.output<Bool>("out", {.depth = static_cast<std::size_t>(params_.depth),
+                                       .reliable = params_.reliable,
+                                       .transient_local = params_.transient_local});
+  }
+  void process(Cycle&) override {
+    if (params_.count > 0 && sent_ >= params_.count) return;
+    ++sent_;
+    out_->publish(Bool{});
+  }
+  void stub(Cycle& c) override { process(c); }
+
+ private:
+  Params params_;
+  Output<Bool>* out_ = nullptr;
+  int sent_ = 0;
+};
+
+/// Like Collect, but declares that its input needs reliable delivery.
+class ReliableCollect final : public Kernel {
+ public:
+  explicit ReliableCollect(KernelSetup& setup)
+      : in_(setup.input<Bool>("in", {.reliability = Reliability::kReliable})) {}
+  void process(Cycle&) override { in_.take_new(); }
+  void stub(Cycle& c) override { process(c); }
+  Input<Bool>& in_;
+};
+
 /// Publishes LineSeg3DSeq cues: for type-mismatch tests.
 class Lines final : public Kernel {
  public:

@@ -236,12 +236,12 @@ SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
 
 void SystemSpec::check_modules(const std::vector<std::string>& plugin_path) const {
   std::vector<std::unique_ptr<Module>> built;
-  std::map<std::string, std::string> output_types;  // "<kernel>/<channel>" -> type
+  std::map<std::string, const OutputPort*> outputs;  // by "<kernel>/<channel>"
   for (const auto& m : modules) {
     built.push_back(std::make_unique<Module>(m.spec, plugin_path));
     for (const auto& k : m.spec.kernels) {
       for (const auto& out : built.back()->kernel(k.name).ports().outputs) {
-        output_types[out->address()] = out->type().name;
+        outputs[out->address()] = out.get();
       }
     }
   }
@@ -250,15 +250,25 @@ void SystemSpec::check_modules(const std::vector<std::string>& plugin_path) cons
       for (const auto& [input, wiring] : k.inputs) {
         if (wiring.source.empty()) continue;
         const auto* port = built[i]->kernel(k.name).ports().find_input(input);
-        const auto it = output_types.find(wiring.source);
-        if (it == output_types.end()) {
+        const auto it = outputs.find(wiring.source);
+        if (it == outputs.end()) {
           fail(k.where, fmt::format("kernel '{}' input '{}': kernel '{}' has no output '{}'",
                                     k.name, input, wiring.source.substr(0, wiring.source.find('/')),
                                     wiring.source.substr(wiring.source.find('/') + 1)));
         }
-        if (port && it->second != port->type().name) {
-          fail(k.where, fmt::format("cannot wire {} ({}) to input {}/{} ({}): the types differ",
-                                    wiring.source, it->second, k.name, input, port->type().name));
+        const auto& output = *it->second;
+        if (port && output.type().name != port->type().name) {
+          fail(k.where,
+               fmt::format("cannot wire {} ({}) to input {}/{} ({}): the types differ",
+                           wiring.source, output.type().name, k.name, input, port->type().name));
+        }
+        // A pull asks over its own reliable topics; only a push reads the output's writer.
+        if (port && port->transfer() == Transfer::kPush) {
+          try {
+            check_reliability(*port, wiring.source, output.options());
+          } catch (const std::invalid_argument& e) {
+            fail(k.where, e.what());
+          }
         }
       }
     }

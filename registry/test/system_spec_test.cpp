@@ -161,5 +161,22 @@ TEST(SystemSpec, CheckModulesRejectsAnUnknownKernelType) {
   }
 }
 
+TEST(SystemSpec, CheckModulesRefusesAReliableInputReadingABestEffortOutputOfAnotherModule) {
+  register_standard_cue_types();
+  const auto s = parse(R"(
+modules:
+  - { name: a, kernels: [ { type: test_emitter, name: src, params: { reliable: false } } ] }
+  - name: b
+    kernels: [ { type: test_reliable_collect, name: sink, inputs: { in: src/out } } ]
+)");
+  try {
+    s.check_modules(plugin_search_path());
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("s.yaml:5: input 'sink.in' (reliable) is wired to 'src/out', "
+                                    "which is best effort"));
+  }
+}
+
 }  // namespace
 }  // namespace oscar

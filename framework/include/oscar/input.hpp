@@ -28,9 +28,17 @@ Transfer parse_transfer(std::string_view text);
 /// Which cue of the producer's ring a pull asks for.
 enum class PullQuery { kLatest, kAtOrBefore, kNearest };
 
+/// What delivery an input asks of its producer's output (DESIGN §4 cue QoS classes).
+enum class Reliability {
+  kAsProducer,  ///< reliable or best effort as the producer's output is declared (default)
+  kReliable,    ///< needs every cue: wiring it to a best-effort output is refused
+  kBestEffort   ///< reads best effort, whatever the producer offers
+};
+
 struct InputOptions {
   std::size_t depth = 16;
   Transfer transfer = Transfer::kPush;
+  Reliability reliability = Reliability::kAsProducer;  ///< declared by the kernel, not the YAML
 };
 
 /// Answers pulls for one input: the producer's ring in this process, or a request over DDS.
@@ -54,6 +62,7 @@ class InputPort {
   const CueTypeInfo& type() const { return type_; }
   Transfer transfer() const { return transfer_; }
   void set_transfer(Transfer t) { transfer_ = t; }
+  Reliability reliability() const { return reliability_; }
   RingBuffer& buffer() { return buffer_; }
   const RingBuffer& buffer() const { return buffer_; }
 
@@ -73,6 +82,7 @@ class InputPort {
   std::string kernel_, name_;
   const CueTypeInfo& type_;
   Transfer transfer_;
+  Reliability reliability_;
   RingBuffer buffer_;
   std::mutex hooks_mutex_;
   std::function<void()> arrival_hook_;

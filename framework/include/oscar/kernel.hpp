@@ -81,13 +81,17 @@ class KernelSetup {
   const std::string& kernel_name() const { return name_; }
   const std::string& kernel_type() const { return type_; }
 
-  /// Declares an input. Options configured for this input (YAML) override `defaults`.
+  /// Declares an input. Options configured for this input (YAML) override `defaults`, except
+  /// the reliability it declares.
   /// @throws std::invalid_argument if the name is taken or not an identifier.
   template <CueType T>
   Input<T>& input(const std::string& name, InputOptions defaults = {}) {
     check_port_name(name);
     auto options = defaults;
-    if (auto it = input_options_.find(name); it != input_options_.end()) options = it->second;
+    if (auto it = input_options_.find(name); it != input_options_.end()) {
+      options = it->second;
+      options.reliability = defaults.reliability;  // what the kernel needs; no YAML key sets it
+    }
     auto port = std::make_unique<Input<T>>(name_, name, cue_type_info<T>(), options);
     auto& ref = *port;
     ports_.inputs.push_back(std::move(port));

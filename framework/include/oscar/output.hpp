@@ -44,6 +44,8 @@ class OutputPort {
   /// Re-publishes a cue exactly as it is (replay): header untouched.
   void forward_erased(std::shared_ptr<const void> cue);
 
+  /// Hands every cue to `input` too.
+  /// @throws std::invalid_argument if the types differ or check_reliability() refuses the pair.
   void connect(InputPort* input);
   void disconnect(InputPort* input);
   /// The frame's DDS writer; called on the publishing thread after in-process delivery.
@@ -66,6 +68,12 @@ class OutputPort {
   std::function<void(const void*)> remote_;
   std::function<Stamp()> clock_;
 };
+
+/// @throws std::invalid_argument naming both ends if `input` declares reliable delivery and the
+///         output `source` ("<kernel>/<channel>", declared `declared`) is best effort: a reliable
+///         reader never matches a best-effort writer (DESIGN §4), so no cue would ever arrive.
+void check_reliability(const InputPort& input, const std::string& source,
+                       const OutputOptions& declared);
 
 /// A typed output handle, as KernelSetup::output<T>() returns it.
 template <CueType T>

@@ -63,7 +63,8 @@ struct SystemSpec {
   static SystemSpec parse(const YAML::Node& root, const std::string& file);
 
   /// Builds every module without DDS (loads the plugins, checks the multi-core rules and the
-  /// types of wires between modules). @throws std::invalid_argument naming module and rule.
+  /// types of wires between modules, and that no reliable input reads a best-effort output).
+  /// @throws std::invalid_argument naming module and rule.
   void check_modules(const std::vector<std::string>& plugin_path) const;
 
   /// Every module's domain becomes `domain` (boot --domain, tests).
