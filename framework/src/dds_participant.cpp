@@ -209,18 +209,25 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
     note(info.info.topicName().to_string(), info.info.typeName().to_string());
     if (info.status == eprosima::fastrtps::rtps::WriterDiscoveryInfo::DISCOVERED_WRITER) {
       const auto& q = info.info.m_qos;
+      const bool reliable = q.m_reliability.kind == dds::RELIABLE_RELIABILITY_QOS;
+      const bool transient_local = q.m_durability.kind == dds::TRANSIENT_LOCAL_DURABILITY_QOS;
       std::lock_guard lock(mutex_);
       writers_[info.info.topicName().to_string()] = {
           info.info.typeName().to_string(),
-          std::string(q.m_reliability.kind == dds::RELIABLE_RELIABILITY_QOS ? "reliable"
-                                                                            : "best_effort") +
-              (q.m_durability.kind == dds::TRANSIENT_LOCAL_DURABILITY_QOS ? ", transient_local"
-                                                                          : ", volatile")};
+          std::string(reliable ? "reliable" : "best_effort") +
+              (transient_local ? ", transient_local" : ", volatile"),
+          reliable, transient_local};
     }
   }
   std::map<std::string, DdsParticipant::DiscoveredWriter> writers() const {
     std::lock_guard lock(mutex_);
     return writers_;
+  }
+  std::optional<DdsParticipant::DiscoveredWriter> writer(const std::string& topic) const {
+    std::lock_guard lock(mutex_);
+    const auto it = writers_.find(topic);
+    if (it == writers_.end()) return std::nullopt;
+    return it->second;
   }
   void on_subscriber_discovery(dds::DomainParticipant*,
                                eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
@@ -317,6 +324,11 @@ std::map<std::string, DdsParticipant::DiscoveredWriter> DdsParticipant::discover
 
 std::vector<std::string> DdsParticipant::discovered_participants() const {
   return listener_->participants();
+}
+
+std::optional<DdsParticipant::DiscoveredWriter> DdsParticipant::discovered_writer(
+    const std::string& topic) const {
+  return listener_->writer(topic);
 }
 
 }  // namespace oscar

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 
@@ -15,17 +16,6 @@
 
 namespace oscar {
 namespace dds = eprosima::fastdds::dds;
-
-namespace {
-dds::DataReaderQos cue_reader_qos(std::size_t depth) {
-  dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
-  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-  q.history().depth = static_cast<std::int32_t>(std::max<std::size_t>(depth, 1));
-  q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
-  return q;
-}
-}  // namespace
 
 // Writes an output's cues to DDS, skipping the serialisation while nobody listens (volatile).
 class Module::Dds::OutputWriter final : public dds::DataWriterListener {
@@ -56,13 +46,18 @@ class Module::Dds::OutputWriter final : public dds::DataWriterListener {
 
 class Module::Dds::CueReader final : public dds::DataReaderListener {
  public:
-  CueReader(DdsParticipant& p, InputPort& input, const std::string& source) : input_(input) {
+  /// `producer`: the source output's declared options, as far as they are known.
+  CueReader(Dds& owner, InputPort& input, const std::string& source, const OutputOptions& producer)
+      : owner_(owner), input_(input), source_(source), producer_(producer) {
+    auto& p = owner.participant_;
     auto& topic = p.topic(cue_topic(source), input.type().new_topic_type());
-    reader_ = p.subscriber().create_datareader(&topic, cue_reader_qos(input.buffer().depth()), this,
-                                               dds::StatusMask::data_available()
-                                                   << dds::StatusMask::subscription_matched());
+    reader_ = p.subscriber().create_datareader(
+        &topic, qos::cue_reader(producer, input.buffer().depth(), input.reliability()), this,
+        dds::StatusMask::data_available() << dds::StatusMask::subscription_matched()
+                                          << dds::StatusMask::requested_incompatible_qos());
     if (!reader_) throw std::runtime_error("cannot create a reader for " + source);
   }
+  const std::string& source() const { return source_; }
   void on_data_available(dds::DataReader* reader) override {
     dds::SampleInfo info;
     for (;;) {
@@ -78,8 +73,21 @@ class Module::Dds::CueReader final : public dds::DataReaderListener {
                                const dds::SubscriptionMatchedStatus& status) override {
     matched_ = status.current_count;
   }
-  bool wait_matched(std::chrono::milliseconds timeout) const {
-    const auto until = std::chrono::steady_clock::now() + timeout;
+  // A writer that offers less than this reader asks: the producer was not seen when the reader
+  // was made, and is best effort (or volatile). The frame makes one that asks no more than that.
+  void on_requested_incompatible_qos(dds::DataReader*,
+                                     const dds::RequestedIncompatibleQosStatus& status) override {
+    auto offered = producer_;
+    if (status.last_policy_id == dds::RELIABILITY_QOS_POLICY_ID) {
+      offered.reliable = false;
+    } else if (status.last_policy_id == dds::DURABILITY_QOS_POLICY_ID) {
+      offered.transient_local = false;
+    } else {
+      return;  // nothing a cue reader's QoS could give
+    }
+    owner_.follow_producer(input_, source_, offered);
+  }
+  bool wait_matched(std::chrono::steady_clock::time_point until) const {
     while (matched_.load() == 0 && std::chrono::steady_clock::now() < until) {
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
@@ -97,7 +105,10 @@ class Module::Dds::CueReader final : public dds::DataReaderListener {
 
  private:
   std::atomic<bool> received_{false};
+  Dds& owner_;
   InputPort& input_;
+  std::string source_;
+  OutputOptions producer_;
   std::atomic<int> matched_{0};
 };
 
@@ -161,8 +172,30 @@ void Module::Dds::connect_input(InputPort& input, const std::string& source, boo
     pull_sources_[&input] = std::move(puller);
     return;
   }
-  auto reader = std::make_unique<CueReader>(participant_, input, source);
-  if (!reader->wait_matched(std::chrono::milliseconds(2000))) {
+  // The reader follows the class the producer declared, which its writer offers: discovery shows
+  // it, usually within milliseconds. A producer not seen within the bound gets a reliable,
+  // volatile reader, which every reliable writer matches; a best-effort one makes the reader
+  // report an incompatible writer, and follow_producer() replaces it.
+  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(2000);
+  std::optional<DdsParticipant::DiscoveredWriter> seen;
+  while (!(seen = participant_.discovered_writer(cue_topic(source))) &&
+         std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  OutputOptions producer;
+  if (seen) {
+    producer.reliable = seen->reliable;
+    producer.transient_local = seen->transient_local;
+  }
+  subscribe(input, source, producer, switching, until);
+}
+
+void Module::Dds::subscribe(InputPort& input, const std::string& source,
+                            const OutputOptions& producer, bool switching,
+                            std::chrono::steady_clock::time_point until) {
+  check_reliability(input, source, producer);
+  auto reader = std::make_unique<CueReader>(*this, input, source, producer);
+  if (!reader->wait_matched(until)) {
     module_.log_->warn("input {}/{}: no publisher of {} matched yet; cues arrive once it appears",
                        input.kernel(), input.name(), cue_topic(source));
   } else if (switching) {
@@ -179,6 +212,28 @@ void Module::Dds::connect_input(InputPort& input, const std::string& source, boo
     slot = std::move(reader);
   }
   if (old) participant_.subscriber().delete_datareader(old->reader_);
+}
+
+// On a DDS thread: entities are made on the configuration thread, in order with rewiring.
+void Module::Dds::follow_producer(InputPort& input, const std::string& source,
+                                  const OutputOptions& offered) {
+  std::lock_guard lock(queue_mutex_);
+  refollow_.push_back({&input, source, offered});
+  queue_cv_.notify_all();
+}
+
+void Module::Dds::refollow(const Refollow& r) {
+  {
+    std::lock_guard lock(readers_mutex_);
+    const auto it = readers_.find(r.input);
+    if (it == readers_.end() || it->second->source() != r.source) return;  // rewired since
+  }
+  try {
+    subscribe(*r.input, r.source, r.offered, /*switching=*/false,
+              std::chrono::steady_clock::now() + std::chrono::milliseconds(2000));
+  } catch (const std::exception& e) {
+    module_.log_->error("{}", e.what());
+  }
 }
 
 void Module::Dds::disconnect_input(InputPort& input) {
@@ -240,8 +295,16 @@ void Module::Dds::start_config() {
 void Module::Dds::serve_config() {
   std::unique_lock lock(queue_mutex_);
   while (true) {
-    queue_cv_.wait(lock, [&] { return !serving_ || !queue_.empty(); });
+    queue_cv_.wait(lock, [&] { return !serving_ || !queue_.empty() || !refollow_.empty(); });
     if (!serving_) return;
+    if (!refollow_.empty()) {
+      const auto r = std::move(refollow_.front());
+      refollow_.pop_front();
+      lock.unlock();
+      refollow(r);
+      lock.lock();
+      continue;
+    }
     auto command = std::move(queue_.front());
     queue_.pop_front();
     lock.unlock();

@@ -3,6 +3,7 @@
 // replies, module state and log records (DESIGN §4 topics and QoS classes).
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <map>
@@ -35,6 +36,8 @@ class Module::Dds {
   /// one is matched (so nothing the new source publishes after the switch is lost).
   /// Connects `input` to `source` and waits until it is matched; a rewire (`switching`) also
   /// waits for the source's first cue (at most 200 ms), so nothing published later is lost.
+  /// Its reader's QoS follows the producer's declared class (qos::cue_reader), as discovery shows
+  /// the producer's writer. @throws std::invalid_argument as check_reliability() does.
   void connect_input(InputPort& input, const std::string& source, bool switching = false);
   void disconnect_input(InputPort& input);
   void start_config();
@@ -45,6 +48,16 @@ class Module::Dds {
   class CueReader;
   class OutputWriter;
   class ConfigListener;
+  /// A reader to make again, asking no more than the producer's writer offers.
+  struct Refollow {
+    InputPort* input;
+    std::string source;
+    OutputOptions offered;
+  };
+  void subscribe(InputPort& input, const std::string& source, const OutputOptions& producer,
+                 bool switching, std::chrono::steady_clock::time_point until);
+  void follow_producer(InputPort& input, const std::string& source, const OutputOptions& offered);
+  void refollow(const Refollow& r);
   void serve_config();
   void beat();
 
@@ -64,6 +77,7 @@ class Module::Dds {
   std::mutex queue_mutex_;
   std::condition_variable queue_cv_;
   std::deque<ConfigCommand> queue_;
+  std::deque<Refollow> refollow_;  // served by the configuration thread, like queue_
   std::map<std::string, ConfigReply> last_reply_;  // by sender: answers repeated commands
   bool serving_ = false;
   std::thread config_thread_;

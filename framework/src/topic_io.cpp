@@ -1,5 +1,7 @@
 #include "oscar/topic_io.hpp"
 
+#include <algorithm>
+
 #include "oscar/output.hpp"
 
 namespace oscar::qos {
@@ -78,6 +80,18 @@ dds::DataWriterQos cue_writer(const OutputOptions& o) {
   q.durability().kind =
       o.transient_local ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
   q.publish_mode().kind = dds::SYNCHRONOUS_PUBLISH_MODE;
+  return q;
+}
+
+dds::DataReaderQos cue_reader(const OutputOptions& producer, std::size_t depth, Reliability input) {
+  const bool reliable = producer.reliable && input != Reliability::kBestEffort;
+  dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
+  q.reliability().kind =
+      reliable ? dds::RELIABLE_RELIABILITY_QOS : dds::BEST_EFFORT_RELIABILITY_QOS;
+  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = static_cast<std::int32_t>(std::max<std::size_t>(depth, 1));
+  q.durability().kind =
+      producer.transient_local ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
   return q;
 }
 

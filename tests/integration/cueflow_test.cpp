@@ -73,6 +73,49 @@ TEST(CueFlow, PushAcrossProcessesDeliversEveryCueInOrder) {
   EXPECT_EQ(r["stamps_min"], 1);
 }
 
+// A bench_sink in another process that reports once it has `expect` Bool cues from em/out.
+std::unique_ptr<Process> sink_of_em(const std::string& report, int expect) {
+  return run("sink", {"-k", "bench_sink:sink", "-p", "sink.type=Bool", "-p",
+                      "sink.report=" + report, "-p", "sink.expect=" + std::to_string(expect), "-i",
+                      "sink.in=em/out", "-m", "single_step"});
+}
+
+TEST(CueFlow, ABestEffortOutputDeliversToAConsumerThatWasWaitingForIt) {
+  const auto report = temp("best_effort_report.json");
+  std::filesystem::remove(report);
+  auto sink = sink_of_em(report, 50);
+  // The consumer made its reader before the producer existed, not knowing its class.
+  ASSERT_TRUE(eventually([&] { return sink->output().find("no publisher") != std::string::npos; }))
+      << sink->output();
+  auto em = local_module(R"(
+name: em
+mode: { continuous: 2ms }
+kernels: [ { type: test_emitter, name: em, params: { reliable: false } } ]
+)");
+  ASSERT_TRUE(eventually([&] { return std::filesystem::exists(report); })) << sink->output();
+  const auto r = nlohmann::json::parse(std::ifstream(report));
+  EXPECT_GE(r["received"].get<int>(), 50);
+}
+
+TEST(CueFlow, ATransientLocalOutputGivesItsLastCuesToAConsumerStartedAfterwards) {
+  auto em = local_module(R"(
+name: em
+mode: { continuous: 2ms }
+kernels:
+  - { type: test_emitter, name: em, params: { transient_local: true, depth: 4, count: 10 } }
+)");
+  auto& out = *em->kernel("em").ports().outputs.front();
+  ASSERT_TRUE(eventually([&] { return out.published() == 10; }));
+  const auto report = temp("history_report.json");
+  std::filesystem::remove(report);
+  auto sink = sink_of_em(report, 4);
+  ASSERT_TRUE(eventually([&] { return std::filesystem::exists(report); })) << sink->output();
+  const auto r = nlohmann::json::parse(std::ifstream(report));
+  EXPECT_EQ(r["received"], 4) << "the output's depth";
+  EXPECT_EQ(r["last_seq"], 10);
+  EXPECT_EQ(r["gaps"], 0) << "cues 7 to 10";
+}
+
 const char* const kPullConsumer = R"(
 name: consumer
 mode: deactivated

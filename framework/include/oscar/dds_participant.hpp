@@ -47,12 +47,16 @@ class DdsParticipant {
   struct DiscoveredWriter {
     std::string type;
     std::string qos;
+    bool reliable = true;
+    bool transient_local = false;
   };
   /// Every topic with a remote writer, by name (what `oscar record` subscribes to).
   std::map<std::string, DiscoveredWriter> discovered_writers() const;
   /// The names of the other participants on the domain that discovery sees now (a module's is
   /// "oscar:<module>").
   std::vector<std::string> discovered_participants() const;
+  /// The last remote writer discovery has seen on `topic`, if any.
+  std::optional<DiscoveredWriter> discovered_writer(const std::string& topic) const;
 
  private:
   class Listener;

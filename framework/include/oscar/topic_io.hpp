@@ -15,6 +15,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
 #include "oscar/dds_participant.hpp"
+#include "oscar/input.hpp"
 
 namespace oscar {
 
@@ -33,6 +34,12 @@ eprosima::fastdds::dds::DataReaderQos beat_reader(std::chrono::milliseconds leas
 /// A kernel output's cue writer: keep last `depth`, reliable or best effort, volatile or
 /// transient-local as the options say, written synchronously.
 eprosima::fastdds::dds::DataWriterQos cue_writer(const OutputOptions& o);
+/// The reader of an input fed by an output declared `producer` (cue_writer's other half), keeping
+/// the last `depth` cues. DDS matches a reader only if the writer offers at least what it
+/// requests: so it is reliable only if the producer is (and the input does not read best effort),
+/// and transient-local only if the producer is (then it gets the producer's history).
+eprosima::fastdds::dds::DataReaderQos cue_reader(const OutputOptions& producer, std::size_t depth,
+                                                 Reliability input);
 }  // namespace qos
 
 /// Calls `on_sample` for every valid sample (on a DDS thread) and `on_lost` when a writer's
