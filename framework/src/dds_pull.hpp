@@ -1,6 +1,6 @@
 #pragma once
-// Pull transfer across processes (DESIGN §5): a consumer's request reaches the producer's frame,
-// which answers from the output's ring buffer with the cue serialized as CDR.
+// Pull transfer across processes (docs/kernels.md): a consumer's request reaches the producer's
+// frame, which answers from the output's ring buffer with the cue serialized as CDR.
 
 #include <atomic>
 #include <future>

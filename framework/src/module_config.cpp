@@ -1,4 +1,5 @@
-// Configuration flow (DESIGN §6): commands, the authority rule, and replies.
+// Configuration flow (docs/architecture.md, "Configuration"): commands, the authority rule, and
+// replies.
 #include <algorithm>
 #include <stdexcept>
 

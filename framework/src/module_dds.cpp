@@ -273,8 +273,9 @@ void Module::Dds::start_config() {
   log_qos.history().depth = 100;
   log_writer_ = participant_.publisher().create_datawriter(
       &participant_.topic("oscar/log", new LogRecordPubSubType()), log_qos);
-  // The heartbeat: manual-by-topic liveliness with the module's lease (DESIGN §4). It stops
-  // when the process stops (SIGSTOP, crash) or a kernel call outlives the watchdog.
+  // The heartbeat: manual-by-topic liveliness with the module's lease (docs/architecture.md,
+  // "Topics and QoS classes"). It stops when the process stops (SIGSTOP, crash) or a kernel call
+  // outlives the watchdog.
   beat_writer_ = participant_.publisher().create_datawriter(
       &participant_.topic("oscar/registry/alive", new ModuleBeatPubSubType()),
       qos::beat_writer(module_.spec_.lease));

@@ -1,6 +1,6 @@
 #pragma once
 // The DDS side of a module frame: cue writers and readers, the configuration topic and its
-// replies, module state and log records (DESIGN §4 topics and QoS classes).
+// replies, module state and log records (docs/architecture.md, "Topics and QoS classes").
 
 #include <atomic>
 #include <chrono>

@@ -74,7 +74,7 @@ KernelSpec parse_kernel(const YAML::Node& node, const std::string& file, std::si
   }
   if (const auto inputs = node["inputs"]) {
     if (!inputs.IsMap()) fail(yaml_where(file, inputs), what + ".inputs: expected a map");
-    // DESIGN §7's short form puts `transfer:`/`depth:` beside the inputs: it applies to all.
+    // The short form (docs/boot.md) puts `transfer:`/`depth:` beside the inputs: it applies to all.
     std::optional<Transfer> all_transfer;
     std::optional<std::size_t> all_depth;
     for (const auto& kv : inputs) {

@@ -1,4 +1,4 @@
-// oscar-run: hosts one or more kernels from plugins in one process (DESIGN §5).
+// oscar-run: hosts one or more kernels from plugins in one process (docs/architecture.md).
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>

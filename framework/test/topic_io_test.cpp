@@ -1,4 +1,5 @@
-// The cue QoS classes of DESIGN §4: the reader of an input asks what its producer offers.
+// The cue QoS classes (docs/architecture.md, "Topics and QoS classes"): the reader of an input asks
+// what its producer offers.
 #include "oscar/topic_io.hpp"
 
 #include <gtest/gtest.h>

@@ -12,7 +12,8 @@
 namespace oscar::modules {
 
 /// Records every cue that reaches its inputs into an MCAP file, in the format `oscar record`
-/// writes (seed 004 §3: generic data loggers hung onto input and output channels; DESIGN §8).
+/// writes (seed 004 §3: generic data loggers hung onto input and output channels;
+/// docs/recording.md).
 class Logger final : public Kernel {
  public:
   struct Params {

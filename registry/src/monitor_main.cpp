@@ -1,4 +1,4 @@
-// oscar-monitor: one per host (DESIGN §7). Starts module processes when the registry asks,
+// oscar-monitor: one per host (docs/boot.md). Starts module processes when the registry asks,
 // captures their output, reports how they end, and shows it is alive with a heartbeat.
 #include <unistd.h>
 

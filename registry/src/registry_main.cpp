@@ -1,4 +1,4 @@
-// oscar-registry: holds the system graph and keeps the system running (DESIGN §7).
+// oscar-registry: holds the system graph and keeps the system running (docs/boot.md).
 #include <csignal>
 #include <cstdio>
 #include <thread>

@@ -15,7 +15,8 @@ class TopicDataType;
 
 namespace oscar {
 
-/// A cue type is an IDL struct whose first member is `CueHeader header` (DESIGN §4).
+/// A cue type is an IDL struct whose first member is `CueHeader header` (docs/architecture.md,
+/// "Topics and QoS classes").
 template <class T>
 concept CueType = requires(T cue, const T ccue) {
   { cue.header() } -> std::same_as<CueHeader&>;

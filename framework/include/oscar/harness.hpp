@@ -1,6 +1,6 @@
 #pragma once
 /// @file KernelHarness: drives one kernel without DDS and without other processes
-/// (DESIGN §5 "Stand-alone"): feed its inputs, step it, read its outputs.
+/// (docs/kernels.md, "Testing a kernel alone"): feed its inputs, step it, read its outputs.
 
 #include <chrono>
 #include <map>

@@ -1,5 +1,6 @@
 #pragma once
-/// @file Inputs: the consumer end of a channel, with its ring buffer and transfer (DESIGN §5).
+/// @file Inputs: the consumer end of a channel, with its ring buffer and transfer
+/// (docs/architecture.md).
 
 #include <chrono>
 #include <functional>
@@ -14,7 +15,7 @@
 
 namespace oscar {
 
-/// How an input gets its cues (DESIGN §5).
+/// How an input gets its cues (docs/architecture.md).
 enum class Transfer {
   kPush,     ///< the producer publishes; cues arrive in the ring buffer (default)
   kPull,     ///< the consumer asks the producer's output ring buffer on demand
@@ -28,7 +29,8 @@ Transfer parse_transfer(std::string_view text);
 /// Which cue of the producer's ring a pull asks for.
 enum class PullQuery { kLatest, kAtOrBefore, kNearest };
 
-/// What delivery an input asks of its producer's output (DESIGN §4 cue QoS classes).
+/// What delivery an input asks of its producer's output (docs/architecture.md, "Topics and QoS
+/// classes").
 enum class Reliability {
   kAsProducer,  ///< reliable or best effort as the producer's output is declared (default)
   kReliable,    ///< needs every cue: wiring it to a best-effort output is refused

@@ -1,5 +1,5 @@
 #pragma once
-/// @file The kernel API (DESIGN §5, STYLE.md "A kernel in one screen"): what a module author
+/// @file The kernel API (docs/kernels.md): what a module author
 /// writes.
 
 #include <cstdint>

@@ -16,7 +16,7 @@
 
 namespace oscar {
 
-/// A kernel's mode (DESIGN §5): continuous with a cycle, single step with a trigger, or off.
+/// A kernel's mode (docs/kernels.md): continuous with a cycle, single step with a trigger, or off.
 struct ModeSpec {
   enum class Kind { kContinuous, kSingleStep, kDeactivated };
   Kind kind = Kind::kSingleStep;
@@ -82,7 +82,7 @@ struct ModuleSpec {
   std::uint32_t incarnation = 1;
   /// Start with all kernels suspended (a restart waits for its configuration to be re-applied).
   bool start_suspended = false;
-  /// Liveliness lease of the module's heartbeat (DESIGN §4: default 300 ms).
+  /// Liveliness lease of the module's heartbeat (default 300 ms; docs/boot.md).
   std::chrono::milliseconds lease{300};
   /// A kernel call running longer than this stops the heartbeat: the registry sees a hang.
   std::chrono::milliseconds watchdog{2000};

@@ -1,5 +1,5 @@
 #pragma once
-/// @file Where a participant may send and listen (DESIGN §4, the network rule).
+/// @file Where a participant may send and listen (docs/network.md).
 
 #include <cstdint>
 #include <string>

@@ -71,7 +71,8 @@ class OutputPort {
 
 /// @throws std::invalid_argument naming both ends if `input` declares reliable delivery and the
 ///         output `source` ("<kernel>/<channel>", declared `declared`) is best effort: a reliable
-///         reader never matches a best-effort writer (DESIGN §4), so no cue would ever arrive.
+///         reader never matches a best-effort writer (docs/architecture.md, "Topics and QoS
+///         classes"), so no cue would ever arrive.
 void check_reliability(const InputPort& input, const std::string& source,
                        const OutputOptions& declared);
 

@@ -1,5 +1,5 @@
 #pragma once
-/// @file The ring buffer behind every channel end (DESIGN §5, seed 004 §2.2).
+/// @file The ring buffer behind every channel end (docs/kernels.md, seed 004 §2.2).
 
 #include <chrono>
 #include <condition_variable>

@@ -8,7 +8,8 @@
 
 namespace oscar {
 
-/// Nanoseconds since the Unix epoch (system clock): the unit of every cue stamp (DESIGN §4).
+/// Nanoseconds since the Unix epoch (system clock): the unit of every cue stamp
+/// (docs/architecture.md, "Topics and QoS classes").
 using Stamp = std::int64_t;
 
 /// The current wall-clock time as a Stamp. Kernels get their time from the Cycle instead.

@@ -1,7 +1,7 @@
 #pragma once
 /// @file Typed readers and writers for the system topics (oscar/registry/..., oscar/system/...,
-/// oscar/log) with the QoS classes of DESIGN §4: state (reliable, transient-local, keep last),
-/// heartbeats (manual-by-topic liveliness with a lease), events (reliable, transient-local).
+/// oscar/log) with the QoS classes of docs/architecture.md: state (reliable, transient-local, keep
+/// last), heartbeats (manual-by-topic liveliness with a lease), events (reliable, transient-local).
 
 #include <atomic>
 #include <chrono>

@@ -1,5 +1,5 @@
 #pragma once
-/// @file Registry: holds the system graph and keeps the system running (DESIGN §7, seed 004
+/// @file Registry: holds the system graph and keeps the system running (docs/boot.md, seed 004
 /// §2.4). Launches every module through its host's monitor, learns of failures three ways
 /// (process events from monitors, lapsed module heartbeats, lost monitors), suspends the
 /// system, restarts/replaces per policy, re-applies configuration and wiring, and resumes.

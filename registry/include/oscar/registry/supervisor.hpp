@@ -1,5 +1,5 @@
 #pragma once
-/// @file Supervisor: the process side of `oscar-monitor` (DESIGN §7). Starts module processes,
+/// @file Supervisor: the process side of `oscar-monitor` (docs/boot.md). Starts module processes,
 /// captures their output to one log file per module, reports how they end, and stops them in
 /// reverse start order. No DDS: the monitor program connects it to the registry.
 

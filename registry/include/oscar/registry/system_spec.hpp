@@ -1,5 +1,5 @@
 #pragma once
-/// @file SystemSpec: a system file (DESIGN §7) — hosts, modules with their restart policies and
+/// @file SystemSpec: a system file (docs/boot.md) — hosts, modules with their restart policies and
 /// debug wrappers — parsed and checked whole before anything is started.
 
 #include <chrono>
@@ -23,7 +23,7 @@ struct HostSpec {
   std::string where;    ///< "file:line"
 };
 
-/// What the registry does when the module fails (DESIGN §7).
+/// What the registry does when the module fails (docs/boot.md).
 struct RestartPolicy {
   enum class Kind { kAuto, kManual, kReplace };
   Kind kind = Kind::kAuto;
