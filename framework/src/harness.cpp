@@ -14,7 +14,7 @@ struct KernelHarness::Captured {
 };
 
 KernelHarness::KernelHarness(const std::string& type, YAML::Node params, std::string name,
-                             std::map<std::string, InputOptions> input_options)
+                             std::map<std::string, InputOverrides> input_options)
     : instance_(std::make_unique<KernelInstance>(load_kernel_type(type, plugin_search_path()),
                                                  std::move(name), std::move(params),
                                                  std::move(input_options))) {

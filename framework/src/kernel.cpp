@@ -49,7 +49,7 @@ OutputPort* KernelPorts::find_output(std::string_view name) const {
 }
 
 KernelSetup::KernelSetup(std::string kernel_name, std::string kernel_type, KernelPorts& ports,
-                         YAML::Node params, std::map<std::string, InputOptions> input_options)
+                         YAML::Node params, std::map<std::string, InputOverrides> input_options)
     : name_(std::move(kernel_name)),
       type_(std::move(kernel_type)),
       ports_(ports),

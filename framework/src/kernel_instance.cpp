@@ -8,14 +8,14 @@
 namespace oscar {
 
 KernelInstance::KernelInstance(const KernelTypeInfo& type, std::string name, YAML::Node params,
-                               std::map<std::string, InputOptions> input_options,
+                               std::map<std::string, InputOverrides> input_options,
                                std::shared_ptr<spdlog::logger> log)
     : name_(std::move(name)),
       type_(type.type),
       ports_(std::make_unique<KernelPorts>(name_)),
       log_(log ? std::move(log) : spdlog::default_logger()) {
   for (const auto& [input, options] : input_options) {
-    if (options.depth == 0) {
+    if (options.depth && *options.depth == 0) {
       throw std::invalid_argument(fmt::format(
           "kernel '{}' ({}): input '{}' has depth 0; a ring buffer holds at least 1 cue", name_,
           type_, input));

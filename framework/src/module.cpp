@@ -53,23 +53,13 @@ Module::Module(ModuleSpec spec, const std::vector<std::string>& plugin_path)
         throw std::runtime_error(fmt::format("{}: kernel '{}': {}", k.where, k.name, e.what()));
       }
     }();
-    std::map<std::string, InputOptions> options;
-    for (const auto& [input, wiring] : k.inputs) {
-      InputOptions o;
-      if (wiring.depth) o.depth = *wiring.depth;
-      if (wiring.transfer) o.transfer = *wiring.transfer;
-      options[input] = o;
-    }
+    std::map<std::string, InputOverrides> options;
+    for (const auto& [input, wiring] : k.inputs) options[input] = {wiring.depth, wiring.transfer};
     auto slot = std::make_unique<Slot>();
     slot->spec = &k;
     try {
       slot->instance = std::make_unique<KernelInstance>(type, k.name, k.params, options,
                                                         make_logger(spec_.name + "/" + k.name));
-      // Declared defaults stand unless the YAML set depth/transfer explicitly.
-      for (const auto& [input, wiring] : k.inputs) {
-        auto* port = slot->instance->ports().find_input(input);
-        if (wiring.transfer) port->set_transfer(*wiring.transfer);
-      }
     } catch (const std::exception& e) {
       throw std::invalid_argument(
           fmt::format("{}: kernel '{}' ({}): {}", k.where, k.name, k.type, e.what()));
@@ -113,9 +103,9 @@ void Module::check_multicore_rules() const {
   std::map<std::string, int> fan_in;   // kernel -> internal inputs
   std::set<std::string> kinds;
   for (const auto& s : slots_) {
-    for (const auto& [input, wiring] : s->spec->inputs) {
-      if (wiring.source.empty() || !spec_.find_kernel(source_kernel(wiring.source))) continue;
-      ++fan_out[wiring.source];
+    for (const auto& [input, source] : s->sources) {  // as wired now (after rewires)
+      if (!spec_.find_kernel(source_kernel(source))) continue;
+      ++fan_out[source];
       ++fan_in[s->instance->name()];
       const auto transfer = s->instance->ports().find_input(input)->transfer();
       kinds.insert(transfer == Transfer::kPush ? "push" : "pull");
@@ -138,26 +128,14 @@ void Module::check_multicore_rules() const {
 
 void Module::wire_in_process() {
   for (auto& s : slots_) {
-    for (const auto& [input_name, wiring] : s->spec->inputs) {
-      if (wiring.source.empty()) continue;
-      const auto producer_name = source_kernel(wiring.source);
-      if (!spec_.find_kernel(producer_name)) continue;  // remote: wired when DDS starts
-      auto* input = s->instance->ports().find_input(input_name);
-      auto& producer = kernel(producer_name);
-      auto* output = producer.ports().find_output(source_channel(wiring.source));
-      if (!output) {
-        throw std::invalid_argument(fmt::format(
-            "{}: kernel '{}' input '{}': kernel '{}' has no output '{}'", s->spec->where,
-            s->instance->name(), input_name, producer_name, source_channel(wiring.source)));
+    for (const auto& [input_name, source] : s->sources) {
+      if (!spec_.find_kernel(source_kernel(source))) continue;  // remote: wired when DDS starts
+      try {
+        connect(*s->instance->ports().find_input(input_name), source, std::nullopt);
+      } catch (const std::exception& e) {
+        throw std::invalid_argument(fmt::format("{}: kernel '{}' input '{}': {}", s->spec->where,
+                                                s->instance->name(), input_name, e.what()));
       }
-      if (input->transfer() == Transfer::kPush) {
-        output->connect(input);  // throws naming both types if they differ
-      } else if (output->type().name != input->type().name) {
-        throw std::invalid_argument(fmt::format(
-            "cannot wire {} ({}) to input {}/{} ({}): the types differ", output->address(),
-            output->type().name, input->kernel(), input->name(), input->type().name));
-      }
-      input->set_pull_source(std::make_shared<internal::RingPullSource>(output->buffer(), *input));
     }
   }
   // Triggers: a single-step kernel triggered by data runs when its trigger input gets a cue.
@@ -174,6 +152,49 @@ void Module::wire_in_process() {
       });
     }
   }
+}
+
+// Wiring in one place: at construction (producers in this module), when DDS starts (the others)
+// and on a rewire (`switch_wait` set). The new connection is made before the old one is broken:
+// a push input is handed the producer's cues (in process) or subscribes to its topic, a pull or
+// prefetch input reads the producer's ring (in process) or asks it over DDS. Returns what a
+// rewire's reply should note (a new source that did not show up in time), or "".
+std::string Module::connect(InputPort& input, const std::string& source,
+                            std::optional<std::chrono::milliseconds> switch_wait) {
+  const auto producer = source_kernel(source);
+  if (spec_.find_kernel(producer)) {
+    auto* output = kernel(producer).ports().find_output(source_channel(source));
+    if (!output) {
+      throw std::invalid_argument(
+          fmt::format("kernel '{}' has no output '{}'", producer, source_channel(source)));
+    }
+    if (output->type().name != input.type().name) {
+      throw std::invalid_argument(fmt::format(
+          "cannot wire {} ({}) to input {}/{} ({}): the types differ", output->address(),
+          output->type().name, input.kernel(), input.name(), input.type().name));
+    }
+    if (input.transfer() == Transfer::kPush) {
+      output->connect(&input);  // also checks the reliability the input declares
+    } else {
+      input.set_pull_source(std::make_shared<internal::RingPullSource>(output->buffer(), input));
+    }
+    for (auto& s : slots_) {
+      for (auto& out : s->instance->ports().outputs) {
+        if (out.get() != output) out->disconnect(&input);
+      }
+    }
+    if (dds_) dds_->disconnect_input(input);
+    return "";
+  }
+  if (!dds_) {
+    throw std::invalid_argument(fmt::format(
+        "source '{}' is not in module '{}' and the module runs without DDS", source, spec_.name));
+  }
+  auto note = dds_->connect_input(input, source, switch_wait);
+  for (auto& s : slots_) {
+    for (auto& out : s->instance->ports().outputs) out->disconnect(&input);
+  }
+  return note;
 }
 
 void Module::mark_pending(Slot& slot) {
@@ -195,9 +216,9 @@ void Module::start(int domain) {
     dds_ = std::make_unique<Dds>(*this, domain);
     dds_->wire_outputs(slots_);
     for (auto& s : slots_) {
-      for (const auto& [input, wiring] : s->spec->inputs) {
-        if (wiring.source.empty() || spec_.find_kernel(source_kernel(wiring.source))) continue;
-        dds_->connect_input(*s->instance->ports().find_input(input), wiring.source);
+      for (const auto& [input, source] : s->sources) {
+        if (spec_.find_kernel(source_kernel(source))) continue;  // wired at construction
+        connect(*s->instance->ports().find_input(input), source, std::nullopt);
       }
     }
   }

@@ -8,9 +8,14 @@
 
 #include "module_dds.hpp"
 #include "module_slot.hpp"
+#include "oscar/time.hpp"
 
 namespace oscar {
 namespace {
+
+// How long a rewire waits for the new source's first cue unless the command says (a source
+// slower than 1 Hz needs its sender to say).
+constexpr std::chrono::milliseconds kRewireWait{1000};
 
 const char* kind_name(CommandKind k) {
   switch (k) {
@@ -193,8 +198,17 @@ ConfigReply Module::apply(const ConfigCommand& c) {
         break;
       }
       case CMD_REWIRE: {
-        need_args(c, 3, "kernel, input, source");
-        rewire(slot_for(c.args()[0], kind), c.args()[1], c.args()[2]);
+        if (c.args().size() != 3 && c.args().size() != 4) {
+          throw std::invalid_argument(fmt::format(
+              "rewire takes 3 or 4 arguments (kernel, input, source, longest wait for the new "
+              "source's first cue, e.g. 2s), got {}",
+              c.args().size()));
+        }
+        const auto wait =
+            c.args().size() == 4
+                ? std::chrono::duration_cast<std::chrono::milliseconds>(parse_duration(c.args()[3]))
+                : kRewireWait;
+        reply.note(rewire(slot_for(c.args()[0], kind), c.args()[1], c.args()[2], wait));
         transition = fmt::format("{}.{} <- {}", c.args()[0], c.args()[1], c.args()[2]);
         break;
       }
@@ -236,7 +250,8 @@ ConfigReply Module::apply(const ConfigCommand& c) {
   return reply;
 }
 
-void Module::rewire(Slot& slot, const std::string& input_name, const std::string& source) {
+std::string Module::rewire(Slot& slot, const std::string& input_name, const std::string& source,
+                           std::chrono::milliseconds switch_wait) {
   auto* input = slot.instance->ports().find_input(input_name);
   if (!input) {
     throw std::invalid_argument(
@@ -246,27 +261,26 @@ void Module::rewire(Slot& slot, const std::string& input_name, const std::string
   if (slash == std::string::npos || slash == 0 || slash + 1 == source.size()) {
     throw std::invalid_argument(fmt::format("source '{}' must be '<kernel>/<channel>'", source));
   }
-  const auto producer = source.substr(0, slash);
-  // Disconnect from every in-process producer first, then connect the new source.
-  for (auto& s : slots_) {
-    for (auto& out : s->instance->ports().outputs) out->disconnect(input);
-  }
-  if (spec_.find_kernel(producer)) {
-    auto* output = kernel(producer).ports().find_output(source.substr(slash + 1));
-    if (!output) {
-      throw std::invalid_argument(
-          fmt::format("kernel '{}' has no output '{}'", producer, source.substr(slash + 1)));
+  std::map<std::string, std::string> before;
+  {
+    // The multi-core rules must hold for the wiring as it will be after the rewire.
+    std::lock_guard lock(mutex_);
+    before = slot.sources;
+    slot.sources[input_name] = source;
+    try {
+      check_multicore_rules();
+    } catch (...) {
+      slot.sources = before;
+      throw;
     }
-    if (dds_) dds_->disconnect_input(*input);
-    output->connect(input);
-  } else if (dds_) {
-    dds_->connect_input(*input, source, /*switching=*/true);  // the new source is matched
-  } else {
-    throw std::invalid_argument(fmt::format(
-        "source '{}' is not in module '{}' and the module runs without DDS", source, spec_.name));
   }
-  std::lock_guard lock(mutex_);
-  slot.sources[input_name] = source;
+  try {
+    return connect(*input, source, switch_wait);
+  } catch (...) {
+    std::lock_guard lock(mutex_);
+    slot.sources = before;  // nothing was broken: the input keeps its old source
+    throw;
+  }
 }
 
 }  // namespace oscar

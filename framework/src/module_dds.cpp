@@ -95,11 +95,12 @@ class Module::Dds::CueReader final : public dds::DataReaderListener {
   }
   /// Waits up to `timeout` for the first cue: once one came, the producer's writer has matched
   /// this reader too, so every cue it publishes from then on arrives.
-  void wait_first_cue(std::chrono::milliseconds timeout) const {
+  bool wait_first_cue(std::chrono::milliseconds timeout) const {
     const auto until = std::chrono::steady_clock::now() + timeout;
     while (!received_.load() && std::chrono::steady_clock::now() < until) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
+    return received_.load();
   }
   dds::DataReader* reader_ = nullptr;
 
@@ -158,25 +159,28 @@ void Module::Dds::wire_outputs(std::vector<std::unique_ptr<Slot>>& slots) {
   }
 }
 
-void Module::Dds::connect_input(InputPort& input, const std::string& source, bool switching) {
+std::string Module::Dds::connect_input(InputPort& input, const std::string& source,
+                                       std::optional<std::chrono::milliseconds> switch_wait) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(2000);
   if (input.transfer() != Transfer::kPush) {
     auto puller = std::make_shared<internal::DdsPullSource>(
         participant_, input, source,
         fmt::format("{}/{}/{}@{}", module_.spec_.name, input.kernel(), input.name(), getpid()));
+    std::string note;
     if (!puller->wait_matched(std::chrono::milliseconds(2000))) {
-      module_.log_->warn("input {}/{}: the producer {} does not answer pulls yet", input.kernel(),
+      note = fmt::format("input {}/{}: the producer {} does not answer pulls yet", input.kernel(),
                          input.name(), source);
+      module_.log_->warn("{}", note);
     }
-    input.set_pull_source(puller);
+    input.set_pull_source(puller);  // make, then break: the old source goes with its last user
     std::lock_guard lock(readers_mutex_);
     pull_sources_[&input] = std::move(puller);
-    return;
+    return note;
   }
   // The reader follows the class the producer declared, which its writer offers: discovery shows
   // it, usually within milliseconds. A producer not seen within the bound gets a reliable,
   // volatile reader, which every reliable writer matches; a best-effort one makes the reader
   // report an incompatible writer, and follow_producer() replaces it.
-  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(2000);
   std::optional<DdsParticipant::DiscoveredWriter> seen;
   while (!(seen = participant_.discovered_writer(cue_topic(source))) &&
          std::chrono::steady_clock::now() < until) {
@@ -187,22 +191,28 @@ void Module::Dds::connect_input(InputPort& input, const std::string& source, boo
     producer.reliable = seen->reliable;
     producer.transient_local = seen->transient_local;
   }
-  subscribe(input, source, producer, switching, until);
+  return subscribe(input, source, producer, switch_wait, until);
 }
 
-void Module::Dds::subscribe(InputPort& input, const std::string& source,
-                            const OutputOptions& producer, bool switching,
-                            std::chrono::steady_clock::time_point until) {
+std::string Module::Dds::subscribe(InputPort& input, const std::string& source,
+                                   const OutputOptions& producer,
+                                   std::optional<std::chrono::milliseconds> switch_wait,
+                                   std::chrono::steady_clock::time_point until) {
   check_reliability(input, source, producer);
   auto reader = std::make_unique<CueReader>(*this, input, source, producer);
+  std::string note;
   if (!reader->wait_matched(until)) {
-    module_.log_->warn("input {}/{}: no publisher of {} matched yet; cues arrive once it appears",
+    note = fmt::format("input {}/{}: no publisher of {} matched yet; cues arrive once it appears",
                        input.kernel(), input.name(), cue_topic(source));
-  } else if (switching) {
+    module_.log_->warn("{}", note);
+  } else if (switch_wait && !reader->wait_first_cue(*switch_wait)) {
     // Matching is seen by each side on its own: until the producer's writer has matched this
-    // reader too, what it publishes does not come here. Its first cue shows it has (a producer
-    // slower than this waits the bound, and its next cue may come from before the match).
-    reader->wait_first_cue(std::chrono::milliseconds(200));
+    // reader too, what it publishes does not come here. Its first cue shows it has.
+    note = fmt::format(
+        "input {}/{}: {} sent no cue within {} ms of the match; switched without it, so a cue it "
+        "published just before the switch may be missing",
+        input.kernel(), input.name(), source, switch_wait->count());
+    module_.log_->warn("{}", note);
   }
   std::unique_ptr<CueReader> old;
   {
@@ -212,6 +222,7 @@ void Module::Dds::subscribe(InputPort& input, const std::string& source,
     slot = std::move(reader);
   }
   if (old) participant_.subscriber().delete_datareader(old->reader_);
+  return note;
 }
 
 // On a DDS thread: entities are made on the configuration thread, in order with rewiring.
@@ -229,7 +240,7 @@ void Module::Dds::refollow(const Refollow& r) {
     if (it == readers_.end() || it->second->source() != r.source) return;  // rewired since
   }
   try {
-    subscribe(*r.input, r.source, r.offered, /*switching=*/false,
+    subscribe(*r.input, r.source, r.offered, std::nullopt,
               std::chrono::steady_clock::now() + std::chrono::milliseconds(2000));
   } catch (const std::exception& e) {
     module_.log_->error("{}", e.what());
@@ -238,14 +249,19 @@ void Module::Dds::refollow(const Refollow& r) {
 
 void Module::Dds::disconnect_input(InputPort& input) {
   std::unique_ptr<CueReader> old;
+  std::shared_ptr<internal::DdsPullSource> old_pull;  // the input reads elsewhere by now
   {
     std::lock_guard lock(readers_mutex_);
-    auto it = readers_.find(&input);
-    if (it == readers_.end()) return;
-    old = std::move(it->second);
-    readers_.erase(it);
+    if (auto it = readers_.find(&input); it != readers_.end()) {
+      old = std::move(it->second);
+      readers_.erase(it);
+    }
+    if (auto it = pull_sources_.find(&input); it != pull_sources_.end()) {
+      old_pull = std::move(it->second);
+      pull_sources_.erase(it);
+    }
   }
-  participant_.subscriber().delete_datareader(old->reader_);
+  if (old) participant_.subscriber().delete_datareader(old->reader_);
 }
 
 void Module::Dds::start_config() {

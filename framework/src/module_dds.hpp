@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include <fastdds/dds/publisher/DataWriter.hpp>
@@ -32,13 +33,16 @@ class Module::Dds {
   ~Dds();
 
   void wire_outputs(std::vector<std::unique_ptr<Slot>>& slots);
-  /// Subscribes the input to a remote source, replacing any earlier subscription once the new
-  /// one is matched (so nothing the new source publishes after the switch is lost).
-  /// Connects `input` to `source` and waits until it is matched; a rewire (`switching`) also
-  /// waits for the source's first cue (at most 200 ms), so nothing published later is lost.
-  /// Its reader's QoS follows the producer's declared class (qos::cue_reader), as discovery shows
-  /// the producer's writer. @throws std::invalid_argument as check_reliability() does.
-  void connect_input(InputPort& input, const std::string& source, bool switching = false);
+  /// Connects `input` to the remote `source`: a push input subscribes to its topic, a pull or
+  /// prefetch input asks its producer. Waits (at most 2 s) until matched; a rewire
+  /// (`switch_wait`) also waits that long for the source's first cue, so that nothing it
+  /// publishes after the switch is lost. Only then is an earlier subscription of the input
+  /// dropped. The reader's QoS follows the producer's declared class (qos::cue_reader), as
+  /// discovery shows its writer. Returns what did not happen in time, or "".
+  /// @throws std::invalid_argument as check_reliability() does.
+  std::string connect_input(InputPort& input, const std::string& source,
+                            std::optional<std::chrono::milliseconds> switch_wait);
+  /// Drops the input's subscription or pull requester, if it has one.
   void disconnect_input(InputPort& input);
   void start_config();
   void stop_config();
@@ -54,8 +58,9 @@ class Module::Dds {
     std::string source;
     OutputOptions offered;
   };
-  void subscribe(InputPort& input, const std::string& source, const OutputOptions& producer,
-                 bool switching, std::chrono::steady_clock::time_point until);
+  std::string subscribe(InputPort& input, const std::string& source, const OutputOptions& producer,
+                        std::optional<std::chrono::milliseconds> switch_wait,
+                        std::chrono::steady_clock::time_point until);
   void follow_producer(InputPort& input, const std::string& source, const OutputOptions& offered);
   void refollow(const Refollow& r);
   void serve_config();

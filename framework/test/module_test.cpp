@@ -210,6 +210,54 @@ kernels:
   EXPECT_EQ(sink.seen()[1]->header().source(), "b/out");
 }
 
+TEST(Module, APullInputRewiredInsideTheModulePullsFromTheNewProducerAndIsPushedNothing) {
+  Module m(spec(R"(
+name: pulling
+mode: single_step
+kernels:
+  - { type: test_counter, name: a, mode: { single_step: { trigger: command } } }
+  - { type: test_counter, name: b, mode: { single_step: { trigger: command } } }
+  - { type: test_collect, name: sink, inputs: { in: { source: a/out, transfer: pull } }, mode: deactivated }
+)"),
+           {});
+  m.start(-1);
+  auto& in = kernel_of<test::Collect>(m, "sink").in_;
+  const auto reply = m.apply(command(CMD_REWIRE, {"sink", "in", "b/out"}));
+  ASSERT_TRUE(reply.ok()) << reply.error();
+  EXPECT_EQ(reply.note(), "");
+  for (const auto* k : {"a", "b"}) {
+    m.apply(command(CMD_TRIGGER, {k}));
+    auto& ring = m.kernel(k).ports().find_output("out")->buffer();
+    ASSERT_TRUE(eventually([&] { return ring.pushed() == 1; })) << k;
+  }
+  EXPECT_EQ(in.transfer(), Transfer::kPull);
+  EXPECT_EQ(in.buffer().pushed(), 0u) << "a pull input is pushed nothing, by either producer";
+  const auto latest = in.pull();
+  ASSERT_TRUE(latest);
+  EXPECT_EQ(latest->header().source(), "b/out");
+}
+
+TEST(Module, AnInputOptionTheYamlNamesReplacesOnlyThatOneOfTheDeclared) {
+  const auto options = [](const std::string& wiring) {
+    Module m(spec(R"(
+name: opts
+mode: single_step
+kernels:
+  - { type: test_counter, name: src, mode: { single_step: { trigger: command } } }
+  - { type: test_prefetching, name: p, inputs: { in: )" +
+                  wiring + R"( } }
+)"),
+             {});
+    const auto& in = kernel_of<test::Prefetching>(m, "p").in_;
+    return std::pair{in.buffer().depth(), in.transfer()};
+  };
+  EXPECT_EQ(options("src/out"), std::pair(std::size_t{64}, Transfer::kPrefetch)) << "declared";
+  EXPECT_EQ(options("{ source: src/out, depth: 8 }"),
+            std::pair(std::size_t{8}, Transfer::kPrefetch));
+  EXPECT_EQ(options("{ source: src/out, transfer: pull }"),
+            std::pair(std::size_t{64}, Transfer::kPull));
+}
+
 TEST(Module, PullAsksTheProducersRingForAGivenTime) {
   Module m(spec(R"(
 name: pulling
@@ -286,6 +334,24 @@ kernels:
       },
       ThrowsMessage<std::invalid_argument>(
           HasSubstr("'no branching together with merging of cue flow'")));
+}
+
+TEST(ModuleRules, ARewireThatWouldBreakARuleIsRefusedAndTheWiringStays) {
+  Module m(spec(R"(
+name: almost_diamond
+mode: single_step
+kernels:
+  - { type: test_counter, name: a, mode: { single_step: { trigger: command } } }
+  - { type: test_counter, name: b, mode: { single_step: { trigger: command } } }
+  - { type: test_merge, name: m, inputs: { a: a/out, b: b/out } }
+)"),
+           {});
+  m.start(-1);
+  const auto reply =
+      m.apply(command(CMD_REWIRE, {"m", "b", "a/out"}));  // a would branch to m twice
+  EXPECT_FALSE(reply.ok());
+  EXPECT_THAT(reply.error(), HasSubstr("'no branching together with merging of cue flow'"));
+  EXPECT_THAT(m.state().kernels()[2].inputs(), testing::ElementsAre("a=a/out", "b=b/out"));
 }
 
 TEST(ModuleBadInput, WiringBetweenDifferentTypesNamesBoth) {

@@ -109,6 +109,16 @@ class ReliableCollect final : public Kernel {
   Input<Bool>& in_;
 };
 
+/// Declares its input's options as a kernel that needs a deep ring of prefetched cues would.
+class Prefetching final : public Kernel {
+ public:
+  explicit Prefetching(KernelSetup& setup)
+      : in_(setup.input<Bool>("in", {.depth = 64, .transfer = Transfer::kPrefetch})) {}
+  void process(Cycle&) override {}
+  void stub(Cycle&) override {}
+  Input<Bool>& in_;
+};
+
 /// Publishes LineSeg3DSeq cues: for type-mismatch tests.
 class Lines final : public Kernel {
  public:

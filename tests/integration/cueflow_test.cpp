@@ -1,4 +1,5 @@
 // Cue flow and configuration across real processes on loopback (issue: foundation tests).
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -208,6 +209,110 @@ kernels: [ { type: test_collect, name: ask, inputs: { in: { source: b/out, trans
   for (std::size_t i = 1; i < from_b.size(); ++i) {
     ASSERT_EQ(from_b[i]->header().seq(), from_b[i - 1]->header().seq() + 1) << "lost after switch";
   }
+}
+
+// Issue 15.2: the wait for a slow new source is the command's (here 3 s); after the switch no cue
+// of the new source is missing and none of the old one arrives.
+TEST(CueFlow, RewireFromA100HzToA1HzSourceLosesAndRepeatsNothingAfterTheSwitch) {
+  auto fast = run("fast", {"-k", "bench_source:fast", "-m", "continuous:10ms"});
+  auto slow = run("slow", {"-k", "bench_source:slow", "-m", "continuous:1s"});
+  auto consumer = local_module(R"(
+name: consumer
+kernels: [ { type: test_collect, name: sink, inputs: { in: { source: fast/out, depth: 512 } } } ]
+)");
+  auto& sink = collect(*consumer, "sink");
+  ASSERT_TRUE(eventually([&] { return sink.seen().size() > 10; }));
+  DdsParticipant participant(test::test_domain(), "test:coordinator");
+  ConfigClient coordinator(participant, "coordinator");
+  const auto reply =
+      coordinator.send("consumer", CMD_REWIRE, {"sink", "in", "slow/out", "3s"}, 8000ms);
+  ASSERT_TRUE(reply.ok()) << reply.error();
+  EXPECT_EQ(reply.note(), "") << "the 1 Hz source's first cue came within the 3 s wait";
+  const auto from_slow = [&] {
+    const auto seen = sink.seen();
+    return std::count_if(seen.begin(), seen.end(),
+                         [](const auto& c) { return c->header().source() == "slow/out"; });
+  };
+  ASSERT_TRUE(eventually([&] { return from_slow() >= 4; }, 15s));
+  consumer->stop();
+  const auto seen = sink.seen();
+  const auto first = std::find_if(seen.begin(), seen.end(),
+                                  [](const auto& c) { return c->header().source() == "slow/out"; });
+  for (auto it = std::next(first); it != seen.end(); ++it) {
+    ASSERT_EQ((*it)->header().source(), "slow/out") << "a cue of the old source after the switch";
+    EXPECT_EQ((*it)->header().seq(), (*std::prev(it))->header().seq() + 1)
+        << "lost or repeated after the switch";
+  }
+}
+
+TEST(CueFlow, ARewireWhoseNewSourceSendsNothingInTheWaitSaysSoInTheReply) {
+  auto a = run("a", {"-k", "bench_source:a", "-m", "continuous:10ms"});
+  auto idle = run("idle", {"-k", "bench_source:idle", "-m", "single_step:command"});
+  auto consumer = local_module(R"(
+name: consumer
+kernels: [ { type: test_collect, name: sink, inputs: { in: a/out } } ]
+)");
+  DdsParticipant participant(test::test_domain(), "test:coordinator");
+  ASSERT_TRUE(
+      eventually([&] { return participant.discovered_writer("oscar/cue/idle/out").has_value(); }));
+  ConfigClient coordinator(participant, "coordinator");
+  const auto reply =
+      coordinator.send("consumer", CMD_REWIRE, {"sink", "in", "idle/out", "100ms"}, 8000ms);
+  ASSERT_TRUE(reply.ok()) << reply.error();
+  EXPECT_THAT(reply.note(), HasSubstr("sink/in: idle/out sent no cue within 100 ms"));
+  EXPECT_THAT(reply.state().kernels()[0].inputs(), testing::ElementsAre("in=idle/out"));
+}
+
+TEST(CueFlow, APullInputRewiredAcrossProcessesPullsFromTheNewProducerOnly) {
+  auto a = run("a", {"-k", "bench_source:a", "-m", "continuous:5ms"});
+  auto b = run("b", {"-k", "bench_source:b", "-m", "continuous:5ms"});
+  auto consumer = local_module(R"(
+name: consumer
+mode: deactivated
+kernels: [ { type: test_collect, name: sink, inputs: { in: { source: a/out, transfer: pull } } } ]
+)");
+  auto& in = collect(*consumer, "sink").in_;
+  Input<Bool>::Ptr got;
+  ASSERT_TRUE(eventually([&] { return (got = in.pull()) != nullptr; }));
+  EXPECT_EQ(got->header().source(), "a/out");
+  DdsParticipant participant(test::test_domain(), "test:coordinator");
+  ConfigClient coordinator(participant, "coordinator");
+  const auto reply = coordinator.send("consumer", CMD_REWIRE, {"sink", "in", "b/out"});
+  ASSERT_TRUE(reply.ok()) << reply.error();
+  const auto asked = in.buffer().pushed();  // what its pulls brought
+  std::this_thread::sleep_for(50ms);        // ten cycles of a and of b
+  EXPECT_EQ(in.buffer().pushed(), asked) << "a pull input receives nothing unasked";
+  ASSERT_TRUE(got = in.pull());
+  EXPECT_EQ(got->header().source(), "b/out");
+}
+
+TEST(CueFlow, APullInputRewiredToAProducerInItsOwnModuleStaysAPullInput) {
+  auto a = run("a", {"-k", "bench_source:a", "-m", "continuous:5ms"});
+  auto consumer = local_module(R"(
+name: consumer
+mode: { continuous: 5ms }
+kernels:
+  - { type: test_counter, name: local }
+  - { type: test_collect, name: sink, inputs: { in: { source: a/out, transfer: pull } } }
+)");
+  auto& in = collect(*consumer, "sink").in_;
+  ASSERT_TRUE(eventually([&] { return in.pull() != nullptr; }));
+  const auto reply = consumer->apply([] {
+    ConfigCommand c;
+    c.id(1);
+    c.sender("coordinator");
+    c.kind(CMD_REWIRE);
+    c.args({"sink", "in", "local/out"});
+    return c;
+  }());
+  ASSERT_TRUE(reply.ok()) << reply.error();
+  const auto asked = in.buffer().pushed();  // what its pulls brought
+  std::this_thread::sleep_for(50ms);        // ten cycles of the producer that is now its source
+  EXPECT_EQ(in.transfer(), Transfer::kPull);
+  EXPECT_EQ(in.buffer().pushed(), asked) << "a pull input receives nothing unasked";
+  const auto got = in.pull();
+  ASSERT_TRUE(got);
+  EXPECT_EQ(got->header().source(), "local/out") << "it pulls from the new producer, not a/out";
 }
 
 TEST(CueFlow, CommandsConfigureAModuleInAnotherProcess) {

@@ -19,7 +19,7 @@ class KernelHarness {
   /// @throws like KernelInstance, or std::runtime_error for an unknown type.
   explicit KernelHarness(const std::string& type, YAML::Node params = {},
                          std::string name = "kernel_under_test",
-                         std::map<std::string, InputOptions> input_options = {});
+                         std::map<std::string, InputOverrides> input_options = {});
   ~KernelHarness();
 
   /// Gives a cue to an input, as a producer would (stamped with the harness time if unstamped).

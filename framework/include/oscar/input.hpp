@@ -7,6 +7,7 @@
 #include <future>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,18 @@ struct InputOptions {
   Reliability reliability = Reliability::kAsProducer;  ///< declared by the kernel, not the YAML
 };
 
+/// What the configuration (a system or module file) sets for one input: each field it names
+/// replaces the kernel's declared value, the others stand.
+struct InputOverrides {
+  std::optional<std::size_t> depth;
+  std::optional<Transfer> transfer;
+  InputOptions applied_to(InputOptions declared) const {
+    if (depth) declared.depth = *depth;
+    if (transfer) declared.transfer = *transfer;
+    return declared;
+  }
+};
+
 /// Answers pulls for one input: the producer's ring in this process, or a request over DDS.
 class PullSource {
  public:
@@ -63,7 +76,6 @@ class InputPort {
   const std::string& name() const { return name_; }
   const CueTypeInfo& type() const { return type_; }
   Transfer transfer() const { return transfer_; }
-  void set_transfer(Transfer t) { transfer_ = t; }
   Reliability reliability() const { return reliability_; }
   RingBuffer& buffer() { return buffer_; }
   const RingBuffer& buffer() const { return buffer_; }

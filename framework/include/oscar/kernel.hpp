@@ -74,23 +74,23 @@ struct KernelPorts {
 /// Handed to a kernel's constructor: declares ports and parameters and returns typed handles.
 class KernelSetup {
  public:
-  /// `params` holds the configured values (YAML map); `input_options` per input name.
+  /// `params` holds the configured values (YAML map); `input_options` what the configuration
+  /// sets per input name.
   KernelSetup(std::string kernel_name, std::string kernel_type, KernelPorts& ports,
-              YAML::Node params = {}, std::map<std::string, InputOptions> input_options = {});
+              YAML::Node params = {}, std::map<std::string, InputOverrides> input_options = {});
 
   const std::string& kernel_name() const { return name_; }
   const std::string& kernel_type() const { return type_; }
 
-  /// Declares an input. Options configured for this input (YAML) override `defaults`, except
-  /// the reliability it declares.
+  /// Declares an input. Each option the configuration names for this input (YAML `depth:`,
+  /// `transfer:`) replaces the one in `defaults`; the others, and the reliability, stand.
   /// @throws std::invalid_argument if the name is taken or not an identifier.
   template <CueType T>
   Input<T>& input(const std::string& name, InputOptions defaults = {}) {
     check_port_name(name);
     auto options = defaults;
     if (auto it = input_options_.find(name); it != input_options_.end()) {
-      options = it->second;
-      options.reliability = defaults.reliability;  // what the kernel needs; no YAML key sets it
+      options = it->second.applied_to(defaults);
     }
     auto port = std::make_unique<Input<T>>(name_, name, cue_type_info<T>(), options);
     auto& ref = *port;
@@ -127,7 +127,7 @@ class KernelSetup {
   std::string name_, type_;
   KernelPorts& ports_;
   YAML::Node params_;
-  std::map<std::string, InputOptions> input_options_;
+  std::map<std::string, InputOverrides> input_options_;
   bool params_bound_ = false;
 };
 

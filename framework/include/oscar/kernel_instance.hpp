@@ -16,7 +16,7 @@ class KernelInstance {
   /// Constructs the kernel. @throws std::invalid_argument for bad parameters or port
   /// declarations, naming the kernel, its type and the rule.
   KernelInstance(const KernelTypeInfo& type, std::string name, YAML::Node params = {},
-                 std::map<std::string, InputOptions> input_options = {},
+                 std::map<std::string, InputOverrides> input_options = {},
                  std::shared_ptr<spdlog::logger> log = nullptr);
 
   const std::string& name() const { return name_; }

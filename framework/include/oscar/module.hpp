@@ -4,11 +4,13 @@
 /// processing thread according to their modes, and obeys configuration commands.
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -62,6 +64,8 @@ class Module {
 
   void check_multicore_rules() const;
   void wire_in_process();
+  std::string connect(InputPort& input, const std::string& source,
+                      std::optional<std::chrono::milliseconds> switch_wait);
   void processing_loop();
   void run_slot(Slot& slot, Trigger trigger, bool stub);
   void kernel_failed(Slot& slot, std::string failure);
@@ -70,7 +74,8 @@ class Module {
   void report(const std::string& transition);
   Slot& slot_for(const std::string& kernel, const std::string& command);
   std::vector<Slot*> slots_for(const std::string& kernel_or_all, const std::string& command);
-  void rewire(Slot& slot, const std::string& input, const std::string& source);
+  std::string rewire(Slot& slot, const std::string& input, const std::string& source,
+                     std::chrono::milliseconds switch_wait);
   ModuleState state_locked() const;
 
   ModuleSpec spec_;

@@ -62,7 +62,7 @@ TEST(LandmarkPose, WithoutAMatchingImageOfBItUsesAAlone) {
 
 TEST(LandmarkPose, PrefetchesBFromItsProducer) {
   KernelHarness h("landmark_pose", YAML::Load("{wait_b: 20ms}"), "pose",
-                  {{"tags_b", InputOptions{.transfer = Transfer::kPrefetch}}});
+                  {{"tags_b", InputOverrides{.depth = {}, .transfer = Transfer::kPrefetch}}});
   h.feed("tags_b", tags("cam_b", 0.1, 1, {-0.02, 0.01, 1}, 7'000));
   h.feed("tags_a", tags("cam_a", 0.0, 0, {-0.08, -0.01, 1}, 7'000));
   h.step();
