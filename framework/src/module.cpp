@@ -360,6 +360,7 @@ void Module::processing_loop() {
       continue;
     }
     std::vector<std::tuple<Slot*, Trigger, bool>> run;
+    const bool activating = due && !due->active;  // on_activate() runs first: not cycle work
     if (due && due->next_due <= now) {
       run.emplace_back(due, Trigger::kCycle, due->stub);
       for (auto& s : slots_) {
@@ -374,7 +375,9 @@ void Module::processing_loop() {
     lock.lock();
     if (due && !run.empty()) {
       const auto after = Clock::now();
-      if (after > due->next_due) {  // the cycle took longer than the cycle time
+      if (after > due->next_due && activating) {
+        due->next_due = after;             // the cycles are counted from the end of the activation
+      } else if (after > due->next_due) {  // the cycle took longer than the cycle time
         ++due->overruns;
         if (due->overruns == 1 || due->overruns % 100 == 0) {
           log_->warn("kernel '{}' overran its {} cycle ({} overruns so far)", due->instance->name(),

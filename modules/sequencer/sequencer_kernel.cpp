@@ -108,6 +108,8 @@ void Sequencer::on_deactivate() {
     if (lane.thread.joinable()) lane.thread.join();
   }
   lanes_.clear();
+  sequences_ = 0;  // a new activation finds its modules again
+  first_sequence_told_ = false;
   client_.reset();
   participant_.reset();
   applied_mode_.clear();
@@ -177,11 +179,18 @@ void Sequencer::process(Cycle& cycle) {
     throw std::runtime_error("sequencer: " + e);
   }
   if (busy()) {  // the last cycle's commands are still on their way
-    if (++skipped_ == 1 || skipped_ % 100 == 0) {
+    if (sequences_ == 1) {
+      // The first commands wait until DDS has found the modules: expected, and said once.
+      if (!first_sequence_told_) {
+        first_sequence_told_ = true;
+        cycle.log().info("first sequence still running (finding its modules): cycles wait for it");
+      }
+    } else if (++skipped_ == 1 || skipped_ % 100 == 0) {
       cycle.log().warn("previous sequence still running: cycle skipped ({} so far)", skipped_);
     }
     return;
   }
+  ++sequences_;
   timeout_ = std::chrono::duration_cast<std::chrono::milliseconds>(params_.timeout);
   const auto lane = [&](const std::string& module) -> std::deque<Command>& {
     auto [it, added] = lanes_.try_emplace(module);

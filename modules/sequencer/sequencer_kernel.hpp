@@ -75,7 +75,9 @@ class Sequencer final : public Kernel {
   std::condition_variable wake_;
   std::chrono::milliseconds timeout_{2000};
   std::string worker_error_;
-  std::uint64_t skipped_ = 0;
+  std::uint64_t sequences_ = 0;  // started since activation
+  std::uint64_t skipped_ = 0;    // cycles skipped after the first sequence
+  bool first_sequence_told_ = false;
   bool stop_ = false;
 };
 
