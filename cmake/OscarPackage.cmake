@@ -2,7 +2,8 @@
 # oscar::run_main, oscar::testing, the IDL generator and oscar_add_module().
 include(CMakePackageConfigHelpers)
 
-install(TARGETS oscar_types oscar_framework oscar_run_main oscar_testing EXPORT oscarTargets
+install(TARGETS oscar_types oscar_framework oscar_run_main oscar_testing oscar_command_line
+  EXPORT oscarTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})

@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
+#include <oscar/command_line.hpp>
 
 #include "oscar/cue_types.hpp"
 #include "oscar/module.hpp"
@@ -85,7 +86,7 @@ int run_main(int argc, char** argv) {
   app.add_flag("--check", check, "load and check the module, print it, and exit");
   app.add_flag("--list-types", list, "list the kernel types that can be loaded and exit");
   app.add_flag("--list-modules", modules, "list the modules of the system file and exit");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 
   auto signals = block_stop_signals();  // every thread started from here inherits it
   keep_cue_memory_in_process();

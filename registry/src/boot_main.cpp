@@ -16,6 +16,7 @@
 #include <fmt/ranges.h>
 #include <oscar/configPubSubTypes.h>
 #include <CLI/CLI.hpp>
+#include <oscar/command_line.hpp>
 
 #include "oscar/cue_types.hpp"
 #include "oscar/kernel_registry.hpp"
@@ -127,7 +128,7 @@ int main(int argc, char** argv) {
   app.add_option("--duration", duration_s, "stop after this many seconds (default: Ctrl-C)");
   app.add_option("--log-dir", log_dir, "where process output goes (default /tmp/oscar/...)");
   app.add_flag("--check", check, "check the system file and its modules, start nothing");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 
   StopRequests stop(oscar::block_stop_signals());
 

@@ -8,6 +8,7 @@
 
 namespace oscar {
 namespace {
+// As a module's own output names them (spdlog's names): one word for a level everywhere.
 const char* level_name(LogLevel l) {
   switch (l) {
     case LOG_TRACE:
@@ -17,11 +18,11 @@ const char* level_name(LogLevel l) {
     case LOG_INFO:
       return "info ";
     case LOG_WARN:
-      return "warn ";
+      return "warning";
     case LOG_ERROR:
       return "error";
     case LOG_CRITICAL:
-      return "crit ";
+      return "critical";
   }
   return "?";
 }

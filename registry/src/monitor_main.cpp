@@ -14,6 +14,7 @@
 #include <oscar/registryPubSubTypes.h>
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
+#include <oscar/command_line.hpp>
 
 #include "janitor.hpp"
 #include "oscar/process_util.hpp"
@@ -48,7 +49,7 @@ int main(int argc, char** argv) {
   app.add_option("--host", host, "this host's name in the system file")->required();
   app.add_option("-d,--domain", domain, "DDS domain (default: the file's)");
   app.add_option("--log-dir", log_dir, "where module output goes (default /tmp/oscar/...)");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 
   const auto signals = oscar::block_stop_signals();
   spdlog::set_pattern("%H:%M:%S.%e %^%-5l%$ [monitor " + host + "] %v");

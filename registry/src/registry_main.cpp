@@ -5,6 +5,7 @@
 
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
+#include <oscar/command_line.hpp>
 
 #include "oscar/process_util.hpp"
 #include "oscar/registry/registry.hpp"
@@ -16,7 +17,7 @@ int main(int argc, char** argv) {
   app.add_option("--system", file, "the system file")->required();
   app.add_option("--host", host, "the host it runs on (default: the system's first local host)");
   app.add_option("-d,--domain", domain, "DDS domain (default: the file's)");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 
   auto signals = oscar::block_stop_signals();
   spdlog::set_pattern("%H:%M:%S.%e %^%-5l%$ %v");

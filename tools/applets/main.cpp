@@ -1,10 +1,11 @@
-// oscar-applets run SCENARIO.yaml [--json] [--dot FILE] — runs an applet scenario on the
+// oscar-applets run SCENARIO.yaml [--json] [--svg FILE] — runs an applet scenario on the
 // deterministic scheduler and prints the holder of every service after each step.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
 #include <fstream>
 #include <iostream>
+#include <oscar/command_line.hpp>
 
 #include "oscar/applets/dot.hpp"
 #include "oscar/applets/scenario.hpp"
@@ -18,9 +19,10 @@ int main(int argc, char** argv) {
   std::string dot_file;
   run->add_option("scenario", file, "Scenario YAML file (docs/applets.md)")->required();
   run->add_flag("--json", json, "Print JSON: {\"steps\":[{\"event\",\"t_ms\",\"holders\"}]}");
-  run->add_option("--dot", dot_file,
-                  "Write a Graphviz picture of the final state (DOT; .svg renders with dot)");
-  CLI11_PARSE(app, argc, argv);
+  run->add_option("--svg,--dot", dot_file,
+                  "Write a picture of the final state: FILE.svg (drawn with Graphviz; FILE.svg.dot "
+                  "is kept beside it) or FILE.dot");
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     const auto scenario = oscar::applets::Scenario::load_file(file);
     oscar::applets::Scheduler final_state(scenario.system().model, scenario.system().options);

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
+#include <oscar/command_line.hpp>
 
 #include "oscar/mcap/reader.hpp"
 
@@ -68,7 +69,7 @@ int main(int argc, char** argv) {
   app.name("oscar info");
   std::string path;
   app.add_option("FILE", path, "MCAP file")->required();
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     oscar::mcap::Reader reader(path);
     print(path, reader.info());

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
+#include <oscar/command_line.hpp>
 
 #include "oscar/network.hpp"
 #include "oscar/process_util.hpp"
@@ -53,7 +54,7 @@ int main(int argc, char** argv) {
   app.add_option("--remap", remaps, "FROM:=TO publish topic FROM as TO");
   app.add_flag("--step", o.step, "publish one message per Enter");
   app.add_option("--domain", o.domain, "DDS domain (default: $OSCAR_DOMAIN or 0)");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   oscar::keep_cue_memory_in_process();
   try {
     if (app.count("--domain") == 0) o.domain = oscar::domain_from_env(0);

@@ -1,5 +1,6 @@
 // oscar-swarm: `oscar swarm plan PROBLEM.yaml|json [-o SCHEDULE.json] [--svg FILE] [--st NODE]`.
 #include <CLI/CLI.hpp>
+#include <oscar/command_line.hpp>
 
 #include <exception>
 #include <fstream>
@@ -18,7 +19,7 @@ int main(int argc, char** argv) {
   plan->add_option("-o,--output", output, "write the schedule JSON here instead of stdout");
   plan->add_option("--svg", svg, "draw world, paths and jobs into this SVG file");
   plan->add_option("--st", st_node, "with --svg: draw the s-t diagram of this node's trajectory");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     const auto problem = oscar::swarm::load_problem(problem_path);
     oscar::swarm::ProblemRunner runner(problem);

@@ -6,6 +6,7 @@
 
 #include <oscar/configPubSubTypes.h>
 #include <CLI/CLI.hpp>
+#include <oscar/command_line.hpp>
 
 #include "oscar/process_util.hpp"
 #include "oscar/registry/log_printer.hpp"
@@ -25,7 +26,7 @@ int main(int argc, char** argv) {
                  "machine, or 0)");
   app.add_option("--duration", duration_s, "stop after this many seconds");
   app.add_flag("--no-colour", no_colour, "plain text even on a terminal");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   const auto signals = oscar::block_stop_signals();
   try {
     auto participant = oscar::tool_participant("oscar-log", system_file, host, domain);

@@ -4,8 +4,10 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
+#include <oscar/command_line.hpp>
 
 #include "oscar/registry/registry_client.hpp"
+#include "oscar/time.hpp"
 
 namespace {
 
@@ -13,8 +15,9 @@ std::string modes(const oscar::ModuleState& s) {
   std::string out;
   for (const auto& k : s.kernels()) {
     if (!out.empty()) out += ",";
-    out +=
-        k.mode() == "continuous" ? fmt::format("cont({}ms)", k.cycle_ns() / 1'000'000) : k.mode();
+    out += k.mode() == "continuous"
+               ? "cont(" + oscar::format_duration(std::chrono::nanoseconds(k.cycle_ns())) + ")"
+               : k.mode();
     if (k.stub()) out += "+stub";
   }
   return out.empty() ? "-" : out;
@@ -70,7 +73,7 @@ int main(int argc, char** argv) {
                  "machine, or 0)");
   app.add_option("--timeout", timeout_s, "seconds to wait for the registry");
   app.add_flag("--json", json, "print the system state as JSON");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     auto participant = oscar::tool_participant("oscar-ps", system_file, host, domain);
     oscar::RegistryClient client(*participant, "ps");

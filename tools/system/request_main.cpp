@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include <CLI/CLI.hpp>
+#include <oscar/command_line.hpp>
 
 #include "oscar/registry/registry_client.hpp"
 
@@ -19,7 +20,7 @@ int main(int argc, char** argv) {
   app.add_option("-d,--domain", domain,
                  "DDS domain (default: the system file's, $OSCAR_DOMAIN, the system booted on this "
                  "machine, or 0)");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     auto participant = oscar::tool_participant(argv[0], system_file, host, domain);
     oscar::RegistryClient client(*participant, "operator");

@@ -14,6 +14,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <numeric>
+#include <oscar/command_line.hpp>
 #include <random>
 
 #include "oscar/applets/runtime.hpp"
@@ -169,7 +170,7 @@ int main(int argc, char** argv) {
   app.add_option("--services", services, "Services in the stress test (>= 3)");
   app.add_option("--seed", seed, "Random seed");
   app.add_option("--period-ms", period_ms, "Shortest applet cycle; cycles are 1-3 times it");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   if (services < 3 || applets < 2 || period_ms < 1) {
     std::cerr << "oscar bench applets: needs --services >= 3, --applets >= 2, --period-ms >= 1\n";
     return 2;

@@ -8,9 +8,10 @@
 #include <optional>
 #include <thread>
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
+#include <oscar/command_line.hpp>
 
 #include "process.hpp"  // tests/common
 
@@ -75,11 +76,12 @@ class Bench {
 
   std::optional<Latency> framework(const Row& r, bool multicore) {
     const auto report = file("oscar", r, multicore);
-    const std::vector<std::string> sink{"-k", "bench_sink:sink", "-p", "sink.type=" + r.type,
-                                        "-p", "sink.report=" + report, "-p",
-                                        fmt::format("sink.expect={}", count_ + warmup_), "-p",
-                                        fmt::format("sink.warmup={}", warmup_), "-i",
-                                        "sink.in=src/out"};
+    const std::vector<std::string> sink{"-k", "bench_sink:sink",
+                                        "-p", "sink.type=" + r.type,
+                                        "-p", "sink.report=" + report,
+                                        "-p", fmt::format("sink.expect={}", count_ + warmup_),
+                                        "-p", fmt::format("sink.warmup={}", warmup_),
+                                        "-i", "sink.in=src/out"};
     const std::vector<std::string> source{"-k", "bench_source:src", "-p", "src.type=" + r.type};
     const auto cycle = fmt::format("continuous:{}us", r.period_us);
     std::vector<std::unique_ptr<Process>> procs;
@@ -88,7 +90,8 @@ class Bench {
       args.insert(args.end(), {"-m", cycle});
       procs.push_back(std::make_unique<Process>(args, log("multicore")));
     } else {
-      auto s = join({bin("oscar-run"), "--name", "sink", "--domain", dom()}, sink, {"-m", "single_step"});
+      auto s = join({bin("oscar-run"), "--name", "sink", "--domain", dom()}, sink,
+                    {"-m", "single_step"});
       procs.push_back(std::make_unique<Process>(s, log("sink")));
       std::this_thread::sleep_for(300ms);
       auto p = join({bin("oscar-run"), "--name", "src", "--domain", dom()}, source, {"-m", cycle});
@@ -99,11 +102,11 @@ class Bench {
 
   std::optional<Latency> raw(const Row& r, bool multicore) {
     const auto report = file("raw", r, multicore);
-    const std::vector<std::string> common{"--type", r.type, "--domain", dom(), "--period-us",
-                                          std::to_string(r.period_us)};
-    const std::vector<std::string> sub{"--report", report, "--expect",
-                                       std::to_string(count_ + warmup_), "--warmup",
-                                       std::to_string(warmup_)};
+    const std::vector<std::string> common{"--type", r.type,        "--domain",
+                                          dom(),    "--period-us", std::to_string(r.period_us)};
+    const std::vector<std::string> sub{"--report", report,
+                                       "--expect", std::to_string(count_ + warmup_),
+                                       "--warmup", std::to_string(warmup_)};
     const std::vector<std::string> pub{"--count", std::to_string(10 * (count_ + warmup_))};
     std::vector<std::unique_ptr<Process>> procs;
     if (multicore) {
@@ -120,7 +123,8 @@ class Bench {
   }
 
  private:
-  static std::vector<std::string> join(std::vector<std::string> a, const std::vector<std::string>& b,
+  static std::vector<std::string> join(std::vector<std::string> a,
+                                       const std::vector<std::string>& b,
                                        const std::vector<std::string>& c) {
     a.insert(a.end(), b.begin(), b.end());
     a.insert(a.end(), c.begin(), c.end());
@@ -149,14 +153,15 @@ int main(int argc, char** argv) {
   std::vector<std::string> types{"Bool", "LineSeg3DSeq", "GvImage"};
   std::vector<std::string> constellations{"multicore", "local"};
   app.add_flag("--json", json, "print JSON instead of a table");
-  app.add_option("--count", count, "measured cues per row (after the warm-up)")->check(CLI::PositiveNumber);
+  app.add_option("--count", count, "measured cues per row (after the warm-up)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--warmup", warmup, "cues left out at the start of each row");
   app.add_option("--domain", domain, "DDS domain for the run");
   app.add_option("--repeat", repeat, "runs per row, OSCAR and raw alternating; medians reported")
       ->check(CLI::PositiveNumber);
   app.add_option("--types", types, "rows to run")->delimiter(',');
   app.add_option("--constellations", constellations, "multicore, local")->delimiter(',');
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 
   const auto dir = std::filesystem::temp_directory_path() / fmt::format("oscar_bench_{}", getpid());
   std::filesystem::create_directories(dir);
@@ -179,8 +184,8 @@ int main(int argc, char** argv) {
         const auto o = bench.framework(r, multicore);
         const auto w = bench.raw(r, multicore);
         if (!o || !w) {
-          std::cerr << fmt::format("bench cueflow: {} {}: no report from {} (logs in {})\n",
-                                   r.type, c, o ? "raw Fast DDS" : "OSCAR", dir.string());
+          std::cerr << fmt::format("bench cueflow: {} {}: no report from {} (logs in {})\n", r.type,
+                                   c, o ? "raw Fast DDS" : "OSCAR", dir.string());
           ++failures;
           continue;
         }
@@ -193,15 +198,25 @@ int main(int argc, char** argv) {
       const double seed = multicore ? r.seed_multicore_us : r.seed_local_us;
       // The ratio of medians: each run's p50 is a median already, runs alternate OSCAR and raw.
       const double ratio = raw.p50 > 0 ? ours.p50 / raw.p50 : 0;
-      rows.push_back({{"type", r.type}, {"bytes", r.bytes}, {"constellation", c},
-                      {"p50_us", ours.p50}, {"p90_us", ours.p90}, {"max_us", ours.max},
-                      {"raw_p50_us", raw.p50}, {"raw_p90_us", raw.p90}, {"raw_max_us", raw.max},
-                      {"ratio", ratio}, {"samples", ours.samples}, {"runs", ours_runs.size()}, {"seed_us", seed}});
+      rows.push_back({{"type", r.type},
+                      {"bytes", r.bytes},
+                      {"constellation", c},
+                      {"p50_us", ours.p50},
+                      {"p90_us", ours.p90},
+                      {"max_us", ours.max},
+                      {"raw_p50_us", raw.p50},
+                      {"raw_p90_us", raw.p90},
+                      {"raw_max_us", raw.max},
+                      {"ratio", ratio},
+                      {"samples", ours.samples},
+                      {"runs", ours_runs.size()},
+                      {"seed_us", seed}});
       if (!json) {
-        std::cout << fmt::format("{:<13} {:>7} {:<10} {:>9.1f} {:>9.1f} {:>9.1f} {:>10.1f} {:>7.2f} {:>10.0f}\n",
-                                 r.type, r.bytes, c, ours.p50, ours.p90, ours.max, raw.p50,
-                                 ratio, seed)
-                  << std::flush;
+        std::cout
+            << fmt::format(
+                   "{:<13} {:>7} {:<10} {:>9.1f} {:>9.1f} {:>9.1f} {:>10.1f} {:>7.2f} {:>10.0f}\n",
+                   r.type, r.bytes, c, ours.p50, ours.p90, ours.max, raw.p50, ratio, seed)
+            << std::flush;
       }
     }
   }

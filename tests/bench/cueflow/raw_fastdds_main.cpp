@@ -14,12 +14,13 @@
 #include <thread>
 #include <vector>
 
+#include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
-#include <fmt/format.h>
+#include <oscar/command_line.hpp>
 
 #include <oscar/cue_type_info.hpp>
 #include <oscar/cue_types.hpp>
@@ -95,12 +96,14 @@ class Sub final : public fdds::DataReaderListener {
     auto v = latency_ns_;
     std::sort(v.begin(), v.end());
     const auto at = [&](double q) {
-      return v.empty() ? 0.0 : v[std::min(v.size() - 1, static_cast<std::size_t>(q * v.size()))] / 1e3;
+      return v.empty() ? 0.0
+                       : v[std::min(v.size() - 1, static_cast<std::size_t>(q * v.size()))] / 1e3;
     };
-    std::ofstream(o_.report) << fmt::format(
-        R"({{"type":"{}","received":{},"samples":{},"delivery_us":{{"p50":{:.2f},"p90":{:.2f},"max":{:.2f}}}}})",
-        o_.type, received_, v.size(), at(0.5), at(0.9), v.empty() ? 0.0 : v.back() / 1e3)
-                              << "\n";
+    std::ofstream(o_.report)
+        << fmt::format(
+               R"({{"type":"{}","received":{},"samples":{},"delivery_us":{{"p50":{:.2f},"p90":{:.2f},"max":{:.2f}}}}})",
+               o_.type, received_, v.size(), at(0.5), at(0.9), v.empty() ? 0.0 : v.back() / 1e3)
+        << "\n";
   }
 
  private:
@@ -114,8 +117,8 @@ class Sub final : public fdds::DataReaderListener {
 template <class T>
 int run(const std::string& mode, const Options& o) {
   oscar::DdsParticipant participant(o.domain, "oscar-bench-raw:" + mode);
-  auto& topic = participant.topic("oscar/bench/raw/" + o.type,
-                                  oscar::cue_type_info<T>().new_topic_type());
+  auto& topic =
+      participant.topic("oscar/bench/raw/" + o.type, oscar::cue_type_info<T>().new_topic_type());
   std::unique_ptr<Sub<T>> sub;
   fdds::DataReader* reader = nullptr;
   if (mode != "pub") {
@@ -159,7 +162,9 @@ int main(int argc, char** argv) {
   CLI::App app{"oscar-bench-raw: raw Fast DDS latency baseline"};
   std::string mode;
   Options o;
-  app.add_option("mode", mode, "pub, sub or both")->required()->check(CLI::IsMember({"pub", "sub", "both"}));
+  app.add_option("mode", mode, "pub, sub or both")
+      ->required()
+      ->check(CLI::IsMember({"pub", "sub", "both"}));
   app.add_option("--type", o.type)->check(CLI::IsMember({"Bool", "LineSeg3DSeq", "GvImage"}));
   app.add_option("--count", o.count);
   app.add_option("--expect", o.expect);
@@ -167,7 +172,7 @@ int main(int argc, char** argv) {
   app.add_option("--period-us", o.period_us);
   app.add_option("--report", o.report);
   app.add_option("--domain", o.domain);
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     oscar::register_standard_cue_types();
     return oscar::visit_standard_type(o.type, [&]<class T>() { return run<T>(mode, o); });

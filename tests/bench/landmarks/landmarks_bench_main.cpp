@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 #include <CLI/CLI.hpp>
+#include <oscar/command_line.hpp>
 
 #include "oscar/dds_participant.hpp"
 #include "oscar/module_spec.hpp"
@@ -151,7 +152,7 @@ int main(int argc, char** argv) {
   app.add_option("--host", host);
   app.add_option("--domain", domain);
   app.add_option("--out", out);
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     if (watch_mode) return watch(system, host, domain, seconds, out);
     if (const auto why = oscar::test::TestHosts::unavailable(); !why.empty()) {

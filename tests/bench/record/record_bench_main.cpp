@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
+#include <oscar/command_line.hpp>
 
 #include "bench_common.hpp"
 #include "oscar/cue_types.hpp"
@@ -44,7 +45,7 @@ int main(int argc, char** argv) {
   app.add_option("--duration", duration_s, "seconds of publishing")->check(CLI::PositiveNumber);
   app.add_option("--compression", compression, "the recorder's compression (zstd, lz4, none)");
   app.add_option("-d,--domain", domain, "DDS domain");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     std::filesystem::create_directories(out_dir);
     const auto file = (std::filesystem::path(out_dir) / "bench_record.mcap").string();

@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
+#include <oscar/command_line.hpp>
 
 #include "bench_common.hpp"
 #include "cue_header_cdr.hpp"  // tools/record
@@ -241,7 +242,7 @@ int main(int argc, char** argv) {
                  "writing one: its log times are the schedule")
       ->check(CLI::ExistingFile);
   app.add_option("-d,--domain", domain, "DDS domain");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   oscar::keep_cue_memory_in_process();  // it receives the images as a module would
   try {
     std::filesystem::create_directories(out_dir);

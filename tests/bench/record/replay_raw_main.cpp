@@ -17,6 +17,7 @@
 
 #include <CLI/CLI.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
+#include <oscar/command_line.hpp>
 
 #include "bench_common.hpp"
 #include "oscar/cue_type_info.hpp"
@@ -98,7 +99,7 @@ int main(int argc, char** argv) {
   int domain = 0;
   app.add_option("SCHEDULE", schedule, "a 'topic type seq offset_ns' line per cue")->required();
   app.add_option("--domain", domain);
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     auto lanes = read_schedule(schedule);
     std::size_t history_bytes = 0;

@@ -12,6 +12,7 @@
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
+#include <oscar/command_line.hpp>
 
 #include "oscar/process_util.hpp"
 #include "oscar/registry/registry_client.hpp"
@@ -122,7 +123,7 @@ int main(int argc, char** argv) {
   app.add_option("--hangs", hangs, "SIGSTOP hangs to time (0: none)")
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--json", json, "print JSON");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     const int domain = 1 + getpid() % 200;
     const auto file = temp("bench_restart") + ".yaml";

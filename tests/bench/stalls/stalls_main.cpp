@@ -20,6 +20,7 @@
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
+#include <oscar/command_line.hpp>
 
 namespace {
 using Clock = std::chrono::steady_clock;
@@ -72,7 +73,7 @@ int main(int argc, char** argv) {
   CLI::App app{"oscar bench stalls: how long this machine holds a running thread back"};
   double seconds = 10;
   app.add_option("--seconds", seconds, "how long to watch")->check(CLI::PositiveNumber);
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     cpu_set_t allowed;
     if (sched_getaffinity(0, sizeof allowed, &allowed) != 0) {

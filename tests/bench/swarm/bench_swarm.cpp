@@ -2,6 +2,7 @@
 // and an end-to-end run. Prints figures; decides nothing by time.
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
+#include <oscar/command_line.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -125,7 +126,7 @@ int main(int argc, char** argv) {
   app.add_option("--obstacles", e2e_obstacles, "end-to-end: moving obstacles");
   app.add_option("--jobs", e2e_jobs, "end-to-end: jobs");
   app.add_option("--max-seconds", max_seconds, "end-to-end: stop scheduling after this long");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 
   nlohmann::json doc;
   auto series = [&](const std::string& name, const std::vector<int>& sizes,

@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
   app.add_option("-n,--count", count, "exit after this many samples (0: until Ctrl-C)");
   app.add_option("--timeout", timeout_s, "seconds to wait for a writer of the topic");
   app.add_option("--max-items", max_items, "items shown of a long sequence");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {

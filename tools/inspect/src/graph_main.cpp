@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "oscar/registry/registry_client.hpp"
+#include "oscar/time.hpp"
 #include "tool_options.hpp"
 
 namespace {
@@ -49,9 +50,10 @@ std::string to_dot(const oscar::SystemState& s,
                        colour(m.status()));
     for (const auto& k : m.state().kernels()) {
       kernels.insert(k.name());
-      const auto mode = k.mode() == "continuous"
-                            ? fmt::format("continuous {} ms", k.cycle_ns() / 1'000'000)
-                            : k.mode();
+      const auto mode =
+          k.mode() == "continuous"
+              ? "continuous " + oscar::format_duration(std::chrono::nanoseconds(k.cycle_ns()))
+              : k.mode();
       dot += fmt::format("    {} [shape=box, style=filled, fillcolor=white, label={}];\n",
                          quoted("k:" + k.name()),
                          quoted(fmt::format("{}\\n({})\\n{}{}", k.name(), k.type(), mode,
@@ -99,7 +101,7 @@ int main(int argc, char** argv) {
                  "default: DOT on stdout");
   app.add_option("--timeout", timeout_s, "seconds to wait for the registry");
   app.add_option("--discovery", discovery_s, "seconds to discover channel types");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     auto participant =
         oscar::tool_participant("oscar-graph", tool.system_file, tool.host, tool.domain);

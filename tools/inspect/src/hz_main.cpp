@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(2, 1000000));
   app.add_option("--duration", duration_s, "seconds to measure, then print the result and exit");
   app.add_option("--timeout", timeout_s, "seconds to wait for a writer of the topic");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {

@@ -4,6 +4,7 @@
 #include <string>
 
 #include <CLI/CLI.hpp>
+#include <oscar/command_line.hpp>
 
 namespace oscar::inspect {
 

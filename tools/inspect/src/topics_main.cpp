@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_flag("--json", json, "print a JSON array");
   app.add_flag("-a,--all", all, "also OSCAR's own topics (registry, config, log), not only cues");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     auto participant =
         oscar::tool_participant("oscar-topics", tool.system_file, tool.host, tool.domain);

@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
+#include <oscar/command_line.hpp>
 
 #include "module_spec.hpp"
 #include "oscar/kernel_registry.hpp"
@@ -22,7 +23,7 @@ int main(int argc, char** argv) {
                  "where to create the folder (default: modules/ in-tree, . out-of-tree)");
   app.add_flag("--out-of-tree", spec.out_of_tree,
                "a stand-alone project built against the installed package (find_package(oscar))");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     for (const auto& i : inputs) spec.inputs.push_back(spec.parse_port(i, "--input"));
     for (const auto& o : outputs) spec.outputs.push_back(spec.parse_port(o, "--output"));

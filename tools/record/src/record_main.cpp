@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
+#include <oscar/command_line.hpp>
 
 #include "oscar/network.hpp"
 #include "recorder.hpp"
@@ -71,7 +72,7 @@ int main(int argc, char** argv) {
   app.add_option("--split-size", split_size, "start a new file after this size (e.g. 500M)");
   app.add_option("--split-duration", split_duration, "start a new file after this time (e.g. 5m)");
   app.add_option("--domain", o.domain, "DDS domain (default: $OSCAR_DOMAIN or 0)");
-  CLI11_PARSE(app, argc, argv);
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     if (app.count("--domain") == 0) o.domain = oscar::domain_from_env(0);
     o.compression = oscar::mcap::parse_compression(compression);
