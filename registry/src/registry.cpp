@@ -174,10 +174,17 @@ void Registry::on_module_state(const ModuleState& s) {
     m->rate_since = now;
     m->rate_published = published;
   }
+  // A transition (a command changed a mode, a parameter, the wiring) is published at once, so
+  // `oscar ps` right after `oscar config` shows it, not the state of up to a second before.
+  const bool transition = m->has_state && s.last_transition() != m->state.last_transition();
   m->state = s;
   m->has_state = true;
   m->pid = s.pid();
-  if (m->status == "starting") started(*m, s);
+  if (m->status == "starting") {
+    started(*m, s);
+  } else if (transition) {
+    publish();
+  }
 }
 
 void Registry::started(Tracked& m, const ModuleState& now) {

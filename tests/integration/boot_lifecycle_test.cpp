@@ -1,6 +1,7 @@
 // oscar boot's life cycle with real processes on loopback: a busy domain is refused, `oscar
 // shutdown` and Ctrl-C (during boot too) end boot, a second Ctrl-C aborts, an operator's restart
-// is no failure, and the tools find the system booted on this machine without flags.
+// is no failure, a command's transition shows in the system state at once, and the tools find
+// the system booted on this machine without flags.
 #include <signal.h>
 #include <stdlib.h>
 
@@ -14,6 +15,7 @@
 
 #include "booted_system.hpp"
 #include "oscar/registry/running_systems.hpp"
+#include "oscar/time.hpp"
 
 namespace oscar {
 namespace {
@@ -230,6 +232,26 @@ modules:
               HasSubstr("exited with code 3 (last output: oscar-run: module 'cam' stopped: "
                         "kernel 'cam' failed 3 times in a row (on_kernel_error: restart); last: "
                         "on_activate(): framegrabber 'cam'"));
+}
+
+TEST(Registry, ACommandsTransitionReachesTheSystemStateAtOnce) {
+  BootedSystem sys("transition", two_sources("transition"));
+  sys.running();
+  // The registry also republishes the whole state once a second; each change must show long
+  // before that (three in a row: by chance all three would fall early in that second 1 in 8).
+  for (const auto* cycle : {"30ms", "40ms", "50ms"}) {
+    const auto reply = sys.config().send("src", CMD_SET_CYCLE, {"src", cycle});
+    ASSERT_TRUE(reply.ok()) << reply.error();
+    const auto cycle_ns = parse_duration(cycle).count();
+    const auto seen = sys.registry().wait_for(
+        [&](const SystemState& st) {
+          const auto* src = entry(st, "src");
+          return src && !src->state().kernels().empty() &&
+                 src->state().kernels()[0].cycle_ns() == cycle_ns;
+        },
+        400ms);
+    EXPECT_TRUE(seen) << "set_cycle " << cycle << " not in the system state within 400 ms";
+  }
 }
 
 std::optional<int> ps(std::string& output) {
