@@ -33,11 +33,12 @@ finish() {
   wait "$recorder" 2>/dev/null || true
   echo
   echo "demo: recording: $(tail -n 2 "$recording.log" | tr '\n' ' ')"
-  build/bin/oscar info "$recording" | head -n 12 || true
+  build/bin/oscar info "$recording" || true
   if [ "$system" = config/landmarks-1host.yaml ]; then
-    echo "demo: replay the camera images into the detectors (docs/landmarks.md):"
-    echo "  build/bin/oscar-run config/landmarks-replay.yaml --module detect &"
-    echo "  build/bin/oscar replay $recording --topics 'oscar/cue/cam_*/frame' --domain 45"
+    echo "demo: replay the camera images into the detectors (docs/landmarks.md); the detectors"
+    echo "run in the background and are stopped when the replay ends:"
+    echo "  build/bin/oscar-run config/landmarks-replay.yaml --module detect & detect=\$!"
+    echo "  build/bin/oscar replay $recording --topics 'oscar/cue/cam_*/frame' --domain 45; kill \$detect"
   fi
 }
 trap finish EXIT

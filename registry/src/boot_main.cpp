@@ -3,6 +3,7 @@
 // Ctrl-C (or --duration), then shuts the system down in order and leaves no process behind.
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <ctime>
@@ -52,6 +53,13 @@ std::string summary(const oscar::SystemState& s) {
     if (m.status() != "running") parts.push_back(m.name() + " " + m.status());
   }
   return parts.empty() ? std::string() : " [" + fmt::format("{}", fmt::join(parts, ", ")) + "]";
+}
+
+// While booting, one line per module that comes up (not one per launch, start and announcement).
+std::string booting_progress(const oscar::SystemState& s) {
+  const auto running = std::count_if(s.modules().begin(), s.modules().end(),
+                                     [](const auto& m) { return m.status() == "running"; });
+  return fmt::format("system booting: {} of {} modules running", running, s.modules().size());
 }
 
 // How long discovery gets to show what already runs on the domain. On the development machine a
@@ -161,7 +169,9 @@ int main(int argc, char** argv) {
     std::string last_line;
     bool booted = false;  // states before are another system's, which check_domain_free names
     oscar::RegistryClient registry(participant, "boot", [&](const oscar::SystemState& s) {
-      auto line = fmt::format("system {}: {}{}", s.state(), s.message(), summary(s));
+      auto line = s.state() == "booting"
+                      ? booting_progress(s)
+                      : fmt::format("system {}: {}{}", s.state(), s.message(), summary(s));
       std::lock_guard lock(last_line_mutex);
       if (booted && line != last_line) {
         log.note("registry", line, s.state() == "suspended" ? oscar::LOG_WARN : oscar::LOG_INFO);

@@ -200,7 +200,7 @@ TEST_F(Inspect, GraphShowsModulesKernelsChannelsAndWiring) {
   EXPECT_THAT(dot, HasSubstr("\"k:sig\" -> \"c:sig/out\""));
   EXPECT_THAT(dot, HasSubstr("\"c:sig/out\" -> \"k:sig_relay\" [label=\"in\"]"));
   EXPECT_THAT(dot, HasSubstr("\"c:sig_relay/out\" -> \"k:sig_sink\" [label=\"in\"]"));
-  EXPECT_THAT(dot, HasSubstr("label=\"out\\noscar::GvImage\""));
+  EXPECT_THAT(dot, HasSubstr("label=\"cam/out\\noscar::GvImage\"")) << "kernel/channel";
   EXPECT_THAT(dot, HasSubstr("sig\\n(bench_source)\\ncontinuous 20ms"));
   const auto svg = test::temp_path("graph") + ".svg";
   EXPECT_THAT(run({"oscar-graph", "-d", domain(), "-o", svg}), HasSubstr("wrote " + svg));

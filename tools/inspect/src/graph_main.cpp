@@ -79,7 +79,7 @@ std::string to_dot(const oscar::SystemState& s,
     const auto w = writers.find("oscar/cue/" + c);
     const auto type = w == writers.end() ? std::string("?") : w->second.type;
     dot += fmt::format("  {} [shape=ellipse, label={}];\n", quoted("c:" + c),
-                       quoted(c.substr(c.find('/') + 1) + "\\n" + type));
+                       quoted(c + "\\n" + type));  // "kernel/channel": many are named "out"
     const auto producer = c.substr(0, c.find('/'));
     if (kernels.count(producer)) {
       dot += fmt::format("  {} -> {};\n", quoted("k:" + producer), quoted("c:" + c));
