@@ -9,6 +9,13 @@ install(TARGETS oscar_types oscar_framework oscar_run_main oscar_testing oscar_c
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/framework/include/oscar DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(EXPORT oscarTargets NAMESPACE oscar:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/oscar)
+# The build tree is a package as well: -DCMAKE_PREFIX_PATH=<this build folder> finds it without
+# an install (its targets point into the source and build trees).
+export(EXPORT oscarTargets NAMESPACE oscar:: FILE ${PROJECT_BINARY_DIR}/oscarTargets.cmake)
+configure_file(${PROJECT_SOURCE_DIR}/cmake/OscarIdl.cmake ${PROJECT_BINARY_DIR}/OscarIdl.cmake
+  COPYONLY)
+configure_file(${PROJECT_SOURCE_DIR}/cmake/OscarModule.cmake ${PROJECT_BINARY_DIR}/OscarModule.cmake
+  COPYONLY)
 
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/oscarConfig.cmake.in
   ${PROJECT_BINARY_DIR}/oscarConfig.cmake

@@ -133,6 +133,51 @@ std::vector<std::string> available_kernel_types(const std::vector<std::string>& 
   return types;
 }
 
+std::vector<std::string> with_plugins(const std::vector<std::string>& plugins,
+                                      std::vector<std::string> search_path) {
+  std::vector<std::string> folders;
+  for (const auto& p : plugins) {
+    if (std::filesystem::is_directory(p)) {
+      folders.push_back(p);
+    } else {
+      load_plugin(p);
+    }
+  }
+  search_path.insert(search_path.begin(), folders.begin(), folders.end());
+  return search_path;
+}
+
+namespace {
+// Edits (insert, delete, replace) that turn `a` into `b`.
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const auto above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// " (did you mean 'x'?)" for the known type nearest to `type`, if one is near enough to be a typo.
+std::string did_you_mean(const std::string& type, const std::vector<std::string>& known) {
+  std::string best;
+  std::size_t best_distance = std::max<std::size_t>(2, type.size() / 3) + 1;
+  for (const auto& k : known) {
+    if (const auto d = edit_distance(type, k); d < best_distance) {
+      best = k;
+      best_distance = d;
+    }
+  }
+  return best.empty() ? "" : fmt::format(" (did you mean '{}'?)", best);
+}
+}  // namespace
+
 std::vector<std::string> load_plugin(const std::string& path) {
   const auto before = kernel_type_names();
   // RTLD_GLOBAL: kernels of one module may share cue types defined in another plugin.
@@ -165,9 +210,12 @@ const KernelTypeInfo& load_kernel_type(const std::string& type,
                     candidate.string(), type,
                     added.empty() ? "nothing" : fmt::format("{}", fmt::join(added, ", "))));
   }
+  const auto known = available_kernel_types(search_path);
   throw std::runtime_error(fmt::format(
-      "unknown kernel type '{}': no plugin {} in [{}] (set OSCAR_PLUGIN_PATH); known types: {}",
-      type, file, fmt::join(search_path, ", "), fmt::join(kernel_type_names(), ", ")));
+      "unknown kernel type '{}'{}: no plugin {} in [{}]; types that can be loaded: {} (a plugin "
+      "elsewhere: name it or its folder under the system file's plugins:, or in "
+      "OSCAR_PLUGIN_PATH)",
+      type, did_you_mean(type, known), file, fmt::join(search_path, ", "), fmt::join(known, ", ")));
 }
 
 }  // namespace oscar

@@ -45,10 +45,17 @@ Module::Module(ModuleSpec spec, const std::vector<std::string>& plugin_path)
     return logger;
   };
   log_ = make_logger(spec_.name);
+  const auto search_path = [&] {
+    try {
+      return with_plugins(spec_.plugins, plugin_path);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(fmt::format("{}: plugins: {}", spec_.where, e.what()));
+    }
+  }();
   for (const auto& k : spec_.kernels) {
     const auto& type = [&]() -> const KernelTypeInfo& {
       try {
-        return load_kernel_type(k.type, plugin_path);
+        return load_kernel_type(k.type, search_path);
       } catch (const std::exception& e) {
         throw std::runtime_error(fmt::format("{}: kernel '{}': {}", k.where, k.name, e.what()));
       }

@@ -1,6 +1,7 @@
 #include "oscar/module_spec.hpp"
 
 #include <algorithm>
+#include <filesystem>
 #include <set>
 #include <stdexcept>
 
@@ -253,7 +254,7 @@ ModuleSpec ModuleSpec::from_yaml(const YAML::Node& node, const std::string& file
   if (!node || !node.IsMap()) fail(file, "a module must be a map with name and kernels");
   check_yaml_keys(node, file, "module",
                   {"name", "host", "domain", "kernels", "mode", "stub", "network", "restart",
-                   "debug", "watchdog", "standby", "on_kernel_error"});
+                   "debug", "watchdog", "standby", "on_kernel_error", "plugins"});
   ModuleSpec m;
   m.where = yaml_where(file, node);
   m.name = scalar(node["name"], m.where, "module name");
@@ -300,6 +301,7 @@ ModuleSpec ModuleSpec::from_yaml(const YAML::Node& node, const std::string& file
       fail(yaml_where(file, node["on_kernel_error"]), std::string("on_kernel_error: ") + e.what());
     }
   }
+  m.plugins = plugins_of(node, file);
   try {
     m.network = NetworkConfig::from_yaml(node["network"]);
   } catch (const std::invalid_argument& e) {
@@ -320,6 +322,8 @@ ModuleSpec ModuleSpec::load(const std::string& path, const std::string& module) 
         auto spec = from_yaml(m, path);
         if (!spec.domain && root["domain"]) spec.domain = root["domain"].as<int>();
         if (!m["network"]) spec.network = NetworkConfig::for_host(root, spec.host);
+        const auto system_plugins = plugins_of(root, path);
+        spec.plugins.insert(spec.plugins.begin(), system_plugins.begin(), system_plugins.end());
         if (root["lease"]) {
           spec.lease = std::chrono::duration_cast<std::chrono::milliseconds>(
               parse_duration(root["lease"].as<std::string>()));
@@ -334,6 +338,35 @@ ModuleSpec ModuleSpec::load(const std::string& path, const std::string& module) 
                                             fmt::join(names, ", ")));
   }
   return from_yaml(root, path);
+}
+
+std::vector<std::string> ModuleSpec::plugins_of(const YAML::Node& root, const std::string& file) {
+  const auto node = root["plugins"];
+  if (!node) return {};
+  const auto where = yaml_where(file, node);
+  std::vector<std::string> texts;
+  if (node.IsScalar()) {
+    texts.push_back(node.Scalar());
+  } else if (node.IsSequence()) {
+    for (const auto& p : node) {
+      if (!p.IsScalar()) fail(yaml_where(file, p), "plugins: each entry is a path");
+      texts.push_back(p.Scalar());
+    }
+  } else {
+    fail(where, "plugins: expected a path or a list of paths (plugin files or folders of them)");
+  }
+  const auto base = std::filesystem::absolute(file).parent_path();
+  std::vector<std::string> out;
+  for (const auto& text : texts) {
+    const auto path = (base / text).lexically_normal();  // an absolute `text` stays as it is
+    if (!std::filesystem::exists(path)) {
+      fail(where, fmt::format("plugins: '{}' does not exist (a plugin liboscar_kernel_<type>.so "
+                              "or a folder of them; relative paths start at the file's folder)",
+                              path.string()));
+    }
+    out.push_back(path.string());
+  }
+  return out;
 }
 
 const KernelSpec* ModuleSpec::find_kernel(const std::string& kernel_name) const {

@@ -395,6 +395,18 @@ TEST(ModuleBadInput, DuplicateKernelNames) {
       ThrowsMessage<std::invalid_argument>(HasSubstr("duplicate kernel name 'a'")));
 }
 
+TEST(ModuleBadInput, AMisspeltKernelTypeGetsTheClosestLoadableTypeAndTheListOfAll) {
+  const auto path = plugin_search_path();  // the build's plugin folder: relay, logger, ...
+  EXPECT_THAT([&] { Module m(spec("{name: u, kernels: [{type: test_colect}]}"), path); },
+              ThrowsMessage<std::runtime_error>(testing::AllOf(
+                  HasSubstr("unknown kernel type 'test_colect' (did you mean 'test_collect'?)"),
+                  testing::ContainsRegex("types that can be loaded: .*relay.*test_collect"),
+                  HasSubstr("plugins:"), HasSubstr("OSCAR_PLUGIN_PATH"))));
+  EXPECT_THAT([&] { Module m(spec("{name: u, kernels: [{type: gripper}]}"), path); },
+              ThrowsMessage<std::runtime_error>(testing::Not(HasSubstr("did you mean"))))
+      << "no suggestion when nothing is near";
+}
+
 TEST(ModuleBadInput, UnknownKernelTypeNamesTheSearchPath) {
   EXPECT_THAT([] { Module m(spec("{name: u, kernels: [{type: no_such_type}]}"), {"/nowhere"}); },
               ThrowsMessage<std::runtime_error>(

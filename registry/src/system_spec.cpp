@@ -164,7 +164,8 @@ SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
   s.root = root;
   if (!root.IsMap()) fail(file, "a system file is a map with system, hosts and modules");
   check_yaml_keys(root, file, "system file",
-                  {"system", "domain", "hosts", "modules", "network", "lease"});
+                  {"system", "domain", "hosts", "modules", "network", "lease", "plugins"});
+  const auto plugins = ModuleSpec::plugins_of(root, file);
   s.name = root["system"] ? root["system"].as<std::string>() : "system";
   if (root["domain"]) {
     s.domain = root["domain"].as<int>();
@@ -206,6 +207,7 @@ SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
     if (!m.spec.domain) m.spec.domain = s.domain;
     if (!node["network"]) m.spec.network = NetworkConfig::for_host(root, m.spec.host);
     m.spec.lease = s.lease;
+    m.spec.plugins.insert(m.spec.plugins.begin(), plugins.begin(), plugins.end());
     m.restart = parse_restart(node["restart"], file, what + ".restart");
     m.debug = parse_debug(node["debug"], file, what + ".debug");
     m.standby = node["standby"] && node["standby"].as<bool>();

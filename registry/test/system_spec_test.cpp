@@ -1,5 +1,9 @@
 #include "oscar/registry/system_spec.hpp"
 
+#include <unistd.h>
+
+#include <filesystem>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -159,6 +163,39 @@ TEST(SystemSpec, CheckModulesRejectsAnUnknownKernelType) {
   } catch (const std::exception& e) {
     EXPECT_THAT(e.what(), HasSubstr("no_such_kernel"));
   }
+}
+
+// A plugin outside every default folder, named by the system file (relative to its folder) as a
+// folder or as a file: boot --check and oscar-run (Module) find it with no OSCAR_PLUGIN_PATH.
+TEST(SystemSpec, PluginsNamedByTheSystemFileAreFoundRelativeToIt) {
+  register_standard_cue_types();
+  std::string relay;
+  for (const auto& dir : plugin_search_path()) {
+    if (std::filesystem::exists(dir + "/liboscar_kernel_relay.so")) relay = dir;
+  }
+  ASSERT_FALSE(relay.empty()) << "the build's relay plugin";
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("oscar_plugins_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir / "mine");
+  std::filesystem::copy_file(relay + "/liboscar_kernel_relay.so",
+                             dir / "mine" / "liboscar_kernel_relay.so");
+  for (const auto* plugins : {"mine", "[mine/liboscar_kernel_relay.so]"}) {
+    const auto s = SystemSpec::parse(
+        YAML::Load(std::string("plugins: ") + plugins +
+                   "\nmodules: [ { name: m, kernels: [ { type: relay, name: r, params: { type: "
+                   "Bool } } ] } ]"),
+        (dir / "system.yaml").string());
+    EXPECT_EQ(s.modules[0].spec.plugins.front().rfind((dir / "mine").string(), 0), 0u) << plugins;
+    EXPECT_NO_THROW(s.check_modules({})) << "only the file's plugins: to search";
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(SystemSpec, APluginPathThatDoesNotExistIsAnErrorWithItsLine) {
+  EXPECT_THAT(
+      error_of("system: t\nplugins: [nowhere]\nmodules: [ { name: m, kernels: [ { type: "
+               "relay, name: r } ] } ]"),
+      testing::AllOf(HasSubstr("s.yaml:2: plugins: '"), HasSubstr("/nowhere' does not exist")));
 }
 
 TEST(SystemSpec, CheckModulesRefusesAReliableInputReadingABestEffortOutputOfAnotherModule) {

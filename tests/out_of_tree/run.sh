@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Proves find_package(oscar): installs this build into a temporary prefix, builds the module in
 # tests/out_of_tree/module against it, runs its unit test, and loads its plugin with the
-# installed oscar-run.
+# installed oscar-run; then builds and tests the same module against the build tree itself
+# (-DCMAKE_PREFIX_PATH=<build folder>, no install).
 set -euo pipefail
 build_dir="$1"
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -19,3 +20,9 @@ echo "$types" | grep -qx blinker || { echo "the out-of-tree plugin was not loade
 check="$("$work/build/bin/oscar-module-blinker" --name b -k blinker:b -m continuous:10ms --check)"
 echo "stand-alone runner: $check"
 [ "$check" = "b (blinker): continuous" ] || { echo "unexpected --check output"; exit 1; }
+
+cmake -S "$here/module" -B "$work/build-tree" -G Ninja -DCMAKE_PREFIX_PATH="$build_dir" \
+  -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$work/build-tree" -j2 >/dev/null
+ctest --test-dir "$work/build-tree" --output-on-failure
+echo "built and tested against the build tree: $build_dir"

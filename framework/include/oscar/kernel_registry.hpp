@@ -23,11 +23,18 @@ std::vector<std::string> kernel_type_names();
 /// `<dir of this program>/../lib/oscar/plugins` and `<dir of this program>/../lib`.
 std::vector<std::string> plugin_search_path();
 
+/// The search path of a module whose file names `plugins` (files and folders, ModuleSpec::plugins):
+/// its folders before `search_path`; the plugin files it names are loaded at once.
+/// @throws std::runtime_error as load_plugin() does.
+std::vector<std::string> with_plugins(const std::vector<std::string>& plugins,
+                                      std::vector<std::string> search_path);
+
 /// The kernel type, loading its plugin (`liboscar_kernel_<type>.so`) from the search path if it
 /// is not registered yet.
-/// @throws std::runtime_error naming the type and the folders searched if no plugin is found,
-///         with the loader's message if the plugin fails to load, and if the plugin loads but
-///         does not register the type.
+/// @throws std::runtime_error naming the type, the folders searched and every type that can be
+///         loaded (with the closest to a misspelt name) if no plugin is found, with the loader's
+///         message if the plugin fails to load, and if the plugin loads but does not register
+///         the type.
 const KernelTypeInfo& load_kernel_type(const std::string& type,
                                        const std::vector<std::string>& search_path);
 

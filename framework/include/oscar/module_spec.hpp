@@ -88,6 +88,9 @@ struct ModuleSpec {
   std::chrono::milliseconds watchdog{2000};
   /// What a kernel that keeps throwing leads to (default: restart the module after 3).
   KernelErrorPolicy on_kernel_error;
+  /// Plugin files and folders of plugins the file names (`plugins:`), absolute: searched before
+  /// $OSCAR_PLUGIN_PATH (with_plugins()).
+  std::vector<std::string> plugins;
 
   /// Parses one module map. `file` names the source in messages ("file:line: ...").
   /// @throws std::invalid_argument for unknown keys, missing names, duplicate kernel names,
@@ -98,6 +101,10 @@ struct ModuleSpec {
   static ModuleSpec load(const std::string& path, const std::string& module = "");
 
   const KernelSpec* find_kernel(const std::string& kernel_name) const;
+
+  /// The `plugins:` key of a system or module file: one path or a list, relative to the file's
+  /// folder; each must exist. @throws std::invalid_argument "file:line: plugins: ...".
+  static std::vector<std::string> plugins_of(const YAML::Node& root, const std::string& file);
   /// Applies what a running incarnation had been configured to (the registry passes it to a
   /// restarted module): `{kernel: {mode: M, stub: B, params: {..}, inputs: {in: k/ch}}}`.
   /// @throws std::invalid_argument naming the kernel and key.

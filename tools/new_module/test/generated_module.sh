@@ -1,13 +1,19 @@
 #!/usr/bin/env bash
-# Generates a module with two inputs, an output and two params with the installed
-# oscar-new-module; builds it out of tree against an install of this build (find_package(oscar));
-# runs its unit test; boots a system that feeds it and echoes its output with oscar echo.
+# The walkthrough of docs/tutorial.md, step by step: generates a module with two inputs, an
+# output and two params with the installed oscar-new-module; builds it out of tree against an
+# install of this build (find_package(oscar)); runs its unit test; boots a system that names its
+# plugin folder under plugins: and feeds it; inspects it (oscar ps, oscar echo); records every
+# cue; then boots the module alone and replays the recorded inputs into it.
 set -euo pipefail
 build_dir="$1"
 work="$(mktemp -d)"
 boot=""
-cleanup() {
+stop_boot() {
   if [ -n "$boot" ] && kill -0 "$boot" 2>/dev/null; then kill -INT "$boot"; wait "$boot" || true; fi
+  boot=""
+}
+cleanup() {
+  stop_boot
   rm -rf "$work"
 }
 trap cleanup EXIT
@@ -38,6 +44,7 @@ domain=$(( $$ % 200 + 1 ))
 cat > system.yaml <<YAML
 system: generated
 lease: 1s
+plugins: [build/lib/oscar/plugins]   # the module's plugin, relative to this file
 modules:
   - name: sig_source
     kernels: [ { type: bench_source, name: sig, params: { type: Bool } } ]
@@ -49,10 +56,12 @@ modules:
     kernels: [ { type: fuse_pair, name: fuse, params: { gain: 2.5 }, inputs: { flag: sig/out, image: cam/out } } ]
     mode: { continuous: 50ms }
 YAML
-export OSCAR_PLUGIN_PATH="$work/build/lib/oscar/plugins"
+unset OSCAR_PLUGIN_PATH  # the system file says where the plugin is
 "$bin/oscar-boot" system.yaml --domain "$domain" --log-dir "$work/logs" --timeout 30 \
   >boot.log 2>&1 &
 boot=$!
+"$bin/oscar-record" --all -o rec.mcap --domain "$domain" >record.log 2>&1 &
+recorder=$!
 out="$(timeout 60 "$bin/oscar-echo" fuse/out -n 3 -d "$domain" --timeout 40)" ||
   fail "oscar echo: $out; boot: $(cat boot.log)"
 echo "$out"
@@ -60,7 +69,39 @@ grep -q '^--- oscar/cue/fuse/out (oscar::Bool)' <<<"$out" || fail "no sample of 
 grep -q '  source: "fuse/out"' <<<"$out" || fail "no header source"
 grep -Eq '  stamps: \[[0-9]+, [0-9]+(, [0-9]+)?\]' <<<"$out" || fail "no fused stamps"
 grep -Eq '^value: (true|false)$' <<<"$out" || fail "no value"
+ps_out="$("$bin/oscar-ps" -d "$domain")" || fail "oscar ps: $ps_out"
+echo "$ps_out"
+grep -Eq '^fuser +localhost +[0-9]+ +1 +running' <<<"$ps_out" || fail "fuser not running in oscar ps"
+sleep 1
+kill -INT "$recorder"
+wait "$recorder" || fail "oscar record exited with $?: $(cat record.log)"
 kill -INT "$boot"
 wait "$boot" || fail "boot exited with $?: $(cat boot.log)"
 boot=""
-echo "generated module: built out of tree, unit-tested, booted and echoed"
+info="$("$bin/oscar-info" rec.mcap)" || fail "oscar info: $info"
+echo "$info"
+for topic in sig/out cam/out fuse/out; do
+  grep -q "oscar/cue/$topic" <<<"$info" || fail "the recording has no oscar/cue/$topic"
+done
+
+# The module alone, fed by the recording: a module file (its inputs wired to kernels that are
+# not there; the replay publishes their topics) run by oscar-run.
+cat > fuser.yaml <<YAML
+name: fuser
+plugins: [build/lib/oscar/plugins]
+kernels: [ { type: fuse_pair, name: fuse, inputs: { flag: sig/out, image: cam/out } } ]
+mode: { continuous: 50ms }
+YAML
+"$bin/oscar-run" fuser.yaml --domain "$domain" >fuser.log 2>&1 &
+boot=$!
+timeout 60 "$bin/oscar-echo" fuse/out -n 1 -d "$domain" --timeout 30 >replayed.txt 2>&1 &
+echo_pid=$!
+sleep 1
+"$bin/oscar-replay" rec.mcap --topics 'oscar/cue/sig/out' --topics 'oscar/cue/cam/out' \
+  --domain "$domain" >replay.log 2>&1 || fail "oscar replay: $(cat replay.log)"
+wait "$echo_pid" || fail "no fuse/out from the replayed inputs: $(cat replayed.txt); $(cat fuser.log)"
+grep -q '^--- oscar/cue/fuse/out (oscar::Bool)' replayed.txt || fail "$(cat replayed.txt)"
+kill -TERM "$boot"
+wait "$boot" || fail "oscar-run exited with $?: $(cat fuser.log)"
+boot=""
+echo "generated module: built out of tree, unit-tested, booted with plugins:, inspected, recorded, replayed"
