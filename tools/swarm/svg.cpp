@@ -4,7 +4,11 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <functional>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "oscar/swarm/forbidden_regions.hpp"
 
@@ -15,6 +19,10 @@ namespace {
 constexpr std::array<const char*, 8> kColours{"#1f77b4", "#d62728", "#2ca02c", "#9467bd",
                                               "#ff7f0e", "#17becf", "#8c564b", "#e377c2"};
 
+// The plot area of both pictures: 800x820 pixels, axes on the left and at the bottom.
+constexpr double kLeft = 60, kTop = 20, kWidth = 720, kHeight = 720;
+
+// World coordinates to pixels, one scale for both axes (metres stay square), y up.
 struct Frame {
   double x0 = std::numeric_limits<double>::max(), y0 = x0, x1 = -x0, y1 = -x0;
   void add(double x, double y) {
@@ -23,9 +31,90 @@ struct Frame {
     x1 = std::max(x1, x);
     y1 = std::max(y1, y);
   }
-  double scale() const { return 760.0 / std::max({x1 - x0, y1 - y0, 1e-9}); }
-  double sx(double x) const { return 20 + (x - x0) * scale(); }
-  double sy(double y) const { return 20 + (y1 - y) * scale(); }  // y up
+  void add(const Polygon& p, double dx = 0, double dy = 0) {
+    for (const auto& v : vertices(p)) add(v.x() + dx, v.y() + dy);
+  }
+  double scale() const {
+    return std::min(kWidth / std::max(x1 - x0, 1e-9), kHeight / std::max(y1 - y0, 1e-9));
+  }
+  double sx(double x) const { return kLeft + (x - x0) * scale(); }
+  double sy(double y) const { return kTop + (y1 - y) * scale(); }
+};
+
+// A round step giving 5-16 ticks over `range`: 1, 2 or 5 times a power of ten.
+double tick_step(double range) {
+  const double raw = std::max(range, 1e-9) / 8;
+  const double power = std::pow(10.0, std::floor(std::log10(raw)));
+  for (const double m : {1.0, 2.0, 5.0}) {
+    if (m * power >= raw) return m * power;
+  }
+  return 10 * power;
+}
+
+// Axis lines with ticks and their values from `lo` to `hi`; `to_px` maps a value to pixels.
+std::string x_axis(double lo, double hi, double y_px, const std::function<double(double)>& to_px,
+                   const std::string& label) {
+  std::string out = fmt::format(
+      "<line x1=\"{:.2f}\" y1=\"{:.2f}\" x2=\"{:.2f}\" y2=\"{:.2f}\" stroke=\"#333\"/>\n",
+      to_px(lo), y_px, to_px(hi), y_px);
+  const double step = tick_step(hi - lo);
+  for (double v = std::ceil(lo / step) * step; v <= hi + step * 1e-6; v += step) {
+    out += fmt::format(
+        "<line x1=\"{0:.2f}\" y1=\"{1:.2f}\" x2=\"{0:.2f}\" y2=\"{2:.2f}\" stroke=\"#333\"/>"
+        "<text x=\"{0:.2f}\" y=\"{3:.2f}\" text-anchor=\"middle\">{4:g}</text>\n",
+        to_px(v), y_px, y_px + 5, y_px + 17, std::abs(v) < step * 1e-6 ? 0.0 : v);
+  }
+  return out + fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\" text-anchor=\"middle\">{}</text>\n",
+                           (to_px(lo) + to_px(hi)) / 2, y_px + 32, label);
+}
+
+std::string y_axis(double lo, double hi, double x_px, const std::function<double(double)>& to_px,
+                   const std::string& label) {
+  std::string out = fmt::format(
+      "<line x1=\"{:.2f}\" y1=\"{:.2f}\" x2=\"{:.2f}\" y2=\"{:.2f}\" stroke=\"#333\"/>\n", x_px,
+      to_px(lo), x_px, to_px(hi));
+  const double step = tick_step(hi - lo);
+  for (double v = std::ceil(lo / step) * step; v <= hi + step * 1e-6; v += step) {
+    out += fmt::format(
+        "<line x1=\"{0:.2f}\" y1=\"{1:.2f}\" x2=\"{2:.2f}\" y2=\"{1:.2f}\" stroke=\"#333\"/>"
+        "<text x=\"{3:.2f}\" y=\"{4:.2f}\" text-anchor=\"end\">{5:g}</text>\n",
+        x_px, to_px(v), x_px - 5, x_px - 7, to_px(v) + 4, std::abs(v) < step * 1e-6 ? 0.0 : v);
+  }
+  return out + fmt::format(
+                   "<text x=\"14\" y=\"{0:.2f}\" text-anchor=\"middle\" transform=\"rotate(-90 14 "
+                   "{0:.2f})\">{1}</text>\n",
+                   (to_px(lo) + to_px(hi)) / 2, label);
+}
+
+// Places labels where they overlap no label placed before (tries offsets around the point).
+class LabelPlacer {
+ public:
+  std::string place(double x, double y, const std::string& text, const std::string& style = "") {
+    const double w = 6.2 * static_cast<double>(text.size()), h = 12;
+    const std::pair<double, double> offsets[] = {{5, 12}, {5, -5},  {-5 - w, 12}, {-5 - w, -5},
+                                                 {5, 25}, {5, -18}, {-5 - w, 25}, {-5 - w, -18}};
+    std::pair<double, double> at = offsets[0];
+    for (const auto& o : offsets) {
+      if (free(x + o.first, y + o.second - h, w, h)) {
+        at = o;
+        break;
+      }
+    }
+    boxes_.push_back({x + at.first, y + at.second - h, w, h});
+    return fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\"{}>{}</text>\n", x + at.first, y + at.second,
+                       style, text);
+  }
+
+ private:
+  struct Box {
+    double x, y, w, h;
+  };
+  bool free(double x, double y, double w, double h) const {
+    return std::none_of(boxes_.begin(), boxes_.end(), [&](const Box& b) {
+      return x < b.x + b.w && b.x < x + w && y < b.y + b.h && b.y < y + h;
+    });
+  }
+  std::vector<Box> boxes_;
 };
 
 std::string polygon(const Frame& f, const Polygon& p, const std::string& style) {
@@ -34,30 +123,40 @@ std::string polygon(const Frame& f, const Polygon& p, const std::string& style) 
   return fmt::format("<polygon points=\"{}\" {}/>\n", pts, style);
 }
 
-std::string header(const std::string& title) {
-  return fmt::format(
+// The picture's frame with its caption (one text line per entry) below the plot.
+std::string header(const std::vector<std::string>& caption) {
+  std::string out =
       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"800\" height=\"820\" "
       "font-family=\"sans-serif\" font-size=\"11\">\n<rect width=\"800\" height=\"820\" "
-      "fill=\"white\"/>\n<text x=\"20\" y=\"814\">{}</text>\n",
-      title);
+      "fill=\"white\"/>\n";
+  double y = 820 - 6 - 14 * static_cast<double>(caption.size() - 1);
+  for (const auto& line : caption) {
+    out += fmt::format("<text x=\"20\" y=\"{:.0f}\">{}</text>\n", y, line);
+    y += 14;
+  }
+  return out;
 }
 
 }  // namespace
 
 std::string world_svg(const Scheduler& s) {
   Frame f;
-  for (const auto& p : s.world().static_obstacles) {
-    for (const auto& v : vertices(p)) f.add(v.x(), v.y());
-  }
+  for (const auto& p : s.world().static_obstacles) f.add(p);
   for (const auto& o : s.world().dynamic_obstacles) {
-    for (const auto& w : o.trajectory.points()) f.add(w.x, w.y);
+    for (const auto& w : o.trajectory.points()) f.add(o.shape, w.x, w.y);  // the whole shape
   }
   for (const auto& id : s.node_ids()) {
     for (const auto& w : s.trajectory(id).points()) f.add(w.x, w.y);
   }
   std::string out = header(
-      "oscar swarm plan: static (grey), moving obstacles (orange, dashed), "
-      "node paths (colour), jobs (dots)");
+      {"oscar swarm plan: static obstacles (grey), moving obstacles at their start and their path "
+       "(orange, dashed),",
+       "node paths (colour, labelled at their start), jobs (dots: id @ start time in s)"});
+  out += x_axis(
+      f.x0, f.x1, f.sy(f.y0) + 8, [&](double x) { return f.sx(x); }, "x [m]");
+  out += y_axis(
+      f.y0, f.y1, f.sx(f.x0) - 8, [&](double y) { return f.sy(y); }, "y [m]");
+  LabelPlacer labels;
   for (const auto& p : s.world().static_obstacles)
     out += polygon(f, p, "fill=\"#bbb\" stroke=\"#666\"");
   for (const auto& o : s.world().dynamic_obstacles) {
@@ -78,13 +177,11 @@ std::string world_svg(const Scheduler& s) {
     out += fmt::format("<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"2\"/>\n",
                        line, colour);
     const auto& start = s.trajectory(id).points().front();
-    out += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\" fill=\"{}\">{}</text>\n", f.sx(start.x) + 4,
-                       f.sy(start.y) - 4, colour, id);
+    out += labels.place(f.sx(start.x), f.sy(start.y), id, fmt::format(" fill=\"{}\"", colour));
     for (const auto& j : s.jobs(id)) {
       out += fmt::format("<circle cx=\"{:.2f}\" cy=\"{:.2f}\" r=\"4\" fill=\"{}\"/>\n", f.sx(j.x),
                          f.sy(j.y), colour);
-      out += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\">{} @{:.1f}</text>\n", f.sx(j.x) + 5,
-                         f.sy(j.y) + 12, j.id, j.start);
+      out += labels.place(f.sx(j.x), f.sy(j.y), fmt::format("{} @{:.1f}", j.id, j.start));
     }
   }
   return out + "</svg>\n";
@@ -124,14 +221,16 @@ std::string st_svg(const Scheduler& s, const std::string& node) {
   f.add(0, traj.start_time());
   f.add(std::max(arc, 1e-3), t_end);
   // s horizontally, t vertically; scale axes independently.
-  const double kx = 760.0 / std::max(f.x1 - f.x0, 1e-9);
-  const double ky = 760.0 / std::max(f.y1 - f.y0, 1e-9);
-  auto X = [&](double v) { return 20 + (v - f.x0) * kx; };
-  auto Y = [&](double v) { return 780 - (v - f.y0) * ky; };
+  const double kx = kWidth / std::max(f.x1 - f.x0, 1e-9);
+  const double ky = kHeight / std::max(f.y1 - f.y0, 1e-9);
+  auto X = [&](double v) { return kLeft + (v - f.x0) * kx; };
+  auto Y = [&](double v) { return kTop + kHeight - (v - f.y0) * ky; };
   std::string out =
-      header(fmt::format("s-t diagram of {}: s 0..{:.2f} m (right), t {:.1f}..{:.1f} s (up); "
-                         "forbidden regions grey, profile red",
-                         node, arc, f.y0, f.y1));
+      header({fmt::format("s-t diagram of {}: forbidden regions of the other nodes and "
+                          "moving obstacles on its path (grey), its profile (red)",
+                          node)});
+  out += x_axis(f.x0, f.x1, Y(f.y0) + 8, X, "s along the path [m]");
+  out += y_axis(f.y0, f.y1, X(f.x0) - 8, Y, "t [s]");
   for (const auto& r : regions) {
     std::string pts;
     for (const auto& v : vertices(r)) pts += fmt::format("{:.2f},{:.2f} ", X(v.x()), Y(v.y()));

@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <stdexcept>
+#include <utility>
 
 namespace oscar::applets {
 namespace {
@@ -33,6 +34,40 @@ std::string priority_name(int p) {
     default:
       return std::to_string(p);
   }
+}
+
+// What the colours and edges mean, in a box of its own.
+std::string legend() {
+  std::string out =
+      "  subgraph cluster_legend {\n    label=\"legend\";\n    fontname=\"Helvetica\";\n"
+      "    node [shape=box, style=filled, fontsize=10];\n";
+  const std::pair<const char*, const char*> bundles[] = {
+      {"active", "palegreen"},
+      {"granted, waiting for hand-over", "khaki"},
+      {"blocked", "lightgrey"},
+      {"being revoked", "orange"},
+      {"idle", "white"}};
+  std::string previous;
+  for (const auto& [state, colour] : bundles) {
+    const auto id = quote(std::string("legend:") + state);
+    out += "    " + id + " [fillcolor=" + colour +
+           ", label=" + quote(std::string("bundle ") + state) + "];\n";
+    if (!previous.empty()) out += "    " + previous + " -> " + id + " [style=invis];\n";
+    previous = id;
+  }
+  out += "    \"legend:service\" [shape=ellipse, fillcolor=lightblue, label=\"service in use\"];\n";
+  const std::pair<const char*, const char*> edges[] = {
+      {"exclusive, granted", "color=red"},
+      {"shared, granted", "color=blue"},
+      {"requested, not granted", "color=grey"},
+      {"provides (from a service applet)", "color=darkgreen, dir=back"},
+      {"needs (a service's dependency)", "style=dashed"}};
+  for (const auto& [meaning, colour] : edges) {
+    const auto from = quote(std::string("legend:from ") + meaning);
+    out += "    " + from + " [shape=point, width=0.05];\n    " + from + " -> \"legend:service\" [" +
+           colour + ", label=" + quote(meaning) + ", fontsize=10];\n";
+  }
+  return out + "  }\n";
 }
 
 }  // namespace
@@ -96,7 +131,7 @@ std::string to_dot(const Scheduler& s) {
       }
     }
   }
-  return out + "}\n";
+  return out + legend() + "}\n";
 }
 
 bool write_picture(const Scheduler& s, const std::string& path) {

@@ -33,6 +33,22 @@ timeline:
   EXPECT_THAT(dot, HasSubstr(R"("s:Dock" -> "s:Pilot" [style=dashed, label="needs exclusive"])"));
   EXPECT_THAT(dot, HasSubstr(R"(label="UI\n(exclusive only)\nblocked")"));
   EXPECT_THAT(dot, HasSubstr(R"("b:Battery/d" -> "s:Dock" [color=red)"));
+  // The legend names every colour the picture uses.
+  EXPECT_THAT(dot, HasSubstr("subgraph cluster_legend"));
+  for (const auto* entry :
+       {R"([fillcolor=palegreen, label="bundle active"])",
+        R"([fillcolor=khaki, label="bundle granted, waiting for hand-over"])",
+        R"([fillcolor=lightgrey, label="bundle blocked"])",
+        R"([fillcolor=orange, label="bundle being revoked"])",
+        R"([fillcolor=white, label="bundle idle"])",
+        R"(fillcolor=lightblue, label="service in use")",
+        R"([color=red, label="exclusive, granted")",
+        R"x([color=darkgreen, dir=back, label="provides (from a service applet)")x",
+        R"x([style=dashed, label="needs (a service's dependency)")x",
+        R"([color=blue, label="shared, granted")",
+        R"([color=grey, label="requested, not granted")"}) {
+    EXPECT_THAT(dot, HasSubstr(entry));
+  }
 }
 
 TEST(Dot, ShowsABundleBeingRevokedAndAnInheritedActiveOne) {
