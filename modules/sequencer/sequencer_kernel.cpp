@@ -186,7 +186,10 @@ void Sequencer::process(Cycle& cycle) {
         cycle.log().info("first sequence still running (finding its modules): cycles wait for it");
       }
     } else if (++skipped_ == 1 || skipped_ % 100 == 0) {
-      cycle.log().warn("previous sequence still running: cycle skipped ({} so far)", skipped_);
+      cycle.log().warn(
+          "previous sequence still running: cycle skipped ({} so far; its modules took longer "
+          "than a cycle to answer)",
+          skipped_);
     }
     return;
   }

@@ -215,7 +215,9 @@ int main(int argc, char** argv) {
     bool registry_gone = false;
     const auto registry_exited = [&] {
       for (const auto& x : children.reap()) {
-        if (x.exit_code != 0 || !state_is("stopped")) {
+        // Code 0 is an orderly end (oscar shutdown, SIGTERM), also when its 'stopped' state
+        // has not reached boot yet.
+        if (x.exit_code != 0) {
           log.note("boot", fmt::format("{} {}", x.module, x.describe()), oscar::LOG_ERROR);
         }
         registry_gone = registry_gone || x.module == "registry";

@@ -104,6 +104,8 @@ TEST(Boot, RefusesADomainWhereASystemRunsAndLeavesThatSystemAlone) {
   EXPECT_EQ(pids(after), pids(before)) << "the running system's modules were touched";
   for (const auto& m : after.modules()) EXPECT_EQ(m.incarnation(), 1u) << m.name();
   EXPECT_EQ(first.shut_down(), 0) << first.boot().output();
+  EXPECT_THAT(first.boot().output(), testing::Not(HasSubstr(" error ")))
+      << "Ctrl-C's orderly shutdown is no error";
 }
 
 TEST(Boot, ExitsWhenTheSystemIsShutDownFromAnotherTerminal) {
@@ -116,6 +118,8 @@ TEST(Boot, ExitsWhenTheSystemIsShutDownFromAnotherTerminal) {
   EXPECT_EQ(sys.boot().wait(20s), 0) << sys.boot().output();
   EXPECT_THAT(sys.boot().output(), HasSubstr("the system was shut down (oscar shutdown)"));
   EXPECT_THAT(sys.boot().output(), HasSubstr("all processes stopped"));
+  EXPECT_THAT(sys.boot().output(), testing::Not(HasSubstr(" error ")))
+      << "an orderly shutdown is no error";
   for (const auto pid : pids(s)) EXPECT_FALSE(test::alive(pid)) << "module pid " << pid;
   EXPECT_TRUE(test::processes_mentioning(sys.file()).empty()) << "a process of the system is left";
 }
