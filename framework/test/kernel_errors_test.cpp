@@ -7,6 +7,7 @@
 #include <spdlog/sinks/ringbuffer_sink.h>
 
 #include "oscar/module.hpp"
+#include "oscar/testing/eventually.hpp"
 #include "repeat_filter_sink.hpp"
 #include "test_kernels.hpp"
 
@@ -30,15 +31,6 @@ kernels: [ {{ type: test_failing, name: cam, params: {{ {} }} }} ]
 }
 
 KernelState cam(const Module& m) { return m.state().kernels().at(0); }
-
-bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds limit = 5s) {
-  const auto until = std::chrono::steady_clock::now() + limit;
-  while (!condition()) {
-    if (std::chrono::steady_clock::now() > until) return false;
-    std::this_thread::sleep_for(1ms);
-  }
-  return true;
-}
 
 TEST(KernelErrors, ContinueCountsEveryFailureAndKeepsCallingTheKernel) {
   auto m = module_with("{ action: continue, after: 1 }");

@@ -8,6 +8,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "oscar/testing/eventually.hpp"
 #include "test_kernels.hpp"
 
 namespace oscar {
@@ -23,15 +24,6 @@ ModuleSpec spec(const std::string& yaml) {
 template <class K>
 K& kernel_of(Module& m, const std::string& name) {
   return dynamic_cast<K&>(m.kernel(name).kernel());
-}
-
-bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds limit = 5s) {
-  const auto until = std::chrono::steady_clock::now() + limit;
-  while (!condition()) {
-    if (std::chrono::steady_clock::now() > until) return false;
-    std::this_thread::sleep_for(1ms);
-  }
-  return true;
 }
 
 ConfigCommand command(CommandKind kind, std::vector<std::string> args,

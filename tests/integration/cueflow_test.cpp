@@ -13,6 +13,7 @@
 #include "oscar/topic_io.hpp"
 
 #include <oscar/configPubSubTypes.h>
+#include "oscar/testing/eventually.hpp"
 #include "process.hpp"  // tests/common
 #include "test_kernels.hpp"
 
@@ -21,15 +22,6 @@ namespace {
 using namespace std::chrono_literals;
 using test::Process;
 using testing::HasSubstr;
-
-bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds limit = 10s) {
-  const auto until = std::chrono::steady_clock::now() + limit;
-  while (!condition()) {
-    if (std::chrono::steady_clock::now() > until) return false;
-    std::this_thread::sleep_for(2ms);
-  }
-  return true;
-}
 
 std::string temp(const std::string& name) {
   return (std::filesystem::temp_directory_path() / (name + "_" + std::to_string(getpid())))

@@ -16,6 +16,7 @@
 #include "oscar/dds_participant.hpp"
 #include "oscar/mcap/reader.hpp"
 #include "oscar/mcap/writer.hpp"
+#include "oscar/testing/eventually.hpp"
 #include "process.hpp"  // tests/common
 
 namespace oscar {
@@ -28,15 +29,6 @@ using testing::HasSubstr;
 std::string temp(const std::string& name) {
   return (std::filesystem::temp_directory_path() / (name + "_" + std::to_string(getpid())))
       .string();
-}
-
-bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds limit = 10s) {
-  const auto until = std::chrono::steady_clock::now() + limit;
-  while (!condition()) {
-    if (std::chrono::steady_clock::now() > until) return false;
-    std::this_thread::sleep_for(10ms);
-  }
-  return true;
 }
 
 std::unique_ptr<Process> source(const std::string& name, const std::string& type, int count,

@@ -16,6 +16,7 @@
 #include "oscar/cue_type_info.hpp"
 #include "oscar/cue_types.hpp"
 #include "oscar/mcap/reader.hpp"
+#include "oscar/testing/eventually.hpp"
 #include "raw_tap.hpp"  // tools/inspect
 
 namespace oscar {
@@ -30,15 +31,6 @@ struct Message {
   std::vector<std::uint8_t> bytes;
   std::uint64_t seq;
 };
-
-bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds limit) {
-  const auto until = std::chrono::steady_clock::now() + limit;
-  while (!condition()) {
-    if (std::chrono::steady_clock::now() > until) return false;
-    std::this_thread::sleep_for(20ms);
-  }
-  return true;
-}
 
 // The header fields a consumer sees, decoded with the compiled type.
 std::string header_text(const std::string& topic, const std::vector<std::uint8_t>& bytes) {
@@ -78,7 +70,7 @@ modules:
                out.find("oscar/cue/lines/out") != std::string::npos &&
                out.find("oscar/cue/img/out") != std::string::npos;
       },
-      15s))
+      15s, 20ms))
       << rec.output();
   std::this_thread::sleep_for(1s);
   for (const auto* k : {"flag", "lines", "img"}) {
@@ -119,7 +111,7 @@ modules:
         for (const auto& [topic, m] : recorded) n += tap.subscribe(topic).empty() ? 0 : 1;
         return n == recorded.size();
       },
-      10s))
+      10s, 20ms))
       << replay.output();
   ASSERT_EQ(replay.wait(60s), 0) << replay.output();
   std::this_thread::sleep_for(500ms);

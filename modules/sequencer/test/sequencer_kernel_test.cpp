@@ -11,6 +11,7 @@
 #include <oscar/perception_types.hpp>
 #include <oscar/testing/conformance.hpp>
 
+#include <oscar/testing/eventually.hpp>
 #include "../sequencer_kernel.hpp"
 
 namespace oscar {
@@ -47,12 +48,6 @@ mode: { single_step: { trigger: command } }
     }
     return "";
   }
-  template <class Pred>
-  bool eventually(Pred pred) {
-    for (int i = 0; i < 300 && !pred(); ++i) std::this_thread::sleep_for(10ms);
-    return pred();
-  }
-
   // Commands go out asynchronously: a failure is reported by a later cycle.
   static std::string first_error(KernelHarness& seq) {
     for (int i = 0; i < 100; ++i) {

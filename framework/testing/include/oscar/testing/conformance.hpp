@@ -1,5 +1,5 @@
 #pragma once
-/// @file The conformance suite every kernel passes (STYLE.md, tests): construction has no side
+/// @file The conformance suite every kernel passes (docs/kernels.md): construction has no side
 /// effects, port names are unique, stub() writes every output, process() survives empty
 /// inputs, and parameters round-trip through YAML.
 
