@@ -146,6 +146,7 @@ void Sequencer::worker_loop(const std::string& module) {
       error = e.what();
     }
     lock.lock();
+    if (stop_) break;  // on_deactivate() emptied the queue while the command was on its way
     queue.pop_front();
     if (!error.empty()) {
       worker_error_ =
