@@ -274,6 +274,17 @@ TEST(Tools, FindTheSystemBootedOnThisMachineWithoutFlagsAndAskWhenThereAreSevera
   one.running();
   ASSERT_EQ(ps(output), 0) << output;
   EXPECT_EQ(nlohmann::json::parse(output)["system"], "found");
+  {
+    // oscar record finds it too (it defaulted to domain 0).
+    const auto file = test::temp_path("found") + ".mcap";
+    test::Process record({test::bin("oscar-record"), "--all", "-o", file},
+                         test::temp_path("found_record.log"));
+    std::this_thread::sleep_for(1500ms);
+    kill(record.pid(), SIGINT);
+    EXPECT_EQ(record.wait(20s), 0) << record.output();
+    EXPECT_THAT(record.output(), testing::ContainsRegex("received [1-9][0-9]*")) << record.output();
+    std::filesystem::remove(file);
+  }
   const auto other_domain = std::to_string(1 + (test::test_domain() + 100) % 200);
   BootedSystem two("found_too", two_sources("found_too"), other_domain);
   for (int i = 0; i < 500 && running_systems().size() < 2; ++i) std::this_thread::sleep_for(10ms);
