@@ -8,6 +8,7 @@
 
 #include <oscar/config_client.hpp>
 #include <oscar/registry/registry_client.hpp>
+#include <oscar/registry/system_options.hpp>
 #include <oscar/time.hpp>
 
 int main(int argc, char** argv) {
@@ -19,18 +20,15 @@ int main(int argc, char** argv) {
       "suspend, resume, stub KERNEL|* on|off, shutdown.\n"
       "Only the coordinator configures modules: an operator acts with its authority only with\n"
       "--as coordinator."};
-  std::string module, command, as = "operator", system_file, host;
+  std::string module, command, as = "operator";
+  oscar::SystemOptions tool;
   std::vector<std::string> args;
-  int domain = -1, timeout_ms = 3000;
+  int timeout_ms = 3000;
   app.add_option("module", module, "target module")->required();
   app.add_option("command", command, "command kind")->required();
   app.add_option("args", args, "command arguments");
   app.add_option("--as", as, "sender authority: coordinator, registry, boot (default: operator)");
-  app.add_option("--system", system_file, "system file (its domain and network)");
-  app.add_option("--host", host, "the host this runs on (with --system)");
-  app.add_option("-d,--domain", domain,
-                 "DDS domain (default: the system file's, $OSCAR_DOMAIN, the system booted on this "
-                 "machine, or 0)");
+  tool.add_to(app);
   auto* timeout = app.add_option("--timeout-ms", timeout_ms,
                                  "how long to wait for the module's reply (default 3000; a rewire "
                                  "adds its WAIT)");
@@ -43,7 +41,7 @@ int main(int argc, char** argv) {
       timeout_ms +=
           static_cast<int>(std::chrono::duration_cast<std::chrono::milliseconds>(wait).count());
     }
-    auto participant = oscar::tool_participant("oscar-config", system_file, host, domain);
+    auto participant = tool.participant("oscar-config");
     oscar::ConfigClient client(*participant, as);
     const auto reply = client.send(module, kind, args, std::chrono::milliseconds(timeout_ms));
     if (!reply.ok()) {

@@ -8,9 +8,8 @@
 #include <CLI/CLI.hpp>
 #include <oscar/command_line.hpp>
 
-#include "oscar/network.hpp"
 #include "oscar/process_util.hpp"
-#include "oscar/registry/registry_client.hpp"
+#include "oscar/registry/system_options.hpp"
 #include "recorder.hpp"  // topic_of
 #include "replayer.hpp"
 
@@ -54,15 +53,12 @@ int main(int argc, char** argv) {
   app.add_option("--topics", o.topics, "topics or globs to replay (default: all)");
   app.add_option("--remap", remaps, "FROM:=TO publish topic FROM as TO");
   app.add_flag("--step", o.step, "publish one message per Enter");
-  app.add_option("--domain", o.domain,
-                 "DDS domain (default: $OSCAR_DOMAIN, the system booted on this machine, or 0)");
+  oscar::SystemOptions system;
+  system.add_domain_to(app);
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   oscar::keep_cue_memory_in_process();
   try {
-    if (app.count("--domain") == 0) {  // as every tool: the system oscar boot runs here
-      const auto booted = oscar::domain_from_env(-1) < 0 ? oscar::default_system() : std::nullopt;
-      o.domain = booted ? booted->domain : oscar::domain_from_env(0);
-    }
+    o.domain = system.resolved_domain();
     if (!start.empty()) o.start = parse_time("--start", start);
     if (!end.empty()) o.end = parse_time("--end", end);
     for (const auto& r : remaps) {

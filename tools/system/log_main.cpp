@@ -11,25 +11,21 @@
 #include "oscar/process_util.hpp"
 #include "oscar/registry/log_printer.hpp"
 #include "oscar/registry/registry_client.hpp"
+#include "oscar/registry/system_options.hpp"
 #include "oscar/topic_io.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"oscar log: follows the merged log of the running system until Ctrl-C"};
-  std::string system_file, host;
-  int domain = -1;
+  oscar::SystemOptions tool;
   double duration_s = 0;
   bool no_colour = false;
-  app.add_option("--system", system_file, "system file (its domain and network)");
-  app.add_option("--host", host, "the host this runs on (with --system)");
-  app.add_option("-d,--domain", domain,
-                 "DDS domain (default: the system file's, $OSCAR_DOMAIN, the system booted on this "
-                 "machine, or 0)");
+  tool.add_to(app);
   app.add_option("--duration", duration_s, "stop after this many seconds");
   app.add_flag("--no-colour", no_colour, "plain text even on a terminal");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   const auto signals = oscar::block_stop_signals();
   try {
-    auto participant = oscar::tool_participant("oscar-log", system_file, host, domain);
+    auto participant = tool.participant("oscar-log");
     oscar::LogPrinter printer(stdout, !no_colour && isatty(1) != 0);
     oscar::TopicReader<oscar::LogRecord, oscar::LogRecordPubSubType> logs(
         *participant, "oscar/log", oscar::qos::stream_reader(100),

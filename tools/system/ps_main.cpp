@@ -7,6 +7,7 @@
 #include <oscar/command_line.hpp>
 
 #include "oscar/registry/registry_client.hpp"
+#include "oscar/registry/system_options.hpp"
 #include "oscar/time.hpp"
 
 namespace {
@@ -62,20 +63,15 @@ nlohmann::json to_json(const oscar::SystemState& s) {
 
 int main(int argc, char** argv) {
   CLI::App app{"oscar ps: the modules of the running system"};
-  std::string system_file, host;
-  int domain = -1;
+  oscar::SystemOptions tool;
   double timeout_s = 3;
   bool json = false;
-  app.add_option("--system", system_file, "system file (its domain and network)");
-  app.add_option("--host", host, "the host this runs on (with --system)");
-  app.add_option("-d,--domain", domain,
-                 "DDS domain (default: the system file's, $OSCAR_DOMAIN, the system booted on this "
-                 "machine, or 0)");
+  tool.add_to(app);
   app.add_option("--timeout", timeout_s, "seconds to wait for the registry");
   app.add_flag("--json", json, "print the system state as JSON");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
-    auto participant = oscar::tool_participant("oscar-ps", system_file, host, domain);
+    auto participant = tool.participant("oscar-ps");
     oscar::RegistryClient client(*participant, "ps");
     const auto s = client.wait_for([](const oscar::SystemState&) { return true; },
                                    std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));

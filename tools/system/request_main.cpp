@@ -7,22 +7,19 @@
 #include <oscar/command_line.hpp>
 
 #include "oscar/registry/registry_client.hpp"
+#include "oscar/registry/system_options.hpp"
 
 int main(int argc, char** argv) {
   const bool restart = std::filesystem::path(argv[0]).filename() == "oscar-restart";
   CLI::App app{restart ? "oscar restart: restarts a module (also one given up or on manual policy)"
                        : "oscar shutdown: stops the system in order"};
-  std::string module, system_file, host;
-  int domain = -1;
+  std::string module;
+  oscar::SystemOptions tool;
   if (restart) app.add_option("module", module, "the module to restart")->required();
-  app.add_option("--system", system_file, "system file (its domain and network)");
-  app.add_option("--host", host, "the host this runs on (with --system)");
-  app.add_option("-d,--domain", domain,
-                 "DDS domain (default: the system file's, $OSCAR_DOMAIN, the system booted on this "
-                 "machine, or 0)");
+  tool.add_to(app);
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
-    auto participant = oscar::tool_participant(argv[0], system_file, host, domain);
+    auto participant = tool.participant(argv[0]);
     oscar::RegistryClient client(*participant, "operator");
     client.request(restart ? oscar::REG_RESTART : oscar::REG_SHUTDOWN, module);
     std::printf(restart ? "restarting %s\n" : "shutting down%s\n", module.c_str());

@@ -13,9 +13,9 @@
 #include "idl_texts.hpp"  // tools/record
 #include "idl_types.hpp"
 #include "oscar/registry/registry_client.hpp"
+#include "oscar/registry/system_options.hpp"
 #include "raw_tap.hpp"
 #include "recorder.hpp"  // topic_of
-#include "tool_options.hpp"
 
 namespace {
 std::atomic<bool> g_stop{false};
@@ -24,7 +24,7 @@ void on_signal(int) { g_stop = true; }
 
 int main(int argc, char** argv) {
   CLI::App app{"oscar echo: print the samples of a topic readably"};
-  oscar::inspect::ToolOptions tool;
+  oscar::SystemOptions tool;
   tool.add_to(app);
   std::string topic_arg;
   long count = 0;
@@ -45,8 +45,7 @@ int main(int argc, char** argv) {
     for (const auto& [name, text] : oscar::record::idl_texts()) {
       if (texts.insert(text).second) types.add(text);
     }
-    auto participant =
-        oscar::tool_participant("oscar-echo", tool.system_file, tool.host, tool.domain);
+    auto participant = tool.participant("oscar-echo");
     const auto type = oscar::inspect::wait_for_writer(
         *participant, topic, std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));
     if (type.empty()) {

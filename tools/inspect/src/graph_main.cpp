@@ -12,8 +12,8 @@
 #include <fmt/format.h>
 
 #include "oscar/registry/registry_client.hpp"
+#include "oscar/registry/system_options.hpp"
 #include "oscar/time.hpp"
-#include "tool_options.hpp"
 
 namespace {
 
@@ -92,7 +92,7 @@ std::string to_dot(const oscar::SystemState& s,
 
 int main(int argc, char** argv) {
   CLI::App app{"oscar graph: the running system as a graph (DOT, or SVG rendered with dot)"};
-  oscar::inspect::ToolOptions tool;
+  oscar::SystemOptions tool;
   tool.add_to(app);
   std::string output;
   double timeout_s = 5, discovery_s = 1;
@@ -103,8 +103,7 @@ int main(int argc, char** argv) {
   app.add_option("--discovery", discovery_s, "seconds to discover channel types");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
-    auto participant =
-        oscar::tool_participant("oscar-graph", tool.system_file, tool.host, tool.domain);
+    auto participant = tool.participant("oscar-graph");
     oscar::RegistryClient client(*participant, "graph");
     const auto s = client.wait_for([](const oscar::SystemState&) { return true; },
                                    std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));

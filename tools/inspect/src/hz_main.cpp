@@ -11,9 +11,9 @@
 #include <fmt/format.h>
 
 #include "oscar/registry/registry_client.hpp"
+#include "oscar/registry/system_options.hpp"
 #include "raw_tap.hpp"
 #include "recorder.hpp"  // topic_of
-#include "tool_options.hpp"
 
 namespace {
 std::atomic<bool> g_stop{false};
@@ -46,7 +46,7 @@ Stats stats(const std::deque<std::uint64_t>& times) {
 
 int main(int argc, char** argv) {
   CLI::App app{"oscar hz: the rate of a topic and the spread of its period"};
-  oscar::inspect::ToolOptions tool;
+  oscar::SystemOptions tool;
   tool.add_to(app);
   std::string topic_arg;
   std::size_t window = 1000;
@@ -62,8 +62,7 @@ int main(int argc, char** argv) {
   std::signal(SIGTERM, on_signal);
   try {
     const auto topic = oscar::record::topic_of(topic_arg);
-    auto participant =
-        oscar::tool_participant("oscar-hz", tool.system_file, tool.host, tool.domain);
+    auto participant = tool.participant("oscar-hz");
     if (oscar::inspect::wait_for_writer(
             *participant, topic, std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)))
             .empty()) {

@@ -10,12 +10,12 @@
 #include <nlohmann/json.hpp>
 
 #include "oscar/registry/registry_client.hpp"
+#include "oscar/registry/system_options.hpp"
 #include "raw_tap.hpp"
-#include "tool_options.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"oscar topics: the topics of the running system, with types and rates"};
-  oscar::inspect::ToolOptions tool;
+  oscar::SystemOptions tool;
   tool.add_to(app);
   double duration_s = 2;
   bool json = false, all = false;
@@ -25,8 +25,7 @@ int main(int argc, char** argv) {
   app.add_flag("-a,--all", all, "also OSCAR's own topics (registry, config, log), not only cues");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
-    auto participant =
-        oscar::tool_participant("oscar-topics", tool.system_file, tool.host, tool.domain);
+    auto participant = tool.participant("oscar-topics");
     std::mutex mutex;
     std::map<std::string, std::uint64_t> counts;
     oscar::inspect::RawTap tap(*participant, [&](const std::string& topic, auto, auto) {

@@ -8,8 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <oscar/command_line.hpp>
 
-#include "oscar/network.hpp"
-#include "oscar/registry/registry_client.hpp"
+#include "oscar/registry/system_options.hpp"
 #include "recorder.hpp"
 
 namespace {
@@ -72,14 +71,11 @@ int main(int argc, char** argv) {
   app.add_option("--compression", compression, "zstd, lz4 or none")->capture_default_str();
   app.add_option("--split-size", split_size, "start a new file after this size (e.g. 500M)");
   app.add_option("--split-duration", split_duration, "start a new file after this time (e.g. 5m)");
-  app.add_option("--domain", o.domain,
-                 "DDS domain (default: $OSCAR_DOMAIN, the system booted on this machine, or 0)");
+  oscar::SystemOptions system;
+  system.add_domain_to(app);
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
-    if (app.count("--domain") == 0) {  // as every tool: the system oscar boot runs here
-      const auto booted = oscar::domain_from_env(-1) < 0 ? oscar::default_system() : std::nullopt;
-      o.domain = booted ? booted->domain : oscar::domain_from_env(0);
-    }
+    o.domain = system.resolved_domain();
     o.compression = oscar::mcap::parse_compression(compression);
     if (!split_size.empty()) o.split_size_bytes = parse_size(split_size);
     if (!split_duration.empty()) o.split_duration = parse_duration(split_duration);
