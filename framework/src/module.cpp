@@ -13,8 +13,8 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
-#include "dds_log_sink.hpp"
-#include "module_dds.hpp"
+#include "dds/log_sink.hpp"
+#include "dds/module_dds.hpp"
 #include "module_slot.hpp"
 #include "repeat_filter_sink.hpp"
 #include "ring_pull_source.hpp"

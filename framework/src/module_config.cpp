@@ -6,7 +6,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "module_dds.hpp"
+#include "dds/module_dds.hpp"
 #include "module_slot.hpp"
 #include "oscar/time.hpp"
 

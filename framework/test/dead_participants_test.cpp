@@ -14,7 +14,7 @@
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
 
 #include "oscar/dds_participant.hpp"
-#include "participant_identity.hpp"  // framework/src
+#include "dds/participant_identity.hpp"  // framework/src
 
 namespace oscar {
 namespace {

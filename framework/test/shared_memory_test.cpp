@@ -16,7 +16,7 @@
 #include <gtest/gtest.h>
 
 #include "oscar/dds_participant.hpp"
-#include "participant_identity.hpp"  // framework/src
+#include "dds/participant_identity.hpp"  // framework/src
 
 namespace oscar {
 namespace {

@@ -4,7 +4,7 @@
 /// A process killed with SIGKILL leaves its shared-memory segments and its listening port
 /// behind (the lock file beside them is no longer held). They stay in /dev/shm, in memory, until
 /// someone removes them; every monitor sweeps them a few seconds after their owner died. (No new
-/// participant ever listens on a dead one's port: see framework/src/participant_identity.hpp.)
+/// participant ever listens on a dead one's port: see framework/src/dds/participant_identity.hpp.)
 
 #include <chrono>
 #include <cstddef>

@@ -1,6 +1,6 @@
-#include "module_dds.hpp"
+#include "dds/module_dds.hpp"
 
-#include "dds_log_sink.hpp"
+#include "dds/log_sink.hpp"
 #include "oscar/topic_io.hpp"
 
 #include <unistd.h>

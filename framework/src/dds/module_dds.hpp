@@ -17,7 +17,7 @@
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 
-#include "dds_pull.hpp"
+#include "dds/pull.hpp"
 #include "module_slot.hpp"
 #include "oscar/dds_participant.hpp"
 #include "oscar/module.hpp"

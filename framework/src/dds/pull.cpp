@@ -1,4 +1,4 @@
-#include "dds_pull.hpp"
+#include "dds/pull.hpp"
 
 #include <thread>
 

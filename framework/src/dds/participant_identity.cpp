@@ -1,4 +1,4 @@
-#include "participant_identity.hpp"
+#include "dds/participant_identity.hpp"
 
 #include <fcntl.h>
 #include <sys/file.h>

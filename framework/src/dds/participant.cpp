@@ -15,7 +15,7 @@
 #include <yaml-cpp/yaml.h>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/log/Log.hpp>
-#include "participant_identity.hpp"
+#include "dds/participant_identity.hpp"
 
 namespace oscar {
 namespace dds = eprosima::fastdds::dds;

@@ -16,7 +16,7 @@
 #include <sstream>
 #include <system_error>
 
-#include "participant_identity.hpp"
+#include "dds/participant_identity.hpp"
 
 namespace oscar {
 namespace {
