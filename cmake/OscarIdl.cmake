@@ -28,9 +28,13 @@ function(oscar_generate_idl target)
     # lines costs ~300 us. The sed makes the registration happen once per process.
     add_custom_command(
       OUTPUT ${generated}
-      # Its progress lines go to a log beside the output, shown only if it fails.
+      # Its progress lines go to a log beside the output, shown only if it fails. Its
+      # preprocessed copy of the IDL goes to the output folder (-t): in the shared temporary
+      # folder, two builds on one machine overwrote each other's copy of a file of the same name
+      # and one generated a header without types.
       COMMAND sh -c "\"$0\" \"$@\" > \"${out}/${stem}.fastddsgen.log\" 2>&1 || { cat \"${out}/${stem}.fastddsgen.log\" >&2; exit 1; }"
-              ${OSCAR_FASTDDSGEN} -typeobject -replace -I ${idl_dir} ${include_flags} -d ${out} ${abs}
+              ${OSCAR_FASTDDSGEN} -typeobject -replace -I ${idl_dir} ${include_flags} -d ${out} -t ${out}
+              ${abs}
       COMMAND sed -i
         "s/^\\([ ]*\\)register\\([A-Za-z0-9_]*\\)Types();$/\\1static const bool oscar_registered = (register\\2Types(), true); (void)oscar_registered;/"
         ${out}/${stem}.cxx
