@@ -30,6 +30,7 @@
 #include "oscar/registry/system_spec.hpp"
 #include "oscar/time.hpp"
 #include "oscar/topic_io.hpp"
+#include "oscar/topics.hpp"
 
 namespace {
 
@@ -193,7 +194,7 @@ int main(int argc, char** argv) {
       booted = true;
     }
     oscar::TopicReader<oscar::LogRecord, oscar::LogRecordPubSubType> logs(
-        participant, "oscar/log", oscar::qos::stream_reader(100),
+        participant, oscar::topics::log(),
         [&](const oscar::LogRecord& r, const auto&) { log.add(r); });
 
     // Registry first (it waits for the monitors), then one monitor per host.

@@ -21,6 +21,7 @@
 #include "oscar/registry/supervisor.hpp"
 #include "oscar/registry/system_spec.hpp"
 #include "oscar/topic_io.hpp"
+#include "oscar/topics.hpp"
 
 namespace {
 
@@ -65,17 +66,16 @@ int main(int argc, char** argv) {
     const auto network = oscar::NetworkConfig::for_host(system.root, host);
     oscar::DdsParticipant participant(system.domain, "oscar-monitor:" + host, network);
     oscar::TopicWriter<oscar::ProcessEvent, oscar::ProcessEventPubSubType> events(
-        participant, "oscar/registry/process", oscar::qos::state_writer(256));
+        participant, oscar::topics::process_events());
     oscar::TopicWriter<oscar::MonitorBeat, oscar::MonitorBeatPubSubType> beats(
-        participant, "oscar/registry/monitor", oscar::qos::beat_writer(system.lease));
+        participant, oscar::topics::monitor_alive(system.lease));
 
     std::mutex mutex;
     std::deque<oscar::LaunchRequest> requests;
     std::set<unsigned long long> seen;
     const long own_pid = getpid();
     oscar::TopicReader<oscar::LaunchRequest, oscar::LaunchRequestPubSubType> launches(
-        participant, "oscar/registry/launch", oscar::qos::state_reader(64),
-        [&](const oscar::LaunchRequest& q, const auto&) {
+        participant, oscar::topics::launch(), [&](const oscar::LaunchRequest& q, const auto&) {
           if (q.host() != host || q.monitor_pid() != own_pid) return;
           std::lock_guard lock(mutex);
           if (seen.insert(q.id()).second) requests.push_back(q);

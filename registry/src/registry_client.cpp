@@ -12,6 +12,7 @@
 
 #include "oscar/registry/system_spec.hpp"
 #include "oscar/topic_io.hpp"
+#include "oscar/topics.hpp"
 
 namespace oscar {
 
@@ -26,20 +27,20 @@ RegistryClient::RegistryClient(DdsParticipant& participant, std::string sender,
     : sender_(std::move(sender)),
       on_state_(std::move(on_state)),
       next_id_(static_cast<unsigned long long>(getpid()) << 24) {
-  io_.reset(new Endpoints{{participant, "oscar/system/state", qos::state_reader(1),
+  io_.reset(new Endpoints{{participant, topics::system_state(),
                            [this](const SystemState& s, const auto&) {
                              if (on_state_) on_state_(s);
                              std::lock_guard lock(mutex_);
                              latest_ = s;
                              changed_.notify_all();
                            }},
-                          {participant, "oscar/registry/reply", qos::state_reader(16),
+                          {participant, topics::registry_reply(),
                            [this](const RegistryReply& r, const auto&) {
                              std::lock_guard lock(mutex_);
                              replies_[r.id()] = r;
                              changed_.notify_all();
                            }},
-                          {participant, "oscar/registry/request", qos::state_writer(16)}});
+                          {participant, topics::registry_request()}});
 }
 
 RegistryClient::~RegistryClient() { io_.reset(); }

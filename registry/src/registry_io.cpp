@@ -1,16 +1,18 @@
 #include "registry_io.hpp"
 
+#include "oscar/topics.hpp"
+
 #include <oscar/configPubSubTypes.h>
 
 namespace oscar {
 
 Registry::Io::Io(Registry& r)
     : r_(r),
-      launch_(r.participant_, "oscar/registry/launch", qos::state_writer(64)),
-      reply_(r.participant_, "oscar/registry/reply", qos::state_writer(16)),
-      system_(r.participant_, "oscar/system/state", qos::state_writer(1)),
+      launch_(r.participant_, topics::launch()),
+      reply_(r.participant_, topics::registry_reply()),
+      system_(r.participant_, topics::system_state()),
       monitors_(
-          r.participant_, "oscar/registry/monitor", qos::beat_reader(r.system_.lease),
+          r.participant_, topics::monitor_alive(r.system_.lease),
           [this](const MonitorBeat& b, const auto& info) {
             {
               std::lock_guard lock(handles_mutex_);
@@ -25,16 +27,16 @@ Registry::Io::Io(Registry& r)
             const auto [host, pid] = it->second;
             r_.post([this, host, pid] { r_.on_monitor_lost(host, pid); });
           }),
-      events_(r.participant_, "oscar/registry/process", qos::state_reader(256),
+      events_(r.participant_, topics::process_events(),
               [this](const ProcessEvent& e, const auto&) {
                 r_.post([this, e] { r_.on_process_event(e); });
               }),
-      states_(r.participant_, "oscar/registry/module_state", qos::state_reader(64),
+      states_(r.participant_, topics::module_state(),
               [this](const ModuleState& s, const auto&) {
                 r_.post([this, s] { r_.on_module_state(s); });
               }),
       beats_(
-          r.participant_, "oscar/registry/alive", qos::beat_reader(r.system_.lease),
+          r.participant_, topics::module_alive(r.system_.lease),
           [this](const ModuleBeat& b, const auto& info) {
             std::lock_guard lock(handles_mutex_);
             module_handles_[info.publication_handle] = {b.module_name(), b.incarnation()};
@@ -47,7 +49,7 @@ Registry::Io::Io(Registry& r)
             const auto [module, incarnation] = it->second;
             r_.post([this, module, incarnation] { r_.on_module_lost(module, incarnation); });
           }),
-      requests_(r.participant_, "oscar/registry/request", qos::state_reader(16),
+      requests_(r.participant_, topics::registry_request(),
                 [this](const RegistryRequest& q, const auto&) {
                   r_.post([this, q] { r_.on_request(q); });
                 }) {}

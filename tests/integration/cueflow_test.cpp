@@ -377,12 +377,11 @@ kernels: [ { type: test_counter, name: counter, mode: "single_step:command" } ]
   DdsParticipant participant(test::test_domain(), "test:repeater");
   std::atomic<int> replies{0};
   TopicReader<ConfigReply, ConfigReplyPubSubType> reply_reader(
-      participant, "oscar/config_reply/counted", qos::state_reader(16),
-      [&](const ConfigReply& r, const auto&) {
+      participant, topics::config_reply("counted"), [&](const ConfigReply& r, const auto&) {
         if (r.id() == 77 && r.ok()) ++replies;
       });
-  TopicWriter<ConfigCommand, ConfigCommandPubSubType> writer(participant, "oscar/config/counted",
-                                                             qos::state_writer(16));
+  TopicWriter<ConfigCommand, ConfigCommandPubSubType> writer(participant,
+                                                             topics::config("counted"));
   ASSERT_TRUE(eventually([&] { return writer.matched() > 0 && reply_reader.matched() > 0; }));
   ConfigCommand trigger;
   trigger.id(77);

@@ -13,6 +13,7 @@
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/registry/system_options.hpp"
 #include "oscar/topic_io.hpp"
+#include "oscar/topics.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"oscar log: follows the merged log of the running system until Ctrl-C"};
@@ -28,7 +29,7 @@ int main(int argc, char** argv) {
     auto participant = tool.participant("oscar-log");
     oscar::LogPrinter printer(stdout, !no_colour && isatty(1) != 0);
     oscar::TopicReader<oscar::LogRecord, oscar::LogRecordPubSubType> logs(
-        *participant, "oscar/log", oscar::qos::stream_reader(100),
+        *participant, oscar::topics::log(),
         [&](const oscar::LogRecord& r, const auto&) { printer.add(r); });
     const auto until = duration_s > 0 ? std::chrono::steady_clock::now() +
                                             std::chrono::milliseconds(long(duration_s * 1000))

@@ -16,6 +16,7 @@
 
 #include "oscar/dds_participant.hpp"
 #include "oscar/input.hpp"
+#include "oscar/topics.hpp"
 
 namespace oscar {
 
@@ -27,7 +28,11 @@ namespace qos {
 eprosima::fastdds::dds::DataWriterQos state_writer(int depth = 1);
 eprosima::fastdds::dds::DataReaderQos state_reader(int depth = 1);
 /// Reliable, volatile, keep last `depth`: a stream for whoever listens now (oscar/log).
+eprosima::fastdds::dds::DataWriterQos stream_writer(int depth);
 eprosima::fastdds::dds::DataReaderQos stream_reader(int depth);
+/// Reliable, volatile, keep all: commands, none of which may be dropped (oscar/config/...).
+eprosima::fastdds::dds::DataWriterQos command_writer();
+eprosima::fastdds::dds::DataReaderQos command_reader();
 /// Reliable, keep last 1, manual-by-topic liveliness with `lease`.
 eprosima::fastdds::dds::DataWriterQos beat_writer(std::chrono::milliseconds lease);
 eprosima::fastdds::dds::DataReaderQos beat_reader(std::chrono::milliseconds lease);
@@ -54,12 +59,12 @@ class TopicReader final : public eprosima::fastdds::dds::DataReaderListener {
               const eprosima::fastdds::dds::DataReaderQos& qos, OnSample on_sample,
               OnLost on_lost = {})
       : participant_(p), on_sample_(std::move(on_sample)), on_lost_(std::move(on_lost)) {
-    namespace dds = eprosima::fastdds::dds;
-    auto mask = dds::StatusMask::data_available() << dds::StatusMask::subscription_matched();
-    if (on_lost_) mask << dds::StatusMask::liveliness_changed();
-    reader_ = p.subscriber().create_datareader(&p.topic(topic, new PubSubType()), qos, this, mask);
-    if (!reader_) throw std::runtime_error("cannot create a reader for " + topic);
+    create(topic, qos);
   }
+  /// A reader of a catalogue topic (oscar/topics.hpp), with the catalogue's QoS.
+  TopicReader(DdsParticipant& p, const TopicSpec<T, PubSubType>& spec, OnSample on_sample,
+              OnLost on_lost = {})
+      : TopicReader(p, spec.name, spec.reader_qos, std::move(on_sample), std::move(on_lost)) {}
   ~TopicReader() override { participant_.subscriber().delete_datareader(reader_); }
   TopicReader(const TopicReader&) = delete;
   TopicReader& operator=(const TopicReader&) = delete;
@@ -85,6 +90,15 @@ class TopicReader final : public eprosima::fastdds::dds::DataReaderListener {
   }
 
  private:
+  void create(const std::string& topic, const eprosima::fastdds::dds::DataReaderQos& qos) {
+    namespace dds = eprosima::fastdds::dds;
+    auto mask = dds::StatusMask::data_available() << dds::StatusMask::subscription_matched();
+    if (on_lost_) mask << dds::StatusMask::liveliness_changed();
+    reader_ = participant_.subscriber().create_datareader(
+        &participant_.topic(topic, new PubSubType()), qos, this, mask);
+    if (!reader_) throw std::runtime_error("cannot create a reader for " + topic);
+  }
+
   DdsParticipant& participant_;
   OnSample on_sample_;
   OnLost on_lost_;
@@ -101,11 +115,17 @@ class TopicWriter {
     writer_ = p.publisher().create_datawriter(&p.topic(topic, new PubSubType()), qos);
     if (!writer_) throw std::runtime_error("cannot create a writer for " + topic);
   }
+  /// A writer of a catalogue topic (oscar/topics.hpp), with the catalogue's QoS.
+  TopicWriter(DdsParticipant& p, const TopicSpec<T, PubSubType>& spec)
+      : TopicWriter(p, spec.name, spec.writer_qos) {}
   ~TopicWriter() { participant_.publisher().delete_datawriter(writer_); }
   TopicWriter(const TopicWriter&) = delete;
   TopicWriter& operator=(const TopicWriter&) = delete;
 
-  void write(const T& sample) { writer_->write(const_cast<T*>(&sample)); }
+  /// False if DDS refused the sample (it logs why).
+  bool write(const T& sample) { return writer_->write(const_cast<T*>(&sample)); }
+  /// The DDS writer, for code that hands it on (the module's log sink).
+  eprosima::fastdds::dds::DataWriter& dds_writer() { return *writer_; }
   int matched() const {
     eprosima::fastdds::dds::PublicationMatchedStatus s;
     writer_->get_publication_matched_status(s);

@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 #include <oscar/configPubSubTypes.h>
 
-#include "oscar/topic_io.hpp"
+#include "oscar/topics.hpp"
 
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
@@ -40,18 +40,22 @@ ConfigClient::~ConfigClient() {
 }
 
 ConfigClient::Channel& ConfigClient::channel(const std::string& module) {
-  auto& c = channels_[module];
-  if (c) return *c;
-  c = std::make_unique<Channel>();
-  dds::DataWriterQos wq = dds::DATAWRITER_QOS_DEFAULT;
-  wq.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  wq.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+  if (const auto it = channels_.find(module); it != channels_.end()) return *it->second;
+  // The replies are polled (send() waits for its own), so the reader has no listener and is
+  // made here rather than as a TopicReader.
+  const auto commands = topics::config(module);
+  const auto replies = topics::config_reply(module);
+  auto c = std::make_unique<Channel>();
   c->writer = participant_.publisher().create_datawriter(
-      &participant_.topic("oscar/config/" + module, new ConfigCommandPubSubType()), wq);
-  const auto rq = qos::state_reader(64);
+      &participant_.topic(commands.name, new ConfigCommandPubSubType()), commands.writer_qos);
   c->reader = participant_.subscriber().create_datareader(
-      &participant_.topic("oscar/config_reply/" + module, new ConfigReplyPubSubType()), rq);
-  return *c;
+      &participant_.topic(replies.name, new ConfigReplyPubSubType()), replies.reader_qos);
+  if (!c->writer || !c->reader) {
+    if (c->writer) participant_.publisher().delete_datawriter(c->writer);
+    if (c->reader) participant_.subscriber().delete_datareader(c->reader);
+    throw std::runtime_error("cannot create the configuration endpoints for module " + module);
+  }
+  return *(channels_[module] = std::move(c));
 }
 
 ConfigReply ConfigClient::send(const std::string& module, CommandKind kind,
@@ -76,8 +80,8 @@ ConfigReply ConfigClient::send(const std::string& module, CommandKind kind,
     if (pub.current_count > 0 && sub.current_count > 0) break;
     if (std::chrono::steady_clock::now() > until) {
       throw std::runtime_error(
-          fmt::format("no module named '{}' is running (nobody reads oscar/config/{} after {} ms)",
-                      module, module, timeout.count()));
+          fmt::format("no module named '{}' is running (nobody reads {} after {} ms)", module,
+                      topics::config(module).name, timeout.count()));
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }

@@ -21,7 +21,7 @@ namespace dds = eprosima::fastdds::dds;
 class Module::Dds::OutputWriter final : public dds::DataWriterListener {
  public:
   OutputWriter(DdsParticipant& p, OutputPort& out) : out_(out) {
-    auto& topic = p.topic(cue_topic(out.address()), out.type().new_topic_type());
+    auto& topic = p.topic(topics::cue(out.address()), out.type().new_topic_type());
     writer_ = p.publisher().create_datawriter(&topic, qos::cue_writer(out.options()), this,
                                               dds::StatusMask::publication_matched());
     if (!writer_) throw std::runtime_error("cannot create a writer for " + out.address());
@@ -50,7 +50,7 @@ class Module::Dds::CueReader final : public dds::DataReaderListener {
   CueReader(Dds& owner, InputPort& input, const std::string& source, const OutputOptions& producer)
       : owner_(owner), input_(input), source_(source), producer_(producer) {
     auto& p = owner.participant_;
-    auto& topic = p.topic(cue_topic(source), input.type().new_topic_type());
+    auto& topic = p.topic(topics::cue(source), input.type().new_topic_type());
     reader_ = p.subscriber().create_datareader(
         &topic, qos::cue_reader(producer, input.buffer().depth(), input.reliability()), this,
         dds::StatusMask::data_available() << dds::StatusMask::subscription_matched()
@@ -113,24 +113,6 @@ class Module::Dds::CueReader final : public dds::DataReaderListener {
   std::atomic<int> matched_{0};
 };
 
-class Module::Dds::ConfigListener final : public dds::DataReaderListener {
- public:
-  explicit ConfigListener(Dds& owner) : owner_(owner) {}
-  void on_data_available(dds::DataReader* reader) override {
-    ConfigCommand c;
-    dds::SampleInfo info;
-    while (reader->take_next_sample(&c, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data) continue;
-      std::lock_guard lock(owner_.queue_mutex_);
-      owner_.queue_.push_back(c);
-      owner_.queue_cv_.notify_all();
-    }
-  }
-
- private:
-  Dds& owner_;
-};
-
 Module::Dds::Dds(Module& module, int domain)
     : module_(module), participant_(domain, "oscar:" + module.spec_.name, module.spec_.network) {}
 
@@ -182,7 +164,7 @@ std::string Module::Dds::connect_input(InputPort& input, const std::string& sour
   // volatile reader, which every reliable writer matches; a best-effort one makes the reader
   // report an incompatible writer, and follow_producer() replaces it.
   std::optional<DdsParticipant::DiscoveredWriter> seen;
-  while (!(seen = participant_.discovered_writer(cue_topic(source))) &&
+  while (!(seen = participant_.discovered_writer(topics::cue(source))) &&
          std::chrono::steady_clock::now() < until) {
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
@@ -203,7 +185,7 @@ std::string Module::Dds::subscribe(InputPort& input, const std::string& source,
   std::string note;
   if (!reader->wait_matched(until)) {
     note = fmt::format("input {}/{}: no publisher of {} matched yet; cues arrive once it appears",
-                       input.kernel(), input.name(), cue_topic(source));
+                       input.kernel(), input.name(), topics::cue(source));
     module_.log_->warn("{}", note);
   } else if (switch_wait && !reader->wait_first_cue(*switch_wait)) {
     // Matching is seen by each side on its own: until the producer's writer has matched this
@@ -266,45 +248,32 @@ void Module::Dds::disconnect_input(InputPort& input) {
 
 void Module::Dds::start_config() {
   const auto& name = module_.spec_.name;
-  state_writer_ = participant_.publisher().create_datawriter(
-      &participant_.topic("oscar/registry/module_state", new ModuleStatePubSubType()),
-      qos::state_writer());
-
-  // Transient-local: a client whose reader this writer has not matched yet still gets the
+  state_writer_ = std::make_unique<TopicWriter<ModuleState, ModuleStatePubSubType>>(
+      participant_, topics::module_state());
+  // A state-class reply: a client whose reader this writer has not matched yet still gets the
   // reply once it does (discovery is not symmetric in time).
-  reply_writer_ = participant_.publisher().create_datawriter(
-      &participant_.topic("oscar/config_reply/" + name, new ConfigReplyPubSubType()),
-      qos::state_writer(64));
-
-  dds::DataReaderQos config_qos = dds::DATAREADER_QOS_DEFAULT;
-  config_qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  config_qos.history().kind = dds::KEEP_ALL_HISTORY_QOS;
-  config_listener_ = std::make_unique<ConfigListener>(*this);
-  config_reader_ = participant_.subscriber().create_datareader(
-      &participant_.topic("oscar/config/" + name, new ConfigCommandPubSubType()), config_qos,
-      config_listener_.get(), dds::StatusMask::data_available());
-  dds::DataWriterQos log_qos = dds::DATAWRITER_QOS_DEFAULT;
-  log_qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  log_qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-  log_qos.history().depth = 100;
-  log_writer_ = participant_.publisher().create_datawriter(
-      &participant_.topic("oscar/log", new LogRecordPubSubType()), log_qos);
+  reply_writer_ = std::make_unique<TopicWriter<ConfigReply, ConfigReplyPubSubType>>(
+      participant_, topics::config_reply(name));
+  config_reader_ = std::make_unique<TopicReader<ConfigCommand, ConfigCommandPubSubType>>(
+      participant_, topics::config(name), [this](const ConfigCommand& c, const auto&) {
+        std::lock_guard lock(queue_mutex_);
+        queue_.push_back(c);
+        queue_cv_.notify_all();
+      });
+  log_writer_ =
+      std::make_unique<TopicWriter<LogRecord, LogRecordPubSubType>>(participant_, topics::log());
   // The heartbeat: manual-by-topic liveliness with the module's lease (docs/architecture.md,
   // "Topics and QoS classes"). It stops when the process stops (SIGSTOP, crash) or a kernel call
   // outlives the watchdog.
-  beat_writer_ = participant_.publisher().create_datawriter(
-      &participant_.topic("oscar/registry/alive", new ModuleBeatPubSubType()),
-      qos::beat_writer(module_.spec_.lease));
-  if (!state_writer_ || !reply_writer_ || !config_reader_ || !log_writer_ || !beat_writer_) {
-    throw std::runtime_error("cannot create the configuration endpoints of module " + name);
-  }
+  beat_writer_ = std::make_unique<TopicWriter<ModuleBeat, ModuleBeatPubSubType>>(
+      participant_, topics::module_alive(module_.spec_.lease));
   {
     std::lock_guard lock(queue_mutex_);
     serving_ = true;
   }
   config_thread_ = std::thread([this] { serve_config(); });
   beat_thread_ = std::thread([this] { beat(); });
-  module_.log_sink_->attach(log_writer_);
+  module_.log_sink_->attach(&log_writer_->dds_writer());
 }
 
 // Commands are applied on their own thread, never inside a DDS callback: a rewire creates and
@@ -329,7 +298,7 @@ void Module::Dds::serve_config() {
     // again, not applied twice.
     auto& last = last_reply_[command.sender()];
     if (last.id() != command.id() || last.module_name().empty()) last = module_.apply(command);
-    reply_writer_->write(&last);
+    reply_writer_->write(last);
     lock.lock();
   }
 }
@@ -346,7 +315,7 @@ void Module::Dds::beat() {
   std::unique_lock lock(queue_mutex_);
   while (serving_) {
     lock.unlock();
-    if (!module_.hung()) beat_writer_->write(&b);
+    if (!module_.hung()) beat_writer_->write(b);
     if (std::chrono::steady_clock::now() >= next_state) {
       publish_state(module_.state());
       next_state += std::chrono::seconds(1);
@@ -365,15 +334,11 @@ void Module::Dds::stop_config() {
   }
   if (config_thread_.joinable()) config_thread_.join();
   if (beat_thread_.joinable()) beat_thread_.join();
-  if (config_reader_) participant_.subscriber().delete_datareader(config_reader_);
-  config_reader_ = nullptr;
+  config_reader_.reset();
 }
 
 void Module::Dds::publish_state(const ModuleState& state) {
-  if (state_writer_) {
-    auto copy = state;
-    state_writer_->write(&copy);
-  }
+  if (state_writer_) state_writer_->write(state);
 }
 
 }  // namespace oscar

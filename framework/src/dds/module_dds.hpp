@@ -21,11 +21,10 @@
 #include "module_slot.hpp"
 #include "oscar/dds_participant.hpp"
 #include "oscar/module.hpp"
+#include "oscar/topic_io.hpp"
+#include "oscar/topics.hpp"
 
 namespace oscar {
-
-/// Topic of a kernel's output channel.
-inline std::string cue_topic(const std::string& address) { return "oscar/cue/" + address; }
 
 class Module::Dds {
  public:
@@ -51,7 +50,6 @@ class Module::Dds {
  private:
   class CueReader;
   class OutputWriter;
-  class ConfigListener;
   /// A reader to make again, asking no more than the producer's writer offers.
   struct Refollow {
     InputPort* input;
@@ -74,11 +72,11 @@ class Module::Dds {
   std::mutex readers_mutex_;
   std::map<InputPort*, std::unique_ptr<CueReader>> readers_;
 
-  eprosima::fastdds::dds::DataWriter* state_writer_ = nullptr;
-  eprosima::fastdds::dds::DataWriter* reply_writer_ = nullptr;
-  eprosima::fastdds::dds::DataWriter* log_writer_ = nullptr;
-  eprosima::fastdds::dds::DataReader* config_reader_ = nullptr;
-  std::unique_ptr<ConfigListener> config_listener_;
+  // The configuration endpoints (topics::...), made by start_config().
+  std::unique_ptr<TopicWriter<ModuleState, ModuleStatePubSubType>> state_writer_;
+  std::unique_ptr<TopicWriter<ConfigReply, ConfigReplyPubSubType>> reply_writer_;
+  std::unique_ptr<TopicWriter<LogRecord, LogRecordPubSubType>> log_writer_;
+  std::unique_ptr<TopicReader<ConfigCommand, ConfigCommandPubSubType>> config_reader_;
   std::mutex queue_mutex_;
   std::condition_variable queue_cv_;
   std::deque<ConfigCommand> queue_;
@@ -86,7 +84,7 @@ class Module::Dds {
   std::map<std::string, ConfigReply> last_reply_;  // by sender: answers repeated commands
   bool serving_ = false;
   std::thread config_thread_;
-  eprosima::fastdds::dds::DataWriter* beat_writer_ = nullptr;
+  std::unique_ptr<TopicWriter<ModuleBeat, ModuleBeatPubSubType>> beat_writer_;
   std::thread beat_thread_;
 };
 

@@ -38,6 +38,34 @@ dds::DataReaderQos state_reader(int depth) {
   return q;
 }
 
+dds::DataWriterQos stream_writer(int depth) {
+  dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
+  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
+  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = depth;
+  q.endpoint().history_memory_policy = kDynamic;
+  return q;
+}
+
+dds::DataWriterQos command_writer() {
+  dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
+  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
+  q.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+  q.endpoint().history_memory_policy = kDynamic;
+  return q;
+}
+
+dds::DataReaderQos command_reader() {
+  dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
+  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
+  q.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+  q.endpoint().history_memory_policy = kDynamic;
+  return q;
+}
+
 dds::DataReaderQos stream_reader(int depth) {
   dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
   q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;

@@ -10,8 +10,10 @@
 
 #include <fmt/format.h>
 
+#include <oscar/command_line.hpp>
 #include "idl_texts.hpp"  // tools/record
 #include "idl_types.hpp"
+
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/registry/system_options.hpp"
 #include "raw_tap.hpp"

@@ -11,9 +11,12 @@
 
 #include <fmt/format.h>
 
+#include <oscar/command_line.hpp>
+
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/registry/system_options.hpp"
 #include "oscar/time.hpp"
+#include "oscar/topics.hpp"
 
 namespace {
 
@@ -71,12 +74,12 @@ std::string to_dot(const oscar::SystemState& s,
   }
   // Channels nobody consumes still show, from discovery.
   for (const auto& [topic, w] : writers) {
-    if (topic.rfind("oscar/cue/", 0) != 0) continue;
-    const auto source = topic.substr(10);
+    if (!oscar::topics::is_cue(topic)) continue;
+    const auto source = topic.substr(oscar::topics::kCuePrefix.size());
     if (kernels.count(source.substr(0, source.find('/')))) channels.insert(source);
   }
   for (const auto& c : channels) {
-    const auto w = writers.find("oscar/cue/" + c);
+    const auto w = writers.find(oscar::topics::cue(c));
     const auto type = w == writers.end() ? std::string("?") : w->second.type;
     dot += fmt::format("  {} [shape=ellipse, label={}];\n", quoted("c:" + c),
                        quoted(c + "\\n" + type));  // "kernel/channel": many are named "out"

@@ -10,6 +10,8 @@
 
 #include <fmt/format.h>
 
+#include <oscar/command_line.hpp>
+
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/registry/system_options.hpp"
 #include "raw_tap.hpp"

@@ -9,8 +9,11 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <oscar/command_line.hpp>
+
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/registry/system_options.hpp"
+#include "oscar/topics.hpp"
 #include "raw_tap.hpp"
 
 int main(int argc, char** argv) {
@@ -32,7 +35,7 @@ int main(int argc, char** argv) {
       std::lock_guard lock(mutex);
       ++counts[topic];
     });
-    const auto wanted = [&](const std::string& t) { return all || t.rfind("oscar/cue/", 0) == 0; };
+    const auto wanted = [&](const std::string& t) { return all || oscar::topics::is_cue(t); };
     // Discovery first (a quarter of the time), then count samples for the rest.
     const auto total = std::chrono::milliseconds(static_cast<long>(duration_s * 1000));
     const auto start = std::chrono::steady_clock::now();

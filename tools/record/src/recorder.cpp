@@ -19,6 +19,7 @@
 #include "idl_texts.hpp"
 #include "oscar/dds_participant.hpp"
 #include "oscar/mcap/writer.hpp"
+#include "oscar/topics.hpp"
 #include "raw_cdr_type.hpp"
 
 namespace oscar::record {
@@ -44,7 +45,7 @@ std::string split_name(const std::string& output, int index) {
 }  // namespace
 
 std::string topic_of(const std::string& argument) {
-  return argument.rfind("oscar/", 0) == 0 ? argument : "oscar/cue/" + argument;
+  return argument.rfind("oscar/", 0) == 0 ? argument : topics::cue(argument);
 }
 
 struct Recorder::Impl {
@@ -115,7 +116,7 @@ struct Recorder::Impl {
   }
 
   bool wanted(const std::string& topic) const {
-    if (o.all && topic.rfind("oscar/cue/", 0) == 0) return true;
+    if (o.all && topics::is_cue(topic)) return true;
     for (const auto& t : o.topics) {
       if (fnmatch(topic_of(t).c_str(), topic.c_str(), 0) == 0) return true;
     }
@@ -173,7 +174,7 @@ struct Recorder::Impl {
     }
     std::map<std::string, std::string> meta{{"type", t.type}, {"qos", t.qos}};
     // oscar/cue/<kernel>/<channel>
-    if (t.name.rfind("oscar/cue/", 0) == 0) {
+    if (topics::is_cue(t.name)) {
       const auto rest = t.name.substr(10);
       const auto slash = rest.find('/');
       meta["kernel"] = rest.substr(0, slash);

@@ -1,0 +1,65 @@
+#pragma once
+/// @file The topic catalogue: every topic OSCAR itself uses, with its name, its IDL type and the
+/// QoS of its writers and readers, defined once. Modules, the registry, the monitors, boot and
+/// the tools all take their endpoints from here, so the two sides of a topic cannot drift apart
+/// (docs/architecture.md, "Topics and QoS classes").
+///
+/// Cue topics are the one exception to "QoS defined here": a cue topic's QoS is the class its
+/// producing output declares (qos::cue_writer) and its readers follow it (qos::cue_reader).
+
+#include <chrono>
+#include <string>
+#include <string_view>
+
+#include <oscar/configPubSubTypes.h>
+#include <oscar/registryPubSubTypes.h>
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+
+namespace oscar {
+
+/// One topic: its name, its IDL type (`T`, with Fast DDS's type support `PubSubType`) and the
+/// QoS every writer and every reader of it uses.
+template <class T, class PubSubType>
+struct TopicSpec {
+  using Sample = T;
+  using TypeSupport = PubSubType;
+  std::string name;
+  eprosima::fastdds::dds::DataWriterQos writer_qos;
+  eprosima::fastdds::dds::DataReaderQos reader_qos;
+};
+
+namespace topics {
+
+/// "oscar/cue/": the prefix of every cue topic.
+inline constexpr std::string_view kCuePrefix = "oscar/cue/";
+/// The cue topic of output `address` ("kernel/channel"): "oscar/cue/kernel/channel".
+std::string cue(std::string_view address);
+/// True for a cue topic's name.
+bool is_cue(std::string_view topic);
+
+/// Configuration commands to `module` (reliable, keep all: no command is dropped).
+TopicSpec<ConfigCommand, ConfigCommandPubSubType> config(const std::string& module);
+/// `module`'s replies to configuration commands (state class, 64 deep: a client that matches
+/// late still gets its reply).
+TopicSpec<ConfigReply, ConfigReplyPubSubType> config_reply(const std::string& module);
+/// Every module's and tool's log records (a stream: reliable, volatile, 100 deep).
+TopicSpec<LogRecord, LogRecordPubSubType> log();
+/// Each module's announcement and state (state class: late joiners get the latest).
+TopicSpec<ModuleState, ModuleStatePubSubType> module_state();
+/// Each module's heartbeat, with liveliness `lease` (manual by topic).
+TopicSpec<ModuleBeat, ModuleBeatPubSubType> module_alive(std::chrono::milliseconds lease);
+/// Each monitor's heartbeat, with liveliness `lease`.
+TopicSpec<MonitorBeat, MonitorBeatPubSubType> monitor_alive(std::chrono::milliseconds lease);
+/// What the monitors saw of their processes: started, exited, failed to start (256 deep).
+TopicSpec<ProcessEvent, ProcessEventPubSubType> process_events();
+/// The registry's launch requests to the monitors.
+TopicSpec<LaunchRequest, LaunchRequestPubSubType> launch();
+/// Requests to the registry (restart, shutdown) and its replies.
+TopicSpec<RegistryRequest, RegistryRequestPubSubType> registry_request();
+TopicSpec<RegistryReply, RegistryReplyPubSubType> registry_reply();
+/// The whole system's state, as the registry publishes it (keep last 1).
+TopicSpec<SystemState, SystemStatePubSubType> system_state();
+
+}  // namespace topics
+}  // namespace oscar

@@ -1,0 +1,57 @@
+#include "oscar/topics.hpp"
+
+#include "oscar/topic_io.hpp"
+
+namespace oscar::topics {
+
+std::string cue(std::string_view address) { return std::string(kCuePrefix).append(address); }
+
+bool is_cue(std::string_view topic) { return topic.starts_with(kCuePrefix); }
+
+TopicSpec<ConfigCommand, ConfigCommandPubSubType> config(const std::string& module) {
+  return {"oscar/config/" + module, qos::command_writer(), qos::command_reader()};
+}
+
+TopicSpec<ConfigReply, ConfigReplyPubSubType> config_reply(const std::string& module) {
+  return {"oscar/config_reply/" + module, qos::state_writer(64), qos::state_reader(64)};
+}
+
+TopicSpec<LogRecord, LogRecordPubSubType> log() {
+  return {"oscar/log", qos::stream_writer(100), qos::stream_reader(100)};
+}
+
+TopicSpec<ModuleState, ModuleStatePubSubType> module_state() {
+  // Each module has a writer of its own that keeps its latest state; the registry's reader
+  // keeps the recent states of all.
+  return {"oscar/registry/module_state", qos::state_writer(1), qos::state_reader(64)};
+}
+
+TopicSpec<ModuleBeat, ModuleBeatPubSubType> module_alive(std::chrono::milliseconds lease) {
+  return {"oscar/registry/alive", qos::beat_writer(lease), qos::beat_reader(lease)};
+}
+
+TopicSpec<MonitorBeat, MonitorBeatPubSubType> monitor_alive(std::chrono::milliseconds lease) {
+  return {"oscar/registry/monitor", qos::beat_writer(lease), qos::beat_reader(lease)};
+}
+
+TopicSpec<ProcessEvent, ProcessEventPubSubType> process_events() {
+  return {"oscar/registry/process", qos::state_writer(256), qos::state_reader(256)};
+}
+
+TopicSpec<LaunchRequest, LaunchRequestPubSubType> launch() {
+  return {"oscar/registry/launch", qos::state_writer(64), qos::state_reader(64)};
+}
+
+TopicSpec<RegistryRequest, RegistryRequestPubSubType> registry_request() {
+  return {"oscar/registry/request", qos::state_writer(16), qos::state_reader(16)};
+}
+
+TopicSpec<RegistryReply, RegistryReplyPubSubType> registry_reply() {
+  return {"oscar/registry/reply", qos::state_writer(16), qos::state_reader(16)};
+}
+
+TopicSpec<SystemState, SystemStatePubSubType> system_state() {
+  return {"oscar/system/state", qos::state_writer(1), qos::state_reader(1)};
+}
+
+}  // namespace oscar::topics

@@ -1,0 +1,67 @@
+// The topic catalogue (oscar/topics.hpp): both sides of every topic take the catalogue's QoS, so
+// a writer and a reader made from one entry must match. A reader asking for more than the
+// writer offers (reliable from best effort, transient-local from volatile, a shorter lease)
+// would silently never match.
+#include "oscar/topics.hpp"
+
+#include <unistd.h>
+
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "oscar/testing/eventually.hpp"
+#include "oscar/topic_io.hpp"
+
+namespace oscar {
+namespace {
+using namespace std::chrono_literals;
+
+template <class T, class PubSubType>
+void expect_both_sides_match(DdsParticipant& p, const TopicSpec<T, PubSubType>& spec) {
+  TopicWriter<T, PubSubType> writer(p, spec);
+  TopicReader<T, PubSubType> reader(p, spec, [](const T&, const auto&) {});
+  EXPECT_TRUE(eventually([&] { return writer.matched() > 0 && reader.matched() > 0; }, 5s))
+      << spec.name << ": its writer and reader QoS do not match";
+}
+
+TEST(Topics, TheWriterAndReaderOfEveryCatalogueTopicMatch) {
+  DdsParticipant p(150 + getpid() % 50, "test:topics");
+  expect_both_sides_match(p, topics::config("m"));
+  expect_both_sides_match(p, topics::config_reply("m"));
+  expect_both_sides_match(p, topics::log());
+  expect_both_sides_match(p, topics::module_state());
+  expect_both_sides_match(p, topics::module_alive(300ms));
+  expect_both_sides_match(p, topics::monitor_alive(300ms));
+  expect_both_sides_match(p, topics::process_events());
+  expect_both_sides_match(p, topics::launch());
+  expect_both_sides_match(p, topics::registry_request());
+  expect_both_sides_match(p, topics::registry_reply());
+  expect_both_sides_match(p, topics::system_state());
+}
+
+TEST(Topics, EveryCatalogueTopicHasANameOfItsOwn) {
+  const std::set<std::string> names{topics::config("m").name,
+                                    topics::config_reply("m").name,
+                                    topics::log().name,
+                                    topics::module_state().name,
+                                    topics::module_alive(1s).name,
+                                    topics::monitor_alive(1s).name,
+                                    topics::process_events().name,
+                                    topics::launch().name,
+                                    topics::registry_request().name,
+                                    topics::registry_reply().name,
+                                    topics::system_state().name,
+                                    topics::cue("k/out")};
+  EXPECT_EQ(names.size(), 12u);
+}
+
+TEST(Topics, CueTopicsAreNamedAfterTheirOutput) {
+  EXPECT_EQ(topics::cue("cam/image"), "oscar/cue/cam/image");
+  EXPECT_TRUE(topics::is_cue("oscar/cue/cam/image"));
+  EXPECT_FALSE(topics::is_cue("oscar/config/cam"));
+  EXPECT_FALSE(topics::is_cue("oscar/cuex"));
+}
+
+}  // namespace
+}  // namespace oscar
