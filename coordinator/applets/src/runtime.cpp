@@ -110,8 +110,9 @@ RuntimeStats Runtime::stats() const {
   return stats_;
 }
 
-// The applet wrapper (seed §4.6.2 "Fail-Stop"): whatever the code throws ends this applet only;
-// its bundles are released and everything else goes on.
+// The applet wrapper (seed §4.6.2 "Fail-Stop"): whatever the code throws — a std::exception or
+// anything else (`throw 42`) — ends this applet only; its bundles are released and everything
+// else goes on.
 void Runtime::applet_main(AppletId id) {
   Slot& slot = *slots_[id];
   AppletContext ctx(*this, id);
@@ -145,7 +146,7 @@ void Runtime::applet_main(AppletId id) {
       slot.cv.wait_until(lock, next, [&] { return stopping_; });
       if (stopping_) return;
     }
-  } catch (const std::exception&) {
+  } catch (...) {  // the boundary of the applet: nothing may escape into the process
     std::unique_lock lock(mutex_);
     slot.crashed = true;
     stats_.crashed.push_back(scheduler_.model().applet(id).name);

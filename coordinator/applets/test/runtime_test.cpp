@@ -201,6 +201,35 @@ TEST(Runtime, CrashedAppletLosesItsResourcesAndNothingElseIsAffected) {
   EXPECT_EQ(rt.stats().crashed, std::vector<std::string>{"Bad"});
 }
 
+// The wrapper is the applet's boundary: a thrown value that is no std::exception ends the applet
+// too, not the process.
+TEST(Runtime, AppletThrowingANonStandardExceptionCrashesAloneAndLosesItsResources) {
+  Model m;
+  const ServiceId s = m.add_service("S");
+  m.add_bundle(m.add_applet("Bad"), "s", {{s, kX}}, kPriorityHigh);
+  m.add_bundle(m.add_applet("Waiting"), "s", {{s, kX}});
+  Runtime rt(m);
+  std::atomic<int> bad_steps{0}, waiting_uses{0};
+  rt.set_code("Bad", {[](AppletContext& c) { c.request("s"); },
+                      [&](AppletContext& c) {
+                        c.use("s", [&] {
+                          if (++bad_steps == 3) throw 42;
+                        });
+                      },
+                      {},
+                      2ms});
+  rt.set_code("Waiting", {[](AppletContext& c) { c.request("s"); },
+                          [&](AppletContext& c) { c.use("s", [&] { ++waiting_uses; }); },
+                          {},
+                          2ms});
+  rt.start();
+  ASSERT_TRUE(eventually([&] { return waiting_uses > 3; }));
+  EXPECT_TRUE(rt.crashed("Bad"));
+  EXPECT_EQ(bad_steps.load(), 3);
+  rt.stop();
+  EXPECT_EQ(rt.stats().crashed, std::vector<std::string>{"Bad"});
+}
+
 TEST(Runtime, HolderThatDoesNotYieldIsRevokedByForceAndToldWhoGetsIt) {
   Model m;
   const ServiceId s = m.add_service("S");
