@@ -113,11 +113,17 @@ std::string to_dot(const Scheduler& s) {
              "fillcolor=" + colour + ", label=" +
              quote(bundle.name + "\nprio " + priority_name(s.priority(b)) + "\n" + state) + "];\n";
     }
+    // A service applet's services start at its first bundle; one without bundles (its services
+    // need nothing) gets a node of its own, so no edge points at a bundle that is not drawn.
+    std::string provider = ap.bundles.empty() ? "a:" + ap.name
+                                              : "b:" + ap.name + "/" + m.bundle(ap.bundles[0]).name;
+    if (ap.bundles.empty() && !ap.provides.empty()) {
+      out += "    " + quote(provider) + " [shape=box, style=dashed, label=" +
+             quote(ap.name + "\nno bundles") + "];\n";
+    }
     out += "  }\n";
     for (ServiceId p : ap.provides) {
-      out += "  " +
-             quote("b:" + ap.name + "/" + m.bundle(ap.bundles.empty() ? 0 : ap.bundles[0]).name) +
-             " -> " + quote("s:" + m.service(p).name) +
+      out += "  " + quote(provider) + " -> " + quote("s:" + m.service(p).name) +
              " [dir=back, color=darkgreen, label=provides];\n";
     }
     for (BundleId b : ap.bundles) {
