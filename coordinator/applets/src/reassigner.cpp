@@ -201,11 +201,15 @@ Notification Scheduler::negotiate_with(ServiceId service, Reassignment::Giving& 
   };
   Notification n = notice(Notification::Kind::kNegotiationRejected, bundle, service);
   n.until = giving.until;
-  if (answer.accept && giving.rounds <= options_.negotiation_rounds_max) {
+  if (giving.rounds <= options_.negotiation_rounds_max) {
+    // The vote decides what the applet asks for (seed §4.5.3, §4.6.1): agreeing to the
+    // revocation, it takes max_needed if that fits, else min_needed (a compromise); objecting to
+    // it, it insists on keeping the bundle for max_needed, and the objection is upheld only if
+    // that fits. A rejected objection leaves the applet its on_reject round to offer less.
     std::optional<milliseconds> granted;
     if (fits(answer.max_needed)) {
       granted = answer.max_needed;
-    } else if (fits(answer.min_needed)) {
+    } else if (answer.accept && fits(answer.min_needed)) {
       granted = answer.min_needed;
     }
     if (granted) {

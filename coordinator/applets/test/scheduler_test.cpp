@@ -114,8 +114,10 @@ TEST(Scheduler, NegotiationExtendsTheWaitWithinTheRoundLimit) {
   auto n = s.negotiate(t.low, Negotiation{milliseconds{3000}, milliseconds{8000}, true});
   EXPECT_EQ(n.kind, Notification::Kind::kNegotiationAccepted);
   EXPECT_EQ(n.until, milliseconds{8000});
-  n = s.negotiate(t.low, Negotiation{milliseconds{0}, milliseconds{0}, false});
+  // An objection insisting on more than a round may grant is rejected (the wait stands).
+  n = s.negotiate(t.low, Negotiation{milliseconds{0}, milliseconds{30000}, false});
   EXPECT_EQ(n.kind, Notification::Kind::kNegotiationRejected);
+  EXPECT_EQ(n.until, milliseconds{8000});
   n = s.negotiate(t.low, Negotiation{milliseconds{100}, milliseconds{100}, true});
   EXPECT_EQ(n.kind, Notification::Kind::kNegotiationRejected);  // third round > 2
   s.advance_to(milliseconds{7999});
@@ -135,6 +137,44 @@ TEST(Scheduler, NegotiationCannotPassTheRoundLimitOrANewHoldersDeadline) {
   EXPECT_EQ(n.until, milliseconds{5000});  // min 1500 fits the deadline; the wait is longer
   n = s.negotiate(t.low, Negotiation{milliseconds{2500}, milliseconds{2500}, true});
   EXPECT_EQ(n.kind, Notification::Kind::kNegotiationRejected);  // latest start is 2000 ms
+}
+
+// Seed §4.5.3: a round carries a vote, agreeing to the revocation or objecting to it, and the
+// scheduler agrees to or rejects that round; an objection is negotiable like an agreement (it used
+// to be rejected whatever it asked for).
+TEST(Scheduler, ObjectionIsUpheldWhenTheTimeItInsistsOnFits) {
+  TwoApplets t;
+  SchedulerOptions o;
+  o.revoke_wait = milliseconds{1000};
+  Scheduler s(t.m, o);
+  s.request(t.low);
+  s.request(t.high);
+  auto n = s.negotiate(t.low, Negotiation{milliseconds{2000}, milliseconds{4000}, false});
+  EXPECT_EQ(n.kind, Notification::Kind::kNegotiationAccepted);
+  EXPECT_EQ(n.until, milliseconds{4000});
+  s.advance_to(milliseconds{3999});
+  EXPECT_TRUE(s.active(t.low));
+  EXPECT_FALSE(s.active(t.high));
+  s.advance_to(milliseconds{4000});
+  EXPECT_TRUE(s.active(t.high));
+}
+
+// What the vote says decides the outcome: with a new holder's latest start at 2000 ms only the
+// minimum fits, which an agreement accepts as a compromise and an objection does not offer.
+TEST(Scheduler, ObjectionAndAgreementAskingTheSameTimesDifferWhenOnlyTheMinimumFits) {
+  for (const bool accept : {true, false}) {
+    TwoApplets t;
+    Scheduler s(t.m);
+    s.request(t.low);
+    s.request(t.high);
+    s.set_deadline(t.high, Deadline{milliseconds{0}, milliseconds{1000}, milliseconds{3000}});
+    const auto n =
+        s.negotiate(t.low, Negotiation{milliseconds{1500}, milliseconds{6000}, accept});
+    EXPECT_EQ(n.kind, accept ? Notification::Kind::kNegotiationAccepted
+                             : Notification::Kind::kNegotiationRejected)
+        << "accept " << accept;
+    EXPECT_EQ(n.until, milliseconds{5000}) << "accept " << accept;  // the wait limit stands
+  }
 }
 
 TEST(Scheduler, PlanTakenBackCancelsTheRevocation) {

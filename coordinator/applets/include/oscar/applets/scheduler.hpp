@@ -30,7 +30,10 @@ struct SchedulerOptions {
 struct Negotiation {
   milliseconds min_needed{0};  ///< Least time the applet still needs the bundle.
   milliseconds max_needed{0};  ///< Most time it needs.
-  bool accept = false;         ///< Vote: agrees to the revocation (after the time it needs).
+  /// Vote: true agrees to the revocation after the time it needs (granted max_needed if that
+  /// fits, else min_needed); false objects to it (upheld with max_needed if that fits, else
+  /// rejected). Either way within the round limits and new holders' deadlines.
+  bool accept = false;
 };
 
 /// What the scheduler tells an applet; delivered through the applet's interrupt queue.
