@@ -3,6 +3,19 @@
 #include <algorithm>
 
 namespace oscar::applets {
+namespace {
+
+// Notices about taking a bundle away (seed §4.4.1, §4.5.3, §4.6.1): what an applet must not
+// answer with a new priority (footnote 11).
+bool is_revocation(Notification::Kind kind) {
+  return kind == Notification::Kind::kRevokeRequested ||
+         kind == Notification::Kind::kNegotiationAccepted ||
+         kind == Notification::Kind::kNegotiationRejected ||
+         kind == Notification::Kind::kRevokedByForce;
+}
+
+}  // namespace
+
 Runtime::Runtime(Model model, SchedulerOptions options)
     : scheduler_(std::move(model), options), start_(Clock::now()) {
   for (std::size_t a = 0; a < scheduler_.model().applets().size(); ++a) {
@@ -127,11 +140,13 @@ void Runtime::applet_main(AppletId id) {
         queue.swap(slot.interrupts);
       }
       for (const Notification& n : queue) {  // Abb. 4.12 line 4: interrupt handlers first
+        if (is_revocation(n.kind)) slot.reacting_to_revocation = n.bundle;
         if (slot.code.on_interrupt) {
           slot.code.on_interrupt(ctx, n);
         } else if (n.kind == Notification::Kind::kRevokeRequested) {
           ctx.yield(scheduler_.model().bundle(n.bundle).name);
         }
+        slot.reacting_to_revocation.reset();
       }
       run_negotiations(ctx);  // follow-up rounds run like interrupt handlers (§4.5.3)
       bool paused;
@@ -205,7 +220,9 @@ void Runtime::run_negotiations(AppletContext& ctx) {
       continue;
     }
     const auto next = chain.next;  // keeps the round alive while it runs
+    slot.reacting_to_revocation = bundle;
     run_round(ctx, bundle, *next);
+    slot.reacting_to_revocation.reset();
   }
 }
 

@@ -12,6 +12,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -78,6 +79,10 @@ class Runtime {
       int rounds = 0;
     };
     std::map<BundleId, Chain> negotiations;  // applet thread only
+    /// The bundle whose revocation the applet's code is reacting to (an interrupt handler for a
+    /// revocation notice, or a negotiation round), if any: no re-prioritising meanwhile (seed
+    /// §4.5.2, footnote 11). Applet thread only.
+    std::optional<BundleId> reacting_to_revocation;
     std::uint64_t steps = 0;                 // main-loop steps so far; applet thread only
     std::condition_variable cv;              // wakes this applet only (no thundering herd)
     std::thread thread;
