@@ -103,11 +103,13 @@ std::string to_dot(const Scheduler& s) {
           : s.active(b)     ? "active"
           : !s.requested(b) ? "idle"
           : plan.bundle_granted[b] ? "granted, waiting for hand-over"
-                                   : "blocked";
+          : s.deadline(b) && s.deadline(b)->t_early > plan.time
+              ? "blocked until t_early " + std::to_string(s.deadline(b)->t_early.count()) + " ms"
+              : "blocked";
       const std::string colour = revoke_by            ? "orange"
                                  : state == "idle"    ? "white"
                                  : state == "active"  ? "palegreen"
-                                 : state == "blocked" ? "lightgrey"
+                                 : state.rfind("blocked", 0) == 0 ? "lightgrey"
                                                       : "khaki";
       out += "    " + quote("b:" + ap.name + "/" + bundle.name) + " [shape=box, style=filled, " +
              "fillcolor=" + colour + ", label=" +

@@ -127,6 +127,10 @@ std::vector<Use> bundle_uses(const Model& model, BundleId b) {
 
 }  // namespace
 
+bool waits_for_t_early(const BundleState& state, std::chrono::milliseconds now) {
+  return state.requested && state.deadline && state.deadline->t_early > now;
+}
+
 bool deadlines_overlap(const Deadline& a, const Deadline& b, std::chrono::milliseconds c) {
   return std::min(a.t_early, b.t_early) + a.t_duration + b.t_duration + c >
          std::max(a.t_finish, b.t_finish);
@@ -135,9 +139,10 @@ bool deadlines_overlap(const Deadline& a, const Deadline& b, std::chrono::millis
 Plan calculate_assignments(const Model& model, const std::vector<BundleState>& state,
                            const std::vector<BundleId>& previous_order,
                            const std::vector<char>& previously_granted,
-                           std::chrono::milliseconds context_switch) {
+                           const PlanContext& context) {
   const std::size_t n = model.bundles().size();
   Plan plan;
+  plan.time = context.now;
   plan.bundle_granted.assign(n, 0);
   plan.resource_granted.assign(model.resources().size(), 0);
   plan.effective_priority.assign(n, 0);
@@ -187,9 +192,11 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
     return held(a) && !held(b);
   });
 
-  // Abb. 4.19 step 3: greedy from the highest priority down.
+  // Abb. 4.19 step 3: greedy from the highest priority down; a bundle before its t_early waits
+  // (§4.5.1), keeping its place for the plan at t_early.
   Assignment assignment(model);
   for (BundleId b : plan.order) {
+    if (waits_for_t_early(state[b], context.now)) continue;
     if (assignment.try_grant(bundle_uses(model, b), b)) plan.bundle_granted[b] = 1;
   }
   plan.uses = assignment.take_uses();
@@ -213,7 +220,8 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
   for (const auto& [prio, list] : by_priority) {
     for (std::size_t i = 0; i < list.size(); ++i) {
       for (std::size_t j = i + 1; j < list.size(); ++j) {
-        if (deadlines_overlap(*state[list[i]].deadline, *state[list[j]].deadline, context_switch)) {
+        if (deadlines_overlap(*state[list[i]].deadline, *state[list[j]].deadline,
+                              context.context_switch)) {
           plan.deadline_overlaps.emplace_back(std::min(list[i], list[j]),
                                               std::max(list[i], list[j]));
         }

@@ -91,8 +91,8 @@ void Runtime::locked_call(const std::function<void(Scheduler&)>& f) {
   scheduler_.advance_to(std::max(scheduler_.now(), clock()));
   f(scheduler_);
   deliver();
-  // Wake the force thread only for an earlier wait limit than it waits for (not on every call).
-  const auto next = scheduler_.next_forced_revocation();
+  // Wake the clock thread only for an earlier event than it waits for (not on every call).
+  const auto next = scheduler_.next_event();
   if (next && *next < forcing_at_) changed_.notify_all();
 }
 
@@ -226,11 +226,12 @@ void Runtime::run_negotiations(AppletContext& ctx) {
   }
 }
 
-// Lets the reassigners revoke by force when a wait limit passes (seed §4.6.1).
+// Follows the clock: the reassigners revoke by force when a wait limit passes (seed §4.6.1),
+// requests expire at t_finish and are planned at t_early (§4.5.1).
 void Runtime::reassigner_main() {
   std::unique_lock lock(mutex_);
   while (!stopping_) {
-    forcing_at_ = scheduler_.next_forced_revocation().value_or(milliseconds::max());
+    forcing_at_ = scheduler_.next_event().value_or(milliseconds::max());
     if (forcing_at_ == milliseconds::max()) {
       changed_.wait(lock);
     } else {

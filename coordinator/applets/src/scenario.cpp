@@ -157,6 +157,9 @@ std::string note(const Model& m, const Notification& n) {
       return who + ": negotiation rejected, yield by " + std::to_string(n.until.count()) + " ms";
     case Notification::Kind::kRevokedByForce:
       return who + ": revoked by force";
+    case Notification::Kind::kDeadlineExpired:
+      return who + ": deadline expired (t_finish " + std::to_string(n.until.count()) +
+             " ms), request withdrawn";
     case Notification::Kind::kDeadlineOverlap:
       return who + ": deadline overlaps " + m.applet(m.bundle(*n.other).applet).name + "/" +
              m.bundle(*n.other).name;
@@ -237,9 +240,25 @@ std::vector<StepResult> Scenario::run(Scheduler* final_state) const {
   for (BundleId b : system_.requested_at_start) sched.request(b);
   std::vector<StepResult> out;
   const Model& m = sched.model();
+  // Applets following the seed's conventions yield between two main-loop steps; on the logical
+  // clock that is at once.
+  auto yield_revoked = [&] {
+    for (BundleId b = 0; auto_yield_ && b < m.bundles().size(); ++b) {
+      if (sched.revoke_deadline(b)) sched.yield(b);
+    }
+  };
+  // The clock moves from event to event (a t_early reached, a t_finish passed, a wait limit), so
+  // that what they revoke is yielded at that time, as it is after an action.
+  auto advance = [&](milliseconds t) {
+    for (auto next = sched.next_event(); next && *next <= t; next = sched.next_event()) {
+      sched.advance_to(std::max(sched.now(), *next));
+      yield_revoked();
+    }
+    sched.advance_to(t);
+  };
   for (const Step& step : steps_) {
     try {
-      if (step.t) sched.advance_to(*step.t);
+      if (step.t) advance(*step.t);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(step.where + ": " + e.what());
     }
@@ -269,7 +288,7 @@ std::vector<StepResult> Scenario::run(Scheduler* final_state) const {
             sched.crash(a.applet);
             break;
           case Action::Kind::kAdvance:
-            sched.advance_to(sched.now() + a.advance);
+            advance(sched.now() + a.advance);
             break;
           case Action::Kind::kNegotiate:
             sched.negotiate(a.bundle, a.negotiation);
@@ -278,11 +297,7 @@ std::vector<StepResult> Scenario::run(Scheduler* final_state) const {
       } catch (const std::invalid_argument& e) {
         throw std::invalid_argument(a.where + ": " + e.what());
       }
-      // Applets following the seed's conventions yield between two main-loop steps; on the
-      // logical clock that is at once.
-      for (BundleId b = 0; auto_yield_ && b < m.bundles().size(); ++b) {
-        if (sched.revoke_deadline(b)) sched.yield(b);
-      }
+      yield_revoked();
     }
     StepResult r;
     r.label = step.label;

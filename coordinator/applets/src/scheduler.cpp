@@ -137,7 +137,7 @@ void Scheduler::crash(AppletId applet) {
 
 void Scheduler::replan() {
   Plan next = calculate_assignments(model_, state_, plan_.order, plan_.bundle_granted,
-                                    options_.context_switch);
+                                    PlanContext{now_, options_.context_switch});
   ++plans_;
   for (const auto& pair : next.deadline_overlaps) {
     if (std::binary_search(plan_.deadline_overlaps.begin(), plan_.deadline_overlaps.end(), pair)) {
@@ -168,7 +168,8 @@ std::string Scheduler::holder(ServiceId service) const {
   }
   if (!uses.empty()) return "blocked";  // held up by a service that depends on it
   for (BundleId b = 0; b < state_.size(); ++b) {
-    if (!state_[b].requested) continue;
+    // A request waiting for its t_early asks for nothing yet.
+    if (!state_[b].requested || waits_for_t_early(state_[b], plan_.time)) continue;
     for (ResourceId r : model_.bundle(b).resources) {
       if (model_.resource(r).service == service) return "blocked";
     }

@@ -289,6 +289,33 @@ TEST(Runtime, ReprioritisingInReactionToARevocationIsRefused) {
   EXPECT_THAT(refused[1], ::testing::HasSubstr("applet 'Holder' triggers bundle 's'"));
 }
 
+// The runtime's clock thread plans again at a reservation's t_early: the bundle is granted then,
+// with nothing else happening, and not before (the grant is stamped with the scheduler's time).
+TEST(Runtime, ReservationIsGrantedAtItsEarliestStartWithoutAnyOtherCall) {
+  Model m;
+  const ServiceId s = m.add_service("S");
+  m.add_bundle(m.add_applet("Later"), "s", {{s, kX}});
+  Runtime rt(m);
+  std::atomic<long long> granted_at{-1}, t_early{-1};
+  rt.set_code("Later",
+              {[&](AppletContext& c) {
+                 milliseconds now{0};
+                 rt.with_scheduler([&](Scheduler& sch) { now = sch.now(); });
+                 t_early = (now + 300ms).count();
+                 c.set_deadline("s", Deadline{now + 300ms, 100ms, now + 10s});
+                 c.request("s");
+               },
+               [](AppletContext&) {},
+               [&](AppletContext&, const Notification& n) {
+                 if (n.kind == Notification::Kind::kGranted) granted_at = n.until.count();
+               },
+               2ms});
+  rt.start();
+  ASSERT_TRUE(eventually([&] { return granted_at >= 0; }));
+  rt.stop();
+  EXPECT_GE(granted_at.load(), t_early.load());
+}
+
 TEST(Runtime, HolderThatDoesNotYieldIsRevokedByForceAndToldWhoGetsIt) {
   Model m;
   const ServiceId s = m.add_service("S");

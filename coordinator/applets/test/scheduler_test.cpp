@@ -177,6 +177,70 @@ TEST(Scheduler, ObjectionAndAgreementAskingTheSameTimesDifferWhenOnlyTheMinimumF
   }
 }
 
+// Seed §4.5.1: a deadline (t_early, t_duration, t_finish) asks for access from t_early on. A
+// reservation for 5000-6000 ms made at 0 ms took the service at once; now it takes nothing
+// before 5000 ms, and the plan at 5000 ms grants it (EDF puts it before a request without one).
+TEST(Scheduler, ReservationForALaterTimeIsGrantedFromItsEarliestStartOn) {
+  Model m;
+  const ServiceId svc = m.add_service("S");
+  const BundleId later = m.add_bundle(m.add_applet("Later"), "s", {{svc, kX}});
+  const BundleId now = m.add_bundle(m.add_applet("Now"), "s", {{svc, kX}});
+  Scheduler s(m);
+  s.set_deadline(later, Deadline{milliseconds{5000}, milliseconds{1000}, milliseconds{6000}});
+  s.request(later);
+  EXPECT_FALSE(s.plan().bundle_granted[later]);
+  EXPECT_FALSE(s.active(later));
+  EXPECT_EQ(s.holder(svc), "undef");  // nobody asks for it yet
+  s.request(now);
+  EXPECT_TRUE(s.active(now));  // the reservation takes nothing from others before its time
+  EXPECT_EQ(s.next_event(), milliseconds{5000});
+  s.advance_to(milliseconds{4999});
+  EXPECT_FALSE(s.plan().bundle_granted[later]);
+  const auto plans = s.plans_computed();
+  s.advance_to(milliseconds{5000});
+  EXPECT_EQ(s.plans_computed(), plans + 1);  // a new plan at t_early
+  EXPECT_TRUE(s.plan().bundle_granted[later]);
+  EXPECT_EQ(s.revoke_deadline(now), milliseconds{10000});  // given back from 5000 ms on
+  s.yield(now);
+  EXPECT_TRUE(s.active(later));
+}
+
+// Seed §4.5.1: t_finish is the latest end of the access. When it passes, the request is withdrawn
+// and the applet told (kDeadlineExpired): a waiting request is dropped, a bundle in use is given
+// back through its reassigners like any other.
+TEST(Scheduler, RequestExpiresWhenItsFinishPasses) {
+  Model m;
+  const ServiceId a = m.add_service("A");
+  const ServiceId b = m.add_service("B");
+  const BundleId holder = m.add_bundle(m.add_applet("Holder"), "a", {{a, kX}}, kPriorityHigh);
+  const BundleId waiting = m.add_bundle(m.add_applet("Waiting"), "a", {{a, kX}});
+  const BundleId using_b = m.add_bundle(m.add_applet("User"), "b", {{b, kX}});
+  Scheduler s(m);
+  s.request(holder);
+  s.request(waiting);
+  s.set_deadline(waiting, Deadline{milliseconds{0}, milliseconds{1000}, milliseconds{3000}});
+  s.request(using_b);
+  s.set_deadline(using_b, Deadline{milliseconds{0}, milliseconds{100}, milliseconds{2000}});
+  EXPECT_TRUE(s.active(using_b));
+  s.take_notifications();
+  s.advance_to(milliseconds{2500});
+  EXPECT_FALSE(s.requested(using_b));
+  EXPECT_TRUE(s.revoke_deadline(using_b).has_value());  // still in use until it yields
+  auto notes = s.take_notifications();
+  ASSERT_GE(notes.size(), 2u);
+  EXPECT_EQ(notes[0].kind, Notification::Kind::kDeadlineExpired);
+  EXPECT_EQ(notes[0].bundle, using_b);
+  EXPECT_EQ(notes[0].until, milliseconds{2000});
+  EXPECT_EQ(notes[1].kind, Notification::Kind::kRevokeRequested);
+  EXPECT_EQ(notes[1].until, milliseconds{7000});  // the wait started at 2000 ms, not 2500 ms
+  EXPECT_TRUE(s.requested(waiting));
+  s.advance_to(milliseconds{3000});
+  EXPECT_FALSE(s.requested(waiting));
+  EXPECT_FALSE(s.deadline(waiting).has_value());
+  s.release(holder);
+  EXPECT_EQ(s.holder(a), "undef");  // the expired request is not granted later
+}
+
 TEST(Scheduler, PlanTakenBackCancelsTheRevocation) {
   TwoApplets t;
   Scheduler s(t.m);

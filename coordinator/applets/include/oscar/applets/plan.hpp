@@ -34,8 +34,18 @@ struct GrantedUse {
   BundleId root = 0;
 };
 
+/// What a plan needs besides the bundles' state.
+struct PlanContext {
+  /// The time the plan is made for: a bundle whose deadline's t_early lies after it is not
+  /// considered yet (seed §4.5.1: access from the earliest start on); a plan at t_early grants it.
+  std::chrono::milliseconds now{0};
+  std::chrono::milliseconds context_switch{0};  ///< c of eq. 4.9–4.11.
+};
+
 /// The result of one plan.
 struct Plan {
+  /// The time it was made for (PlanContext::now).
+  std::chrono::milliseconds time{0};
   /// The sorted working set W_t (requested bundles); the next plan starts from it.
   std::vector<BundleId> order;
   std::vector<char> bundle_granted;           ///< Per bundle: all its resources are granted.
@@ -50,12 +60,17 @@ struct Plan {
 /// Computes the plan (seed Abb. 4.19): the working set `previous_order` extended by new requests,
 /// stably sorted by priority (descending; a triggered bundle just above its level), then EDF on
 /// the relative deadline, then held bundles first; walked greedily, each bundle granted with
-/// everything it needs down the service hierarchy (priority inheritance) or not at all.
+/// everything it needs down the service hierarchy (priority inheritance) or not at all. A
+/// requested bundle whose t_early lies after `context.now` keeps its place in the working set
+/// but is not granted (it waits, taking nothing from others).
 /// Runs in O(n log n) for n bundles when the service hierarchy is bounded.
 Plan calculate_assignments(const Model& model, const std::vector<BundleState>& state,
                            const std::vector<BundleId>& previous_order,
                            const std::vector<char>& previously_granted,
-                           std::chrono::milliseconds context_switch = std::chrono::milliseconds{0});
+                           const PlanContext& context = {});
+
+/// Whether a bundle's request waits for its earliest start: t_early later than `now`.
+bool waits_for_t_early(const BundleState& state, std::chrono::milliseconds now);
 
 /// Whether a new use of `service` with `access` could be granted beside `plan` (with all it needs).
 bool can_grant(const Model& model, const Plan& plan, ServiceId service, Access access);

@@ -45,6 +45,9 @@ struct Notification {
     kNegotiationRejected,  ///< No more time; yield before `until`.
     kRevokedByForce,       ///< The wait limit passed: the bundle is gone.
     kDeadlineOverlap,      ///< Its deadline overlaps `other`'s (eq. 4.11); best effort.
+    /// t_finish (`until`) passed: the access window is over, the request is withdrawn (a bundle
+    /// still in use is given back through its reassigners like any other).
+    kDeadlineExpired,
   };
   Kind kind = Kind::kGranted;
   AppletId applet = 0;
@@ -79,7 +82,9 @@ class Scheduler {
   const SchedulerOptions& options() const { return options_; }
   milliseconds now() const { return now_; }
 
-  /// Moves the logical clock forward and revokes by force where the wait limit passed.
+  /// Moves the logical clock forward. What falls due on the way happens at its own time, in
+  /// order: requests whose t_finish passed expire (kDeadlineExpired), requests whose t_early is
+  /// reached are planned (a new plan), wait limits that passed revoke by force.
   /// @throws std::invalid_argument if `t` lies before now().
   void advance_to(milliseconds t);
 
@@ -92,7 +97,8 @@ class Scheduler {
   void yield(BundleId bundle);
   /// Changes a bundle's priority. @throws std::invalid_argument if negative.
   void set_priority(BundleId bundle, int priority);
-  /// Sets or clears a deadline (eq. 4.9–4.10 with the context-switch time).
+  /// Sets or clears a deadline (eq. 4.9–4.10 with the context-switch time). The bundle is not
+  /// granted before t_early, and its request expires at t_finish (seed §4.5.1).
   /// @throws std::invalid_argument naming the violated inequality.
   void set_deadline(BundleId bundle, std::optional<Deadline> deadline);
   /// Raises a requested bundle just above its priority level for one plan, then restores it
@@ -115,10 +121,16 @@ class Scheduler {
   std::optional<milliseconds> revoke_deadline(BundleId bundle) const;
   /// The earliest wait limit of any running reassigner (when advance_to next revokes by force).
   std::optional<milliseconds> next_forced_revocation() const;
+  /// The earliest time at which advance_to changes something: a forced revocation, a t_early
+  /// reached or a t_finish passed. The threaded Runtime wakes then.
+  std::optional<milliseconds> next_event() const;
   /// The reassigner of a service; `giving` is empty when none runs.
   const Reassignment& reassignment(ServiceId service) const { return reassigners_.at(service); }
   bool requested(BundleId bundle) const { return state_.at(bundle).requested; }
   int priority(BundleId bundle) const { return state_.at(bundle).priority; }
+  const std::optional<Deadline>& deadline(BundleId bundle) const {
+    return state_.at(bundle).deadline;
+  }
 
   /// The planned holder of a service for people: applet names (sorted, joined by ','), "blocked"
   /// (requested but not granted, or held up by a dependency) or "undef" (nobody asked).
@@ -147,6 +159,8 @@ class Scheduler {
   Notification notice(Notification::Kind kind, BundleId bundle,
                       std::optional<ServiceId> service = std::nullopt) const;
   void replan();
+  // Expiries, t_early reached and forced revocations due at now_.
+  void handle_due();
   void update_handover();
   const std::vector<FootUse>& footprint(BundleId bundle) const;
   const std::vector<ServiceId>& services_of(BundleId bundle) const;
