@@ -12,8 +12,9 @@ namespace {
 // half-way leaves no trace (all or nothing, seed Abb. 4.6 and 4.9).
 class Assignment {
  public:
-  explicit Assignment(const Model& model)
+  Assignment(const Model& model, const std::vector<char>& unavailable)
       : model_(model),
+        unavailable_(unavailable),
         uses_(model.services().size()),
         exclusive_(model.services().size(), 0),
         expanded_(model.services().size(), 0),
@@ -69,6 +70,7 @@ class Assignment {
   bool use(const Use& u, BundleId root) {
     const bool by_resource = u.by == Use::By::kResource;
     if (by_resource && resource_used_[u.holder]) return true;
+    if (u.service < unavailable_.size() && unavailable_[u.service]) return false;
     auto& list = uses_[u.service];
     if (exclusive_[u.service]) return false;
     if (u.access == Access::kExclusive && !list.empty()) return false;
@@ -109,6 +111,7 @@ class Assignment {
   }
 
   const Model& model_;
+  const std::vector<char>& unavailable_;
   std::vector<std::vector<GrantedUse>> uses_;
   std::vector<char> exclusive_;
   std::vector<char> expanded_;
@@ -143,6 +146,7 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
   const std::size_t n = model.bundles().size();
   Plan plan;
   plan.time = context.now;
+  plan.unavailable = context.unavailable;
   plan.bundle_granted.assign(n, 0);
   plan.resource_granted.assign(model.resources().size(), 0);
   plan.effective_priority.assign(n, 0);
@@ -194,7 +198,7 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
 
   // Abb. 4.19 step 3: greedy from the highest priority down; a bundle before its t_early waits
   // (§4.5.1), keeping its place for the plan at t_early.
-  Assignment assignment(model);
+  Assignment assignment(model, plan.unavailable);
   for (BundleId b : plan.order) {
     if (waits_for_t_early(state[b], context.now)) continue;
     if (assignment.try_grant(bundle_uses(model, b), b)) plan.bundle_granted[b] = 1;
@@ -233,7 +237,7 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
 }
 
 bool can_grant(const Model& model, const Plan& plan, ServiceId service, Access access) {
-  Assignment assignment(model);
+  Assignment assignment(model, plan.unavailable);
   for (const auto& list : plan.uses) {
     for (const GrantedUse& g : list) assignment.add_existing(g);
   }

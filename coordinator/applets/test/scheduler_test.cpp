@@ -295,5 +295,51 @@ TEST(Scheduler, CrashReleasesOnlyTheCrashedAppletsBundles) {
   EXPECT_FALSE(s.requested(ba));
 }
 
+// Seed §4.6.1 (cascading effects): when a service applet crashes, its services are gone. Its
+// resources used to be granted again through inheritance, and the users of its service kept
+// their grant; now the users lose it at once (told, naming the service), keep their request,
+// and what the service applet held is free for others.
+TEST(Scheduler, CrashedServiceAppletsServicesBecomeUnavailableAndTheirUsersLoseThem) {
+  Model m;
+  const ServiceId monitor = m.add_service("Monitor", true);
+  const ServiceId ui = m.add_service("UI", true);
+  const ServiceId menu_view = m.add_service("MenuView");
+  m.add_dependency(menu_view, ui);  // down the hierarchy: MenuView needs UI
+  const AppletId provider = m.add_applet("UIService");
+  m.provide(provider, ui);
+  const BundleId io = m.add_bundle(provider, "io", {{monitor, kX}});
+  const BundleId menu = m.add_bundle(m.add_applet("Menu"), "ui", {{ui, kX}}, kPriorityHigh);
+  const BundleId viewer = m.add_bundle(m.add_applet("Viewer"), "v", {{menu_view, kX}});
+  const BundleId screen = m.add_bundle(m.add_applet("Screen"), "m", {{monitor, kX}}, kPriorityLow);
+  Scheduler s(m);
+  s.request(menu);
+  s.request(screen);
+  EXPECT_TRUE(s.active(menu));
+  EXPECT_TRUE(s.active(io));      // inherited
+  EXPECT_FALSE(s.active(screen));  // the service applet holds the monitor
+  s.take_notifications();
+  s.crash(provider);
+  EXPECT_TRUE(s.crashed(provider));
+  EXPECT_FALSE(s.available(ui));
+  EXPECT_FALSE(s.active(menu));
+  EXPECT_TRUE(s.requested(menu));
+  EXPECT_FALSE(s.plan().bundle_granted[io]);
+  EXPECT_FALSE(s.active(io));
+  EXPECT_EQ(s.holder(ui), "unavailable");
+  EXPECT_TRUE(s.active(screen));  // the monitor is free again
+  EXPECT_EQ(s.holder(monitor), "Screen");
+  bool told = false;
+  for (const Notification& n : s.take_notifications()) {
+    told = told || (n.kind == Notification::Kind::kRevokedByForce && n.bundle == menu &&
+                    n.service == ui);
+  }
+  EXPECT_TRUE(told);
+  s.request(viewer);  // needs UI down the hierarchy: cannot be granted
+  EXPECT_FALSE(s.plan().bundle_granted[viewer]);
+  EXPECT_EQ(s.holder(menu_view), "blocked");
+  EXPECT_THAT(error_of([&] { s.request(io); }),
+              HasSubstr("applet 'UIService' requests bundle 'io' but it crashed"));
+}
+
 }  // namespace
 }  // namespace oscar::applets

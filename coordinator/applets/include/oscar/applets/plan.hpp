@@ -40,6 +40,9 @@ struct PlanContext {
   /// considered yet (seed §4.5.1: access from the earliest start on); a plan at t_early grants it.
   std::chrono::milliseconds now{0};
   std::chrono::milliseconds context_switch{0};  ///< c of eq. 4.9–4.11.
+  /// Per service (or empty: none): the service is gone (its service applet crashed); nothing
+  /// that needs it can be granted (seed §4.6.1, cascading effects).
+  std::vector<char> unavailable;
 };
 
 /// The result of one plan.
@@ -55,6 +58,8 @@ struct Plan {
   std::vector<std::pair<BundleId, BundleId>> deadline_overlaps;
   /// Per bundle: the priority it was sorted with (cycles take their highest, seed §4.5.1).
   std::vector<int> effective_priority;
+  /// PlanContext::unavailable, kept for can_grant.
+  std::vector<char> unavailable;
 };
 
 /// Computes the plan (seed Abb. 4.19): the working set `previous_order` extended by new requests,
@@ -72,7 +77,8 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
 /// Whether a bundle's request waits for its earliest start: t_early later than `now`.
 bool waits_for_t_early(const BundleState& state, std::chrono::milliseconds now);
 
-/// Whether a new use of `service` with `access` could be granted beside `plan` (with all it needs).
+/// Whether a new use of `service` with `access` could be granted beside `plan` (with all it needs,
+/// none of it unavailable).
 bool can_grant(const Model& model, const Plan& plan, ServiceId service, Access access);
 
 /// Eq. 4.11 with the context-switch time c: min(t_early) + d_i + d_j + c > max(t_finish).

@@ -89,7 +89,8 @@ class Scheduler {
   void advance_to(milliseconds t);
 
   /// Asks for a bundle (again). @throws std::invalid_argument if another requested bundle of the
-  /// same applet uses one of its services and either asks for exclusive access.
+  /// same applet uses one of its services and either asks for exclusive access, or if the
+  /// applet crashed.
   void request(BundleId bundle);
   /// Gives a bundle back and withdraws the request.
   void release(BundleId bundle);
@@ -104,8 +105,15 @@ class Scheduler {
   /// Raises a requested bundle just above its priority level for one plan, then restores it
   /// (seed §4.5.2, Abb. 4.18). @throws std::invalid_argument if the bundle is not requested.
   void trigger(BundleId bundle);
-  /// An applet crashed: all its bundles are released at once, nothing else is touched.
+  /// An applet crashed (seed §4.6.1): all its bundles are released at once, and the services it
+  /// provides become unavailable for good — the bundles using them (directly or down the
+  /// hierarchy) lose them at once (kRevokedByForce naming the service) and keep their request,
+  /// which cannot be granted while the service is gone. Nothing else is touched.
   void crash(AppletId applet);
+  /// Whether the applet crashed.
+  bool crashed(AppletId applet) const { return crashed_.at(applet) != 0; }
+  /// Whether the service can be used: false once its service applet crashed.
+  bool available(ServiceId service) const { return plan_context_.unavailable.at(service) == 0; }
   /// An applet answers a revocation: every reassigner taking a service of the bundle decides on
   /// its own (it gets one notification per service). Returns the summary: accepted if all
   /// accepted, `until` the earliest time by which the bundle must be yielded.
@@ -133,7 +141,8 @@ class Scheduler {
   }
 
   /// The planned holder of a service for people: applet names (sorted, joined by ','), "blocked"
-  /// (requested but not granted, or held up by a dependency) or "undef" (nobody asked).
+  /// (requested but not granted, or held up by a dependency), "unavailable" (its service applet
+  /// crashed) or "undef" (nobody asked).
   std::string holder(ServiceId service) const;
   /// Who may use a service right now (handed over, seed Abb. 4.2): applet names joined by ',',
   /// or "none". Differs from holder() while a reassignment is under way.
@@ -183,6 +192,8 @@ class Scheduler {
   std::vector<char> active_;
   std::vector<char> revoking_;             // per bundle: in some reassigner's `giving`
   std::vector<Reassignment> reassigners_;  // per service
+  std::vector<char> crashed_;              // per applet
+  PlanContext plan_context_;               // unavailable: per service
   std::vector<Notification> notifications_;
   std::uint64_t plans_ = 0;
   mutable std::vector<std::optional<std::vector<FootUse>>> footprint_cache_;  // sorted by service
