@@ -106,22 +106,22 @@ std::string to_dot(const Scheduler& s) {
           : s.deadline(b) && s.deadline(b)->t_early > plan.time
               ? "blocked until t_early " + std::to_string(s.deadline(b)->t_early.count()) + " ms"
               : "blocked";
-      const std::string colour = revoke_by            ? "orange"
-                                 : state == "idle"    ? "white"
-                                 : state == "active"  ? "palegreen"
+      const std::string colour = revoke_by                        ? "orange"
+                                 : state == "idle"                ? "white"
+                                 : state == "active"              ? "palegreen"
                                  : state.rfind("blocked", 0) == 0 ? "lightgrey"
-                                                      : "khaki";
+                                                                  : "khaki";
       out += "    " + quote("b:" + ap.name + "/" + bundle.name) + " [shape=box, style=filled, " +
              "fillcolor=" + colour + ", label=" +
              quote(bundle.name + "\nprio " + priority_name(s.priority(b)) + "\n" + state) + "];\n";
     }
     // A service applet's services start at its first bundle; one without bundles (its services
     // need nothing) gets a node of its own, so no edge points at a bundle that is not drawn.
-    std::string provider = ap.bundles.empty() ? "a:" + ap.name
-                                              : "b:" + ap.name + "/" + m.bundle(ap.bundles[0]).name;
+    std::string provider =
+        ap.bundles.empty() ? "a:" + ap.name : "b:" + ap.name + "/" + m.bundle(ap.bundles[0]).name;
     if (ap.bundles.empty() && !ap.provides.empty()) {
-      out += "    " + quote(provider) + " [shape=box, style=dashed, label=" +
-             quote(ap.name + "\nno bundles") + "];\n";
+      out += "    " + quote(provider) +
+             " [shape=box, style=dashed, label=" + quote(ap.name + "\nno bundles") + "];\n";
     }
     out += "  }\n";
     for (ServiceId p : ap.provides) {

@@ -162,7 +162,7 @@ std::optional<milliseconds> Scheduler::next_event() const {
   };
   for (const BundleState& b : state_) {
     if (!b.requested || !b.deadline) continue;
-    consider(b.deadline->t_finish);                                    // expiry
+    consider(b.deadline->t_finish);                                       // expiry
     if (waits_for_t_early(b, plan_.time)) consider(b.deadline->t_early);  // planned then
   }
   return next;

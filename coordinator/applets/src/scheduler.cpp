@@ -147,8 +147,8 @@ void Scheduler::crash(AppletId applet) {
   for (BundleId b = 0; b < state_.size(); ++b) {
     if (!active_[b]) continue;
     const auto& services = services_of(b);
-    const auto lost = std::find_if(services.begin(), services.end(),
-                                   [&](ServiceId s) { return gone[s] != 0; });
+    const auto lost =
+        std::find_if(services.begin(), services.end(), [&](ServiceId s) { return gone[s] != 0; });
     if (lost == services.end()) continue;
     stop_giving(b);
     active_[b] = 0;

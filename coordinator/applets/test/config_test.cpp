@@ -149,18 +149,20 @@ timeline:
               HasSubstr("sys.yaml:4: step: 'priority' beside 'do'"));
   EXPECT_THAT(error_of(sys + "  - {request: A/b, trigger: maybe}\n"),
               HasSubstr("sys.yaml:4: trigger must be true or false"));
-  EXPECT_THAT(error_of(sys + "  - {foo_ms: 3}\n"), HasSubstr("sys.yaml:4: step: unknown key 'foo_ms'"));
+  EXPECT_THAT(error_of(sys + "  - {foo_ms: 3}\n"),
+              HasSubstr("sys.yaml:4: step: unknown key 'foo_ms'"));
 }
 
 // A scalar where a list belongs used to read as an empty list (provides: S provided nothing).
 TEST(Config, ScalarWhereAListBelongsIsAnError) {
-  EXPECT_THAT(error_of(R"(services: [{name: S}]
+  EXPECT_THAT(
+      error_of(R"(services: [{name: S}]
 applets:
   - name: A
     provides: S
 timeline: []
 )"),
-              HasSubstr("sys.yaml:4: applet 'A': provides must be a list of services, such as [UI]"));
+      HasSubstr("sys.yaml:4: applet 'A': provides must be a list of services, such as [UI]"));
   EXPECT_THAT(error_of(R"(services: [{name: S}]
 applets:
   - name: A

@@ -297,19 +297,18 @@ TEST(Runtime, ReservationIsGrantedAtItsEarliestStartWithoutAnyOtherCall) {
   m.add_bundle(m.add_applet("Later"), "s", {{s, kX}});
   Runtime rt(m);
   std::atomic<long long> granted_at{-1}, t_early{-1};
-  rt.set_code("Later",
-              {[&](AppletContext& c) {
-                 milliseconds now{0};
-                 rt.with_scheduler([&](Scheduler& sch) { now = sch.now(); });
-                 t_early = (now + 300ms).count();
-                 c.set_deadline("s", Deadline{now + 300ms, 100ms, now + 10s});
-                 c.request("s");
-               },
-               [](AppletContext&) {},
-               [&](AppletContext&, const Notification& n) {
-                 if (n.kind == Notification::Kind::kGranted) granted_at = n.until.count();
-               },
-               2ms});
+  rt.set_code("Later", {[&](AppletContext& c) {
+                          milliseconds now{0};
+                          rt.with_scheduler([&](Scheduler& sch) { now = sch.now(); });
+                          t_early = (now + 300ms).count();
+                          c.set_deadline("s", Deadline{now + 300ms, 100ms, now + 10s});
+                          c.request("s");
+                        },
+                        [](AppletContext&) {},
+                        [&](AppletContext&, const Notification& n) {
+                          if (n.kind == Notification::Kind::kGranted) granted_at = n.until.count();
+                        },
+                        2ms});
   rt.start();
   ASSERT_TRUE(eventually([&] { return granted_at >= 0; }));
   rt.stop();

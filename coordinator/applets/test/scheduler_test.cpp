@@ -168,8 +168,7 @@ TEST(Scheduler, ObjectionAndAgreementAskingTheSameTimesDifferWhenOnlyTheMinimumF
     s.request(t.low);
     s.request(t.high);
     s.set_deadline(t.high, Deadline{milliseconds{0}, milliseconds{1000}, milliseconds{3000}});
-    const auto n =
-        s.negotiate(t.low, Negotiation{milliseconds{1500}, milliseconds{6000}, accept});
+    const auto n = s.negotiate(t.low, Negotiation{milliseconds{1500}, milliseconds{6000}, accept});
     EXPECT_EQ(n.kind, accept ? Notification::Kind::kNegotiationAccepted
                              : Notification::Kind::kNegotiationRejected)
         << "accept " << accept;
@@ -315,7 +314,7 @@ TEST(Scheduler, CrashedServiceAppletsServicesBecomeUnavailableAndTheirUsersLoseT
   s.request(menu);
   s.request(screen);
   EXPECT_TRUE(s.active(menu));
-  EXPECT_TRUE(s.active(io));      // inherited
+  EXPECT_TRUE(s.active(io));       // inherited
   EXPECT_FALSE(s.active(screen));  // the service applet holds the monitor
   s.take_notifications();
   s.crash(provider);
@@ -330,8 +329,8 @@ TEST(Scheduler, CrashedServiceAppletsServicesBecomeUnavailableAndTheirUsersLoseT
   EXPECT_EQ(s.holder(monitor), "Screen");
   bool told = false;
   for (const Notification& n : s.take_notifications()) {
-    told = told || (n.kind == Notification::Kind::kRevokedByForce && n.bundle == menu &&
-                    n.service == ui);
+    told = told ||
+           (n.kind == Notification::Kind::kRevokedByForce && n.bundle == menu && n.service == ui);
   }
   EXPECT_TRUE(told);
   s.request(viewer);  // needs UI down the hierarchy: cannot be granted

@@ -84,8 +84,8 @@ class Runtime {
     /// revocation notice, or a negotiation round), if any: no re-prioritising meanwhile (seed
     /// §4.5.2, footnote 11). Applet thread only.
     std::optional<BundleId> reacting_to_revocation;
-    std::uint64_t steps = 0;                 // main-loop steps so far; applet thread only
-    std::condition_variable cv;              // wakes this applet only (no thundering herd)
+    std::uint64_t steps = 0;     // main-loop steps so far; applet thread only
+    std::condition_variable cv;  // wakes this applet only (no thundering herd)
     std::thread thread;
   };
   using Clock = std::chrono::steady_clock;
