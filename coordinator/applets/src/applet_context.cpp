@@ -34,12 +34,24 @@ void AppletContext::yield(const std::string& bundle) {
     s.yield(b);
   });
 }
+void AppletContext::refuse_reprioritising(const std::string& bundle, const char* what) const {
+  const auto& revoked = runtime_.slots_[applet_]->reacting_to_revocation;
+  if (!revoked) return;
+  const Model& m = runtime_.scheduler_.model();
+  throw std::invalid_argument(
+      "applet '" + m.applet(applet_).name + "' " + what + " bundle '" + bundle +
+      "' while it reacts to the revocation of its bundle '" + m.bundle(*revoked).name +
+      "'; an applet never re-prioritises in reaction to a revocation (seed 000 §4.5.2, footnote "
+      "11: it would make the plan oscillate) — yield or negotiate instead");
+}
 void AppletContext::trigger(const std::string& bundle) {
   const BundleId b = bundle_id(bundle);
+  refuse_reprioritising(bundle, "triggers");
   runtime_.with_scheduler([&](Scheduler& s) { s.trigger(b); });
 }
 void AppletContext::set_priority(const std::string& bundle, int priority) {
   const BundleId b = bundle_id(bundle);
+  refuse_reprioritising(bundle, "changes the priority of");
   runtime_.with_scheduler([&](Scheduler& s) { s.set_priority(b, priority); });
 }
 void AppletContext::set_deadline(const std::string& bundle, std::optional<Deadline> deadline) {

@@ -24,11 +24,23 @@ long long number(const YAML::Node& node, const std::string& file, const std::str
   }
 }
 
+bool flag(const YAML::Node& node, const std::string& file, const std::string& what) {
+  if (!node) return false;
+  if (node.IsScalar()) {
+    try {
+      return node.as<bool>();
+    } catch (const YAML::Exception&) {
+    }
+  }
+  fail_at(node, file, what + " must be true or false");
+}
+
 }  // namespace internal
 
 namespace {
 
 using internal::fail_at;
+using internal::flag;
 using internal::number;
 
 void allow_keys(const YAML::Node& node, const std::string& file, const std::string& what,
@@ -144,12 +156,11 @@ SystemConfig load_system(const YAML::Node& root, const std::string& file) {
   for (const auto& s : services) {
     allow_keys(s, file, "service", {"name", "exclusive_only", "depends_on", "params"});
     const std::string name = text(s["name"], file, "service name");
+    const bool exclusive_only = flag(s["exclusive_only"], file, "exclusive_only");
     try {
-      c.model.add_service(name, s["exclusive_only"] && s["exclusive_only"].as<bool>());
+      c.model.add_service(name, exclusive_only);
     } catch (const std::invalid_argument& e) {
       fail_at(s["name"], file, e.what());
-    } catch (const YAML::Exception&) {
-      fail_at(s["exclusive_only"], file, "exclusive_only must be true or false");
     }
     c.service_params[name] = params_of(s["params"], file);
   }
@@ -187,12 +198,22 @@ SystemConfig load_system(const YAML::Node& root, const std::string& file) {
     allow_keys(a, file, "applet", {"name", "provides", "bundles", "params", "fail_stop"});
     const std::string name = text(a["name"], file, "applet name");
     AppletId id = 0;
+    const bool fail_stop = flag(a["fail_stop"], file, "fail_stop");
     try {
-      id = c.model.add_applet(name, a["fail_stop"] && a["fail_stop"].as<bool>());
+      id = c.model.add_applet(name, fail_stop);
     } catch (const std::invalid_argument& e) {
       fail_at(a["name"], file, e.what());
     }
     c.applet_params[name] = params_of(a["params"], file);
+    // A scalar or a mapping where a list belongs would be read as an empty list: say so.
+    for (const char* key : {"provides", "bundles"}) {
+      if (a[key] && !a[key].IsSequence()) {
+        fail_at(a[key], file,
+                "applet '" + name + "': " + key + " must be a list" +
+                    (std::string(key) == "provides" ? " of services, such as [UI]"
+                                                    : " of bundles, such as [{name: b, ...}]"));
+      }
+    }
     for (const auto& p : a["provides"]) {
       try {
         c.model.provide(id, service_at(c.model, p, file, "applet '" + name + "' provides"));
@@ -215,9 +236,10 @@ SystemConfig load_system(const YAML::Node& root, const std::string& file) {
         resources.emplace_back(service_at(c.model, r["service"], file, who), access);
       }
       const int prio = b["priority"] ? parse_priority(b["priority"], file) : kPriorityNormal;
+      const bool requested = flag(b["requested"], file, "requested");
       try {
         const BundleId bid = c.model.add_bundle(id, bname, resources, prio);
-        if (b["requested"] && b["requested"].as<bool>()) {
+        if (requested) {
           c.requested_at_start.push_back(bid);
           requested_at.push_back(b);
         }

@@ -103,21 +103,29 @@ std::string to_dot(const Scheduler& s) {
           : s.active(b)     ? "active"
           : !s.requested(b) ? "idle"
           : plan.bundle_granted[b] ? "granted, waiting for hand-over"
-                                   : "blocked";
-      const std::string colour = revoke_by            ? "orange"
-                                 : state == "idle"    ? "white"
-                                 : state == "active"  ? "palegreen"
-                                 : state == "blocked" ? "lightgrey"
-                                                      : "khaki";
+          : s.deadline(b) && s.deadline(b)->t_early > plan.time
+              ? "blocked until t_early " + std::to_string(s.deadline(b)->t_early.count()) + " ms"
+              : "blocked";
+      const std::string colour = revoke_by                        ? "orange"
+                                 : state == "idle"                ? "white"
+                                 : state == "active"              ? "palegreen"
+                                 : state.rfind("blocked", 0) == 0 ? "lightgrey"
+                                                                  : "khaki";
       out += "    " + quote("b:" + ap.name + "/" + bundle.name) + " [shape=box, style=filled, " +
              "fillcolor=" + colour + ", label=" +
              quote(bundle.name + "\nprio " + priority_name(s.priority(b)) + "\n" + state) + "];\n";
     }
+    // A service applet's services start at its first bundle; one without bundles (its services
+    // need nothing) gets a node of its own, so no edge points at a bundle that is not drawn.
+    std::string provider =
+        ap.bundles.empty() ? "a:" + ap.name : "b:" + ap.name + "/" + m.bundle(ap.bundles[0]).name;
+    if (ap.bundles.empty() && !ap.provides.empty()) {
+      out += "    " + quote(provider) +
+             " [shape=box, style=dashed, label=" + quote(ap.name + "\nno bundles") + "];\n";
+    }
     out += "  }\n";
     for (ServiceId p : ap.provides) {
-      out += "  " +
-             quote("b:" + ap.name + "/" + m.bundle(ap.bundles.empty() ? 0 : ap.bundles[0]).name) +
-             " -> " + quote("s:" + m.service(p).name) +
+      out += "  " + quote(provider) + " -> " + quote("s:" + m.service(p).name) +
              " [dir=back, color=darkgreen, label=provides];\n";
     }
     for (BundleId b : ap.bundles) {

@@ -126,30 +126,36 @@ BundleId Model::bundle_id(AppletId applet, std::string_view name) const {
   fail("applet '" + applets_[applet].name + "' has no bundle '" + std::string(name) + "'");
 }
 
-const std::vector<Use>& Model::needs(ServiceId service) const {
-  analyse();
-  return needs_.at(service);
-}
-
 const std::vector<BundleId>& Model::cycle_of(BundleId bundle) const {
-  analyse();
-  return cycles_.at(bundle);
+  static const std::vector<BundleId> kNone;
+  const auto index = cycle_index(bundle);
+  return index ? cycles_[*index] : kNone;
 }
 
 void Model::analyse() const {
   if (analysed_) return;
   const std::size_t n = services_.size();
-  needs_.assign(n, {});
+  needs_.clear();
+  needs_begin_.assign(1, 0);
   for (ServiceId s = 0; s < n; ++s) {
     for (const Dependency& d : services_[s].dependencies) {
-      needs_[s].push_back(Use{d.service, d.access, Use::By::kService, s});
+      needs_.push_back(Use{d.service, d.access, Use::By::kService, s});
     }
     if (services_[s].provider) {
       for (ResourceId r : applets_[*services_[s].provider].resources) {
-        needs_[s].push_back(
-            Use{resources_[r].service, resources_[r].access, Use::By::kResource, r});
+        needs_.push_back(Use{resources_[r].service, resources_[r].access, Use::By::kResource, r});
       }
     }
+    needs_begin_.push_back(static_cast<std::uint32_t>(needs_.size()));
+  }
+  bundle_uses_.clear();
+  bundle_uses_begin_.assign(1, 0);
+  for (const Bundle& b : bundles_) {
+    for (ResourceId r : b.resources) {
+      bundle_uses_.push_back(
+          Use{resources_[r].service, resources_[r].access, Use::By::kResource, r});
+    }
+    bundle_uses_begin_.push_back(static_cast<std::uint32_t>(bundle_uses_.size()));
   }
   // Strongly connected components of the service graph (Tarjan, iterative enough for the sizes
   // of applet systems; recursion depth is bounded by the number of services).
@@ -161,7 +167,8 @@ void Model::analyse() const {
     index[v] = low[v] = counter++;
     stack.push_back(v);
     on_stack[v] = 1;
-    for (const Use& u : needs_[v]) {
+    for (const Use& u : std::span<const Use>(needs_.data() + needs_begin_[v],
+                                             needs_begin_[v + 1] - needs_begin_[v])) {
       const ServiceId w = u.service;
       if (index[w] < 0) {
         visit(w);
@@ -200,9 +207,13 @@ void Model::analyse() const {
     }
     if (found >= 0) members[found].push_back(b);
   }
-  cycles_.assign(bundles_.size(), {});
-  for (const auto& m : members) {
-    for (BundleId b : m) cycles_[b] = m;
+  // Each cycle's members once (a copy per member was quadratic in the size of a cycle).
+  cycles_.clear();
+  cycle_index_.assign(bundles_.size(), kNoCycle);
+  for (auto& m : members) {
+    if (m.empty()) continue;
+    for (BundleId b : m) cycle_index_[b] = static_cast<std::uint32_t>(cycles_.size());
+    cycles_.push_back(std::move(m));
   }
   analysed_ = true;
 }

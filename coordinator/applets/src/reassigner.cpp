@@ -155,12 +155,53 @@ std::optional<milliseconds> Scheduler::next_forced_revocation() const {
   return next;
 }
 
+std::optional<milliseconds> Scheduler::next_event() const {
+  std::optional<milliseconds> next = next_forced_revocation();
+  auto consider = [&](milliseconds t) {
+    if (!next || t < *next) next = t;
+  };
+  for (const BundleState& b : state_) {
+    if (!b.requested || !b.deadline) continue;
+    consider(b.deadline->t_finish);                                       // expiry
+    if (waits_for_t_early(b, plan_.time)) consider(b.deadline->t_early);  // planned then
+  }
+  return next;
+}
+
 void Scheduler::advance_to(milliseconds t) {
   if (t < now_) {
     throw std::invalid_argument("time " + std::to_string(t.count()) + " ms lies before now (" +
                                 std::to_string(now_.count()) + " ms); time only advances");
   }
+  // Everything that falls due on the way happens at its own time, in order (a revocation by
+  // force at 3000 ms hands over before a request planned at 5000 ms, and is stamped 3000 ms).
+  for (auto next = next_event(); next && *next <= t; next = next_event()) {
+    now_ = std::max(now_, *next);
+    handle_due();
+  }
   now_ = t;
+}
+
+void Scheduler::handle_due() {
+  // Seed §4.5.1: t_finish is the latest end of the access; after it the request is withdrawn.
+  // A bundle still in use is given back through its reassigners (the plan no longer grants it).
+  bool replan_now = false;
+  for (BundleId b = 0; b < state_.size(); ++b) {
+    BundleState& st = state_[b];
+    if (!st.requested || !st.deadline) continue;
+    if (st.deadline->t_finish <= now_) {
+      Notification n = notice(Notification::Kind::kDeadlineExpired, b);
+      n.until = st.deadline->t_finish;
+      notifications_.push_back(std::move(n));
+      st.requested = false;
+      st.boosted = false;
+      st.deadline.reset();
+      replan_now = true;
+    } else if (waits_for_t_early(st, plan_.time) && st.deadline->t_early <= now_) {
+      replan_now = true;  // its earliest start is reached: the plan considers it now
+    }
+  }
+  if (replan_now) replan();
   // Seed §4.6.1: a reassigner whose wait limit for a holder passed revokes by force; the holder
   // loses its whole bundle (all or nothing), so it leaves the other reassigners too.
   std::vector<std::pair<BundleId, ServiceId>> overdue;
@@ -201,11 +242,15 @@ Notification Scheduler::negotiate_with(ServiceId service, Reassignment::Giving& 
   };
   Notification n = notice(Notification::Kind::kNegotiationRejected, bundle, service);
   n.until = giving.until;
-  if (answer.accept && giving.rounds <= options_.negotiation_rounds_max) {
+  if (giving.rounds <= options_.negotiation_rounds_max) {
+    // The vote decides what the applet asks for (seed §4.5.3, §4.6.1): agreeing to the
+    // revocation, it takes max_needed if that fits, else min_needed (a compromise); objecting to
+    // it, it insists on keeping the bundle for max_needed, and the objection is upheld only if
+    // that fits. A rejected objection leaves the applet its on_reject round to offer less.
     std::optional<milliseconds> granted;
     if (fits(answer.max_needed)) {
       granted = answer.max_needed;
-    } else if (fits(answer.min_needed)) {
+    } else if (answer.accept && fits(answer.min_needed)) {
       granted = answer.min_needed;
     }
     if (granted) {

@@ -3,6 +3,19 @@
 #include <algorithm>
 
 namespace oscar::applets {
+namespace {
+
+// Notices about taking a bundle away (seed §4.4.1, §4.5.3, §4.6.1): what an applet must not
+// answer with a new priority (footnote 11).
+bool is_revocation(Notification::Kind kind) {
+  return kind == Notification::Kind::kRevokeRequested ||
+         kind == Notification::Kind::kNegotiationAccepted ||
+         kind == Notification::Kind::kNegotiationRejected ||
+         kind == Notification::Kind::kRevokedByForce;
+}
+
+}  // namespace
+
 Runtime::Runtime(Model model, SchedulerOptions options)
     : scheduler_(std::move(model), options), start_(Clock::now()) {
   for (std::size_t a = 0; a < scheduler_.model().applets().size(); ++a) {
@@ -78,8 +91,8 @@ void Runtime::locked_call(const std::function<void(Scheduler&)>& f) {
   scheduler_.advance_to(std::max(scheduler_.now(), clock()));
   f(scheduler_);
   deliver();
-  // Wake the force thread only for an earlier wait limit than it waits for (not on every call).
-  const auto next = scheduler_.next_forced_revocation();
+  // Wake the clock thread only for an earlier event than it waits for (not on every call).
+  const auto next = scheduler_.next_event();
   if (next && *next < forcing_at_) changed_.notify_all();
 }
 
@@ -110,8 +123,9 @@ RuntimeStats Runtime::stats() const {
   return stats_;
 }
 
-// The applet wrapper (seed §4.6.2 "Fail-Stop"): whatever the code throws ends this applet only;
-// its bundles are released and everything else goes on.
+// The applet wrapper (seed §4.6.2 "Fail-Stop"): whatever the code throws — a std::exception or
+// anything else (`throw 42`) — ends this applet only; its bundles are released and everything
+// else goes on.
 void Runtime::applet_main(AppletId id) {
   Slot& slot = *slots_[id];
   AppletContext ctx(*this, id);
@@ -126,11 +140,13 @@ void Runtime::applet_main(AppletId id) {
         queue.swap(slot.interrupts);
       }
       for (const Notification& n : queue) {  // Abb. 4.12 line 4: interrupt handlers first
+        if (is_revocation(n.kind)) slot.reacting_to_revocation = n.bundle;
         if (slot.code.on_interrupt) {
           slot.code.on_interrupt(ctx, n);
         } else if (n.kind == Notification::Kind::kRevokeRequested) {
           ctx.yield(scheduler_.model().bundle(n.bundle).name);
         }
+        slot.reacting_to_revocation.reset();
       }
       run_negotiations(ctx);  // follow-up rounds run like interrupt handlers (§4.5.3)
       bool paused;
@@ -145,7 +161,7 @@ void Runtime::applet_main(AppletId id) {
       slot.cv.wait_until(lock, next, [&] { return stopping_; });
       if (stopping_) return;
     }
-  } catch (const std::exception&) {
+  } catch (...) {  // the boundary of the applet: nothing may escape into the process
     std::unique_lock lock(mutex_);
     slot.crashed = true;
     stats_.crashed.push_back(scheduler_.model().applet(id).name);
@@ -204,15 +220,18 @@ void Runtime::run_negotiations(AppletContext& ctx) {
       continue;
     }
     const auto next = chain.next;  // keeps the round alive while it runs
+    slot.reacting_to_revocation = bundle;
     run_round(ctx, bundle, *next);
+    slot.reacting_to_revocation.reset();
   }
 }
 
-// Lets the reassigners revoke by force when a wait limit passes (seed §4.6.1).
+// Follows the clock: the reassigners revoke by force when a wait limit passes (seed §4.6.1),
+// requests expire at t_finish and are planned at t_early (§4.5.1).
 void Runtime::reassigner_main() {
   std::unique_lock lock(mutex_);
   while (!stopping_) {
-    forcing_at_ = scheduler_.next_forced_revocation().value_or(milliseconds::max());
+    forcing_at_ = scheduler_.next_event().value_or(milliseconds::max());
     if (forcing_at_ == milliseconds::max()) {
       changed_.wait(lock);
     } else {

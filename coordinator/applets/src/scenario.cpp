@@ -1,6 +1,7 @@
 #include "oscar/applets/scenario.hpp"
 
 #include <algorithm>
+#include <map>
 #include <set>
 #include <stdexcept>
 
@@ -12,6 +13,7 @@ namespace oscar::applets {
 namespace {
 
 using internal::fail_at;
+using internal::flag;
 using internal::number;
 
 BundleId bundle_at(const Model& model, const YAML::Node& node, const std::string& file) {
@@ -27,27 +29,64 @@ BundleId bundle_at(const Model& model, const YAML::Node& node, const std::string
   }
 }
 
-const std::set<std::string> kActionKeys = {"request", "release",      "yield",
-                                           "trigger", "set_priority", "set_deadline",
-                                           "crash",   "advance_ms",   "negotiate"};
+// The keys of each event: its own and its fields (docs/applets.md, "Events").
+const std::map<std::string, std::set<std::string>> kEvents = {
+    {"request", {"trigger"}},
+    {"release", {}},
+    {"yield", {}},
+    {"trigger", {}},
+    {"set_priority", {"priority"}},
+    {"set_deadline", {"t_early_ms", "t_duration_ms", "t_finish_ms", "clear"}},
+    {"crash", {}},
+    {"advance_ms", {}},
+    {"negotiate", {"min_ms", "max_ms", "accept"}}};
+const std::set<std::string> kStepKeys = {"label", "t_ms", "do", "expect", "expect_active"};
 
-Action parse_action(const Model& model, const YAML::Node& a, const std::string& file) {
+// Whether `key` names an event or one of an event's fields.
+bool is_event_key(const std::string& key) {
+  for (const auto& [event, fields] : kEvents) {
+    if (key == event || fields.count(key)) return true;
+  }
+  return false;
+}
+
+std::string joined(const std::vector<std::string>& keys) {
+  std::string out;
+  for (const auto& k : keys) out += (out.empty() ? "" : ", ") + k;
+  return out;
+}
+
+// One event: a mapping with exactly one event key and only that event's fields; an event written
+// directly in a step may sit beside the step's own keys (`step_keys`).
+Action parse_action(const Model& model, const YAML::Node& a, const std::string& file,
+                    const std::set<std::string>& step_keys = {}) {
   if (!a.IsMap()) fail_at(a, file, "an event must be a mapping such as {request: Applet/bundle}");
   Action act;
   act.where = where(a, file);
   std::string kind;
   for (const auto& kv : a) {
     const auto key = kv.first.as<std::string>();
-    if (kActionKeys.count(key) && !(key == "trigger" && a["request"])) {
+    if (kEvents.count(key) && !(key == "trigger" && a["request"])) {
       if (!kind.empty())
         fail_at(kv.first, file, "one event per mapping: '" + kind + "' and '" + key + "'");
       kind = key;
     }
   }
   if (kind.empty()) {
-    fail_at(a, file,
-            "unknown event (allowed: request, release, yield, trigger, set_priority, "
-            "set_deadline, crash, advance_ms, negotiate)");
+    std::vector<std::string> events;
+    for (const auto& [event, fields] : kEvents) events.push_back(event);
+    fail_at(a, file, "unknown event (allowed: " + joined(events) + ")");
+  }
+  const std::set<std::string>& fields = kEvents.at(kind);
+  for (const auto& kv : a) {
+    const auto key = kv.first.as<std::string>();
+    if (key == kind || fields.count(key) || step_keys.count(key)) continue;
+    std::vector<std::string> allowed{kind};
+    allowed.insert(allowed.end(), fields.begin(), fields.end());
+    fail_at(kv.first, file,
+            "event '" + kind + "': unknown key '" + key + "' (allowed: " + joined(allowed) +
+                (step_keys.empty() ? "" : "; and the step's label, t_ms, expect, expect_active") +
+                ")");
   }
   const YAML::Node v = a[kind];
   auto ms_field = [&](const char* key) {
@@ -57,7 +96,7 @@ Action parse_action(const Model& model, const YAML::Node& a, const std::string& 
   if (kind == "request") {
     act.kind = Action::Kind::kRequest;
     act.bundle = bundle_at(model, v, file);
-    act.trigger = a["trigger"] && a["trigger"].as<bool>();
+    act.trigger = flag(a["trigger"], file, "trigger");
   } else if (kind == "release") {
     act.kind = Action::Kind::kRelease;
     act.bundle = bundle_at(model, v, file);
@@ -75,7 +114,7 @@ Action parse_action(const Model& model, const YAML::Node& a, const std::string& 
   } else if (kind == "set_deadline") {
     act.kind = Action::Kind::kSetDeadline;
     act.bundle = bundle_at(model, v, file);
-    if (!(a["clear"] && a["clear"].as<bool>())) {
+    if (!flag(a["clear"], file, "clear")) {
       act.deadline =
           Deadline{ms_field("t_early_ms"), ms_field("t_duration_ms"), ms_field("t_finish_ms")};
     }
@@ -94,7 +133,7 @@ Action parse_action(const Model& model, const YAML::Node& a, const std::string& 
     act.kind = Action::Kind::kNegotiate;
     act.bundle = bundle_at(model, v, file);
     act.negotiation =
-        Negotiation{ms_field("min_ms"), ms_field("max_ms"), a["accept"] && a["accept"].as<bool>()};
+        Negotiation{ms_field("min_ms"), ms_field("max_ms"), flag(a["accept"], file, "accept")};
   }
   return act;
 }
@@ -118,6 +157,9 @@ std::string note(const Model& m, const Notification& n) {
       return who + ": negotiation rejected, yield by " + std::to_string(n.until.count()) + " ms";
     case Notification::Kind::kRevokedByForce:
       return who + ": revoked by force";
+    case Notification::Kind::kDeadlineExpired:
+      return who + ": deadline expired (t_finish " + std::to_string(n.until.count()) +
+             " ms), request withdrawn";
     case Notification::Kind::kDeadlineOverlap:
       return who + ": deadline overlaps " + m.applet(m.bundle(*n.other).applet).name + "/" +
              m.bundle(*n.other).name;
@@ -151,25 +193,28 @@ Scenario Scenario::parse(const std::string& yaml_text, const std::string& file) 
     if (!st.IsMap()) fail_at(st, file, "a step must be a mapping");
     Step step;
     step.where = where(st, file);
+    bool has_event = false;
     for (const auto& kv : st) {
       const auto key = kv.first.as<std::string>();
-      if (key != "label" && key != "t_ms" && key != "do" && key != "expect" &&
-          key != "expect_active" && !kActionKeys.count(key) && key != "priority" &&
-          key != "trigger" && key.find("_ms") == std::string::npos && key != "accept" &&
-          key != "clear") {
+      if (kStepKeys.count(key)) continue;
+      if (!is_event_key(key)) {
         fail_at(kv.first, file,
-                "step: unknown key '" + key + "' (allowed: label, t_ms, do, expect, or one event)");
+                "step: unknown key '" + key +
+                    "' (allowed: label, t_ms, do, expect, expect_active, or one event)");
       }
+      if (st["do"]) {
+        fail_at(kv.first, file,
+                "step: '" + key + "' beside 'do' (write the event into the do list)");
+      }
+      has_event = true;
     }
     if (st["label"]) step.label = st["label"].as<std::string>();
     if (st["t_ms"]) step.t = milliseconds{number(st["t_ms"], file, "t_ms")};
     if (st["do"]) {
       if (!st["do"].IsSequence()) fail_at(st["do"], file, "'do' must be a list of events");
       for (const auto& a : st["do"]) step.actions.push_back(parse_action(s.system_.model, a, file));
-    } else {
-      bool has_event = false;
-      for (const auto& k : kActionKeys) has_event = has_event || st[k];
-      if (has_event) step.actions.push_back(parse_action(s.system_.model, st, file));
+    } else if (has_event) {
+      step.actions.push_back(parse_action(s.system_.model, st, file, kStepKeys));
     }
     for (const char* key : {"expect", "expect_active"}) {
       const auto e = st[key];
@@ -195,9 +240,25 @@ std::vector<StepResult> Scenario::run(Scheduler* final_state) const {
   for (BundleId b : system_.requested_at_start) sched.request(b);
   std::vector<StepResult> out;
   const Model& m = sched.model();
+  // Applets following the seed's conventions yield between two main-loop steps; on the logical
+  // clock that is at once.
+  auto yield_revoked = [&] {
+    for (BundleId b = 0; auto_yield_ && b < m.bundles().size(); ++b) {
+      if (sched.revoke_deadline(b)) sched.yield(b);
+    }
+  };
+  // The clock moves from event to event (a t_early reached, a t_finish passed, a wait limit), so
+  // that what they revoke is yielded at that time, as it is after an action.
+  auto advance = [&](milliseconds t) {
+    for (auto next = sched.next_event(); next && *next <= t; next = sched.next_event()) {
+      sched.advance_to(std::max(sched.now(), *next));
+      yield_revoked();
+    }
+    sched.advance_to(t);
+  };
   for (const Step& step : steps_) {
     try {
-      if (step.t) sched.advance_to(*step.t);
+      if (step.t) advance(*step.t);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(step.where + ": " + e.what());
     }
@@ -227,7 +288,7 @@ std::vector<StepResult> Scenario::run(Scheduler* final_state) const {
             sched.crash(a.applet);
             break;
           case Action::Kind::kAdvance:
-            sched.advance_to(sched.now() + a.advance);
+            advance(sched.now() + a.advance);
             break;
           case Action::Kind::kNegotiate:
             sched.negotiate(a.bundle, a.negotiation);
@@ -236,11 +297,7 @@ std::vector<StepResult> Scenario::run(Scheduler* final_state) const {
       } catch (const std::invalid_argument& e) {
         throw std::invalid_argument(a.where + ": " + e.what());
       }
-      // Applets following the seed's conventions yield between two main-loop steps; on the
-      // logical clock that is at once.
-      for (BundleId b = 0; auto_yield_ && b < m.bundles().size(); ++b) {
-        if (sched.revoke_deadline(b)) sched.yield(b);
-      }
+      yield_revoked();
     }
     StepResult r;
     r.label = step.label;

@@ -27,6 +27,8 @@ Scheduler::Scheduler(Model model, SchedulerOptions options)
   active_.assign(n, 0);
   revoking_.assign(n, 0);
   reassigners_.resize(model_.services().size());
+  crashed_.assign(model_.applets().size(), 0);
+  plan_context_.unavailable.assign(model_.services().size(), 0);
   footprint_cache_.assign(n, std::nullopt);
   services_cache_.assign(n, std::nullopt);
   own_cache_.assign(n, std::nullopt);
@@ -61,6 +63,11 @@ void Scheduler::check_bundle(BundleId bundle) const {
 
 void Scheduler::request(BundleId bundle) {
   if (state_.at(bundle).requested) return;
+  const AppletId applet = model_.bundle(bundle).applet;
+  if (crashed_[applet]) {
+    fail("applet '" + model_.applet(applet).name + "' requests bundle '" +
+         model_.bundle(bundle).name + "' but it crashed; a crashed applet requests nothing");
+  }
   check_bundle(bundle);
   state_[bundle].requested = true;
   replan();
@@ -126,18 +133,35 @@ void Scheduler::trigger(BundleId bundle) {
 }
 
 void Scheduler::crash(AppletId applet) {
+  crashed_.at(applet) = 1;
   for (BundleId b : model_.applet(applet).bundles) {
     state_[b].requested = false;
     state_[b].boosted = false;
     active_[b] = 0;
     stop_giving(b);
   }
+  // Its services are gone (seed §4.6.1, cascading effects): whoever uses them, directly or down
+  // the hierarchy, loses them now — there is nothing left to hand back — and is told so.
+  std::vector<char>& gone = plan_context_.unavailable;
+  for (ServiceId s : model_.applet(applet).provides) gone[s] = 1;
+  for (BundleId b = 0; b < state_.size(); ++b) {
+    if (!active_[b]) continue;
+    const auto& services = services_of(b);
+    const auto lost =
+        std::find_if(services.begin(), services.end(), [&](ServiceId s) { return gone[s] != 0; });
+    if (lost == services.end()) continue;
+    stop_giving(b);
+    active_[b] = 0;
+    notifications_.push_back(notice(Notification::Kind::kRevokedByForce, b, *lost));
+  }
   replan();
 }
 
 void Scheduler::replan() {
-  Plan next = calculate_assignments(model_, state_, plan_.order, plan_.bundle_granted,
-                                    options_.context_switch);
+  plan_context_.now = now_;
+  plan_context_.context_switch = options_.context_switch;
+  Plan next =
+      calculate_assignments(model_, state_, plan_.order, plan_.bundle_granted, plan_context_);
   ++plans_;
   for (const auto& pair : next.deadline_overlaps) {
     if (std::binary_search(plan_.deadline_overlaps.begin(), plan_.deadline_overlaps.end(), pair)) {
@@ -154,6 +178,7 @@ void Scheduler::replan() {
 }
 
 std::string Scheduler::holder(ServiceId service) const {
+  if (!available(service)) return "unavailable";
   const auto& uses = plan_.uses.at(service);
   std::set<std::string> names;
   for (const GrantedUse& g : uses) {
@@ -168,7 +193,8 @@ std::string Scheduler::holder(ServiceId service) const {
   }
   if (!uses.empty()) return "blocked";  // held up by a service that depends on it
   for (BundleId b = 0; b < state_.size(); ++b) {
-    if (!state_[b].requested) continue;
+    // A request waiting for its t_early asks for nothing yet.
+    if (!state_[b].requested || waits_for_t_early(state_[b], plan_.time)) continue;
     for (ResourceId r : model_.bundle(b).resources) {
       if (model_.resource(r).service == service) return "blocked";
     }

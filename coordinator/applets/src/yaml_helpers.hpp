@@ -13,4 +13,7 @@ namespace oscar::applets::internal {
 /// A whole number. @throws std::invalid_argument naming `what` and the value.
 long long number(const YAML::Node& node, const std::string& file, const std::string& what);
 
+/// true or false; an absent node is false. @throws std::invalid_argument naming `what`.
+bool flag(const YAML::Node& node, const std::string& file, const std::string& what);
+
 }  // namespace oscar::applets::internal

@@ -17,8 +17,10 @@ using namespace std::chrono_literals;
 using testing::eventually;
 constexpr auto kX = Access::kExclusive;
 
-// Seed §4.5.3: the docked battery applet asks for time, and in the accepted follow-up round
-// undocks before the drive gets the pilot; a rejected vote runs the reject round instead. The
+// Seed §4.5.3: the docked battery applet asks for 50 ms to 30 s, and in the accepted follow-up
+// round undocks before the drive gets the pilot. Agreeing to the revocation, it is given the
+// 50 ms (30 s is more than a round may grant); objecting to it, it insists on the 30 s, is
+// rejected and runs the reject round instead. The
 // battery's bundle hears from two reassigners (Dock and, down the hierarchy, Pilot) and starts
 // one chain only.
 TEST(Negotiation, RoundsRunTheirCodeBeforeTheHandOver) {
@@ -36,9 +38,10 @@ TEST(Negotiation, RoundsRunTheirCodeBeforeTheHandOver) {
     rt.set_code("Battery", {[](AppletContext& c) { c.request("dock"); },
                             [&](AppletContext& c) { c.use("dock", [&] { docked = true; }); },
                             [&, vote](AppletContext& c, const Notification& n) {
-                              if (n.kind == Notification::Kind::kNegotiationAccepted ||
-                                  n.kind == Notification::Kind::kNegotiationRejected) {
-                                reply = static_cast<int>(n.kind);
+                              if ((n.kind == Notification::Kind::kNegotiationAccepted ||
+                                   n.kind == Notification::Kind::kNegotiationRejected) &&
+                                  reply < 0) {
+                                reply = static_cast<int>(n.kind);  // the first round's reply
                               }
                               if (n.kind != Notification::Kind::kRevokeRequested) return;
                               ++revoke_notices;
@@ -47,7 +50,7 @@ TEST(Negotiation, RoundsRunTheirCodeBeforeTheHandOver) {
                               undock->answer = {0ms, 0ms, true};
                               auto hard = std::make_shared<NegotiationRound>();
                               hard->first = [&] { stopped_hard = true; };
-                              NegotiationRound ask{{50ms, 200ms, vote}, {}, undock, hard};
+                              NegotiationRound ask{{50ms, 30s, vote}, {}, undock, hard};
                               if (c.negotiate("dock", ask)) ++chains;
                             },
                             2ms});
@@ -70,8 +73,7 @@ TEST(Negotiation, RoundsRunTheirCodeBeforeTheHandOver) {
     EXPECT_EQ(stopped_hard.load(), !vote);
     EXPECT_EQ(revoke_notices.load(), 2);  // the reassigners of Dock and Pilot
     EXPECT_EQ(chains.load(), 1);
-    // The last reply: the undock round's "accept, no time" is accepted; the reject round
-    // answers with the default (a vote against), which is rejected.
+    // The first round's reply follows its vote.
     EXPECT_EQ(reply.load(), static_cast<int>(vote ? Notification::Kind::kNegotiationAccepted
                                                   : Notification::Kind::kNegotiationRejected));
   }

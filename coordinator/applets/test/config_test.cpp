@@ -128,5 +128,51 @@ timeline:
   }
 }
 
+// An event's keys are checked like every other mapping's: a misspelt field inside do: (or beside
+// an event written in the step) is an error naming it, not an event without it.
+TEST(Config, UnknownKeyInsideAnEventIsNamedWithItsLine) {
+  const std::string sys = R"(services: [{name: P}]
+applets: [{name: A, bundles: [{name: b, resources: [{service: P}]}]}]
+timeline:
+)";
+  EXPECT_THAT(error_of(sys + "  - do: [{request: A/b, trigerr: true}]\n"),
+              HasSubstr("sys.yaml:4: event 'request': unknown key 'trigerr' (allowed: request, "
+                        "trigger)"));
+  EXPECT_THAT(error_of(sys + "  - do:\n      - {set_priority: A/b, priority: high, clear: true}\n"),
+              HasSubstr("sys.yaml:5: event 'set_priority': unknown key 'clear' (allowed: "
+                        "set_priority, priority)"));
+  EXPECT_THAT(error_of(sys + "  - {label: x, set_priority: A/b, priorty: high}\n"),
+              HasSubstr("sys.yaml:4: step: unknown key 'priorty'"));
+  EXPECT_THAT(error_of(sys + "  - {label: x, set_priority: A/b, priority: high, accept: true}\n"),
+              HasSubstr("sys.yaml:4: event 'set_priority': unknown key 'accept'"));
+  EXPECT_THAT(error_of(sys + "  - {do: [{release: A/b}], priority: high}\n"),
+              HasSubstr("sys.yaml:4: step: 'priority' beside 'do'"));
+  EXPECT_THAT(error_of(sys + "  - {request: A/b, trigger: maybe}\n"),
+              HasSubstr("sys.yaml:4: trigger must be true or false"));
+  EXPECT_THAT(error_of(sys + "  - {foo_ms: 3}\n"),
+              HasSubstr("sys.yaml:4: step: unknown key 'foo_ms'"));
+}
+
+// A scalar where a list belongs used to read as an empty list (provides: S provided nothing).
+TEST(Config, ScalarWhereAListBelongsIsAnError) {
+  EXPECT_THAT(
+      error_of(R"(services: [{name: S}]
+applets:
+  - name: A
+    provides: S
+timeline: []
+)"),
+      HasSubstr("sys.yaml:4: applet 'A': provides must be a list of services, such as [UI]"));
+  EXPECT_THAT(error_of(R"(services: [{name: S}]
+applets:
+  - name: A
+    bundles: {name: b, resources: [{service: S}]}
+timeline: []
+)"),
+              HasSubstr("sys.yaml:4: applet 'A': bundles must be a list of bundles"));
+  EXPECT_THAT(error_of("services: [{name: S, exclusive_only: sometimes}]\ntimeline: []\n"),
+              HasSubstr("sys.yaml:1: exclusive_only must be true or false"));
+}
+
 }  // namespace
 }  // namespace oscar::applets

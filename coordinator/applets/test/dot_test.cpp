@@ -72,5 +72,30 @@ timeline:
   EXPECT_THAT(dot, HasSubstr(R"(label="io\nprio normal\nactive")"));  // inherited, not requested
 }
 
+// A service applet without bundles: its provides edge starts at a node of its own inside its
+// box (it used to start at an undrawn "b:Clock/<another applet's bundle>" node, which Graphviz
+// draws as a phantom ellipse outside every box).
+TEST(Dot, ServiceAppletWithoutBundlesHasNoPhantomNode) {
+  const auto s = Scenario::parse(
+      R"(services: [{name: Time}, {name: Pilot}]
+applets:
+  - {name: Clock, provides: [Time]}
+  - {name: Driver, bundles: [{name: d, resources: [{service: Pilot}, {service: Time, access: shared}]}]}
+timeline:
+  - {request: Driver/d}
+)",
+      "d.yaml");
+  Scheduler final_state(s.system().model, s.system().options);
+  s.run(&final_state);
+  const std::string dot = to_dot(final_state);
+  EXPECT_THAT(dot, HasSubstr(R"("a:Clock" [shape=box, style=dashed, label="Clock\nno bundles"])"));
+  EXPECT_THAT(dot, HasSubstr(R"("a:Clock" -> "s:Time" [dir=back, color=darkgreen)"));
+  // Every node an edge names is declared: no "b:" node appears only in edges.
+  for (std::size_t at = dot.find("\"b:"); at != std::string::npos; at = dot.find("\"b:", at + 1)) {
+    const std::string node = dot.substr(at, dot.find('"', at + 1) - at + 1);
+    EXPECT_THAT(dot, HasSubstr(node + " [shape=box")) << node << " is drawn but never declared";
+  }
+}
+
 }  // namespace
 }  // namespace oscar::applets

@@ -73,7 +73,8 @@ TEST(Reassigner, EachReassignerDecidesTheNegotiationForItsService) {
   s.request(t.held);
   s.request(t.bx);
   s.request(t.cy);
-  s.set_deadline(t.cy, Deadline{milliseconds{0}, milliseconds{1000}, milliseconds{3000}});
+  // Latest start 2000 ms; t_finish after the forced revocation at 5000 ms (it expires then).
+  s.set_deadline(t.cy, Deadline{milliseconds{0}, milliseconds{4000}, milliseconds{6000}});
   s.take_notifications();
   const Notification summary =
       s.negotiate(t.held, Negotiation{milliseconds{2500}, milliseconds{8000}, true});

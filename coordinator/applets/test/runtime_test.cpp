@@ -1,11 +1,13 @@
 // The threaded runtime. No test depends on timing beyond "eventually, within seconds".
 #include "oscar/applets/runtime.hpp"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "test_support.hpp"
 
 #include <atomic>
+#include <functional>
 #include <mutex>
 #include <thread>
 
@@ -199,6 +201,118 @@ TEST(Runtime, CrashedAppletLosesItsResourcesAndNothingElseIsAffected) {
   ASSERT_TRUE(eventually([&] { return bystander > b + 3; }));
   rt.stop();
   EXPECT_EQ(rt.stats().crashed, std::vector<std::string>{"Bad"});
+}
+
+// The wrapper is the applet's boundary: a thrown value that is no std::exception ends the applet
+// too, not the process.
+TEST(Runtime, AppletThrowingANonStandardExceptionCrashesAloneAndLosesItsResources) {
+  Model m;
+  const ServiceId s = m.add_service("S");
+  m.add_bundle(m.add_applet("Bad"), "s", {{s, kX}}, kPriorityHigh);
+  m.add_bundle(m.add_applet("Waiting"), "s", {{s, kX}});
+  Runtime rt(m);
+  std::atomic<int> bad_steps{0}, waiting_uses{0};
+  rt.set_code("Bad", {[](AppletContext& c) { c.request("s"); },
+                      [&](AppletContext& c) {
+                        c.use("s", [&] {
+                          if (++bad_steps == 3) throw 42;
+                        });
+                      },
+                      {},
+                      2ms});
+  rt.set_code("Waiting", {[](AppletContext& c) { c.request("s"); },
+                          [&](AppletContext& c) { c.use("s", [&] { ++waiting_uses; }); },
+                          {},
+                          2ms});
+  rt.start();
+  ASSERT_TRUE(eventually([&] { return waiting_uses > 3; }));
+  EXPECT_TRUE(rt.crashed("Bad"));
+  EXPECT_EQ(bad_steps.load(), 3);
+  rt.stop();
+  EXPECT_EQ(rt.stats().crashed, std::vector<std::string>{"Bad"});
+}
+
+// Seed §4.5.2, footnote 11: answering a revocation with a new priority (or a trigger) would make
+// the plan oscillate; the runtime refuses both from a revocation's interrupt handler, while the
+// same calls in a main-loop step are fine.
+TEST(Runtime, ReprioritisingInReactionToARevocationIsRefused) {
+  Model m;
+  const ServiceId s = m.add_service("S");
+  m.add_bundle(m.add_applet("Holder"), "s", {{s, kX}});
+  const BundleId urgent = m.add_bundle(m.add_applet("Urgent"), "s", {{s, kX}}, kPriorityHigh);
+  Runtime rt(m);
+  std::mutex mu;
+  std::vector<std::string> refused;
+  std::atomic<bool> raised_in_step{false}, handled{false};
+  rt.set_code("Holder",
+              {[](AppletContext& c) { c.request("s"); },
+               [&](AppletContext& c) {
+                 if (!raised_in_step) {
+                   c.set_priority("s", kPriorityNormal + 1);  // outside a handler: allowed
+                   raised_in_step = true;
+                 }
+               },
+               [&](AppletContext& c, const Notification& n) {
+                 if (n.kind != Notification::Kind::kRevokeRequested) return;
+                 for (const auto& call : std::vector<std::function<void()>>{
+                          [&] { c.set_priority("s", kPrioritySystem); }, [&] { c.trigger("s"); }}) {
+                   try {
+                     call();
+                   } catch (const std::invalid_argument& e) {
+                     std::lock_guard lock(mu);
+                     refused.emplace_back(e.what());
+                   }
+                 }
+                 c.yield("s");
+                 handled = true;
+               },
+               2ms});
+  rt.start();
+  ASSERT_TRUE(eventually([&] { return raised_in_step.load(); }));
+  rt.with_scheduler([&](Scheduler& sch) { sch.request(urgent); });
+  ASSERT_TRUE(eventually([&] { return handled.load(); }));
+  ASSERT_TRUE(eventually([&] {
+    bool active = false;
+    rt.with_scheduler([&](Scheduler& sch) { active = sch.active(urgent); });
+    return active;
+  }));
+  int holder_priority = 0;
+  rt.with_scheduler([&](Scheduler& sch) { holder_priority = sch.priority(0); });
+  rt.stop();
+  EXPECT_EQ(holder_priority, kPriorityNormal + 1);
+  std::lock_guard lock(mu);
+  ASSERT_EQ(refused.size(), 2u);
+  EXPECT_THAT(refused[0], ::testing::HasSubstr(
+                              "applet 'Holder' changes the priority of bundle 's' while it reacts "
+                              "to the revocation of its bundle 's'"));
+  EXPECT_THAT(refused[0], ::testing::HasSubstr("footnote 11"));
+  EXPECT_THAT(refused[1], ::testing::HasSubstr("applet 'Holder' triggers bundle 's'"));
+}
+
+// The runtime's clock thread plans again at a reservation's t_early: the bundle is granted then,
+// with nothing else happening, and not before (the grant is stamped with the scheduler's time).
+TEST(Runtime, ReservationIsGrantedAtItsEarliestStartWithoutAnyOtherCall) {
+  Model m;
+  const ServiceId s = m.add_service("S");
+  m.add_bundle(m.add_applet("Later"), "s", {{s, kX}});
+  Runtime rt(m);
+  std::atomic<long long> granted_at{-1}, t_early{-1};
+  rt.set_code("Later", {[&](AppletContext& c) {
+                          milliseconds now{0};
+                          rt.with_scheduler([&](Scheduler& sch) { now = sch.now(); });
+                          t_early = (now + 300ms).count();
+                          c.set_deadline("s", Deadline{now + 300ms, 100ms, now + 10s});
+                          c.request("s");
+                        },
+                        [](AppletContext&) {},
+                        [&](AppletContext&, const Notification& n) {
+                          if (n.kind == Notification::Kind::kGranted) granted_at = n.until.count();
+                        },
+                        2ms});
+  rt.start();
+  ASSERT_TRUE(eventually([&] { return granted_at >= 0; }));
+  rt.stop();
+  EXPECT_GE(granted_at.load(), t_early.load());
 }
 
 TEST(Runtime, HolderThatDoesNotYieldIsRevokedByForceAndToldWhoGetsIt) {

@@ -27,6 +27,33 @@ std::string holder_of(const StepResult& r, const std::string& service) {
   return "?";
 }
 
+// On the logical clock of a scenario, a reservation for later is planned at its t_early and its
+// request expires at t_finish, with notes for both (seed §4.5.1).
+TEST(Scenario, ReservationIsPlannedAtItsEarliestStartAndExpiresAtItsFinish) {
+  const auto s = Scenario::parse(R"(services: [{name: Pilot}]
+applets:
+  - {name: Battery, bundles: [{name: dock, resources: [{service: Pilot}]}]}
+  - {name: DriveTo, bundles: [{name: drive, resources: [{service: Pilot}]}]}
+timeline:
+  - label: battery reserves 5000-6000 ms
+    do:
+      - {set_deadline: Battery/dock, t_early_ms: 5000, t_duration_ms: 1000, t_finish_ms: 6000}
+      - {request: Battery/dock}
+      - {request: DriveTo/drive}
+    expect: {Pilot: DriveTo}
+  - {label: before, t_ms: 4999, expect: {Pilot: DriveTo}}
+  - {label: t_early, t_ms: 5000, expect: {Pilot: Battery}, expect_active: {Pilot: Battery}}
+  - {label: after t_finish, t_ms: 6500, expect: {Pilot: DriveTo}, expect_active: {Pilot: DriveTo}}
+)",
+                                 "r.yaml");
+  const auto results = s.run();
+  for (const auto& r : results) EXPECT_TRUE(r.mismatches.empty()) << r.mismatches[0];
+  const auto& expired = results[3].notes;
+  EXPECT_NE(std::find(expired.begin(), expired.end(),
+                      "Battery/dock: deadline expired (t_finish 6000 ms), request withdrawn"),
+            expired.end());
+}
+
 TEST(Scenario, RealWorldScenarioReproducesAbb54TwentyTimes) {
   const Scenario s = Scenario::load_file(scenario_path("real_world_5_3.yaml"));
   std::string first;

@@ -114,8 +114,10 @@ TEST(Scheduler, NegotiationExtendsTheWaitWithinTheRoundLimit) {
   auto n = s.negotiate(t.low, Negotiation{milliseconds{3000}, milliseconds{8000}, true});
   EXPECT_EQ(n.kind, Notification::Kind::kNegotiationAccepted);
   EXPECT_EQ(n.until, milliseconds{8000});
-  n = s.negotiate(t.low, Negotiation{milliseconds{0}, milliseconds{0}, false});
+  // An objection insisting on more than a round may grant is rejected (the wait stands).
+  n = s.negotiate(t.low, Negotiation{milliseconds{0}, milliseconds{30000}, false});
   EXPECT_EQ(n.kind, Notification::Kind::kNegotiationRejected);
+  EXPECT_EQ(n.until, milliseconds{8000});
   n = s.negotiate(t.low, Negotiation{milliseconds{100}, milliseconds{100}, true});
   EXPECT_EQ(n.kind, Notification::Kind::kNegotiationRejected);  // third round > 2
   s.advance_to(milliseconds{7999});
@@ -135,6 +137,107 @@ TEST(Scheduler, NegotiationCannotPassTheRoundLimitOrANewHoldersDeadline) {
   EXPECT_EQ(n.until, milliseconds{5000});  // min 1500 fits the deadline; the wait is longer
   n = s.negotiate(t.low, Negotiation{milliseconds{2500}, milliseconds{2500}, true});
   EXPECT_EQ(n.kind, Notification::Kind::kNegotiationRejected);  // latest start is 2000 ms
+}
+
+// Seed §4.5.3: a round carries a vote, agreeing to the revocation or objecting to it, and the
+// scheduler agrees to or rejects that round; an objection is negotiable like an agreement (it used
+// to be rejected whatever it asked for).
+TEST(Scheduler, ObjectionIsUpheldWhenTheTimeItInsistsOnFits) {
+  TwoApplets t;
+  SchedulerOptions o;
+  o.revoke_wait = milliseconds{1000};
+  Scheduler s(t.m, o);
+  s.request(t.low);
+  s.request(t.high);
+  auto n = s.negotiate(t.low, Negotiation{milliseconds{2000}, milliseconds{4000}, false});
+  EXPECT_EQ(n.kind, Notification::Kind::kNegotiationAccepted);
+  EXPECT_EQ(n.until, milliseconds{4000});
+  s.advance_to(milliseconds{3999});
+  EXPECT_TRUE(s.active(t.low));
+  EXPECT_FALSE(s.active(t.high));
+  s.advance_to(milliseconds{4000});
+  EXPECT_TRUE(s.active(t.high));
+}
+
+// What the vote says decides the outcome: with a new holder's latest start at 2000 ms only the
+// minimum fits, which an agreement accepts as a compromise and an objection does not offer.
+TEST(Scheduler, ObjectionAndAgreementAskingTheSameTimesDifferWhenOnlyTheMinimumFits) {
+  for (const bool accept : {true, false}) {
+    TwoApplets t;
+    Scheduler s(t.m);
+    s.request(t.low);
+    s.request(t.high);
+    s.set_deadline(t.high, Deadline{milliseconds{0}, milliseconds{1000}, milliseconds{3000}});
+    const auto n = s.negotiate(t.low, Negotiation{milliseconds{1500}, milliseconds{6000}, accept});
+    EXPECT_EQ(n.kind, accept ? Notification::Kind::kNegotiationAccepted
+                             : Notification::Kind::kNegotiationRejected)
+        << "accept " << accept;
+    EXPECT_EQ(n.until, milliseconds{5000}) << "accept " << accept;  // the wait limit stands
+  }
+}
+
+// Seed §4.5.1: a deadline (t_early, t_duration, t_finish) asks for access from t_early on. A
+// reservation for 5000-6000 ms made at 0 ms took the service at once; now it takes nothing
+// before 5000 ms, and the plan at 5000 ms grants it (EDF puts it before a request without one).
+TEST(Scheduler, ReservationForALaterTimeIsGrantedFromItsEarliestStartOn) {
+  Model m;
+  const ServiceId svc = m.add_service("S");
+  const BundleId later = m.add_bundle(m.add_applet("Later"), "s", {{svc, kX}});
+  const BundleId now = m.add_bundle(m.add_applet("Now"), "s", {{svc, kX}});
+  Scheduler s(m);
+  s.set_deadline(later, Deadline{milliseconds{5000}, milliseconds{1000}, milliseconds{6000}});
+  s.request(later);
+  EXPECT_FALSE(s.plan().bundle_granted[later]);
+  EXPECT_FALSE(s.active(later));
+  EXPECT_EQ(s.holder(svc), "undef");  // nobody asks for it yet
+  s.request(now);
+  EXPECT_TRUE(s.active(now));  // the reservation takes nothing from others before its time
+  EXPECT_EQ(s.next_event(), milliseconds{5000});
+  s.advance_to(milliseconds{4999});
+  EXPECT_FALSE(s.plan().bundle_granted[later]);
+  const auto plans = s.plans_computed();
+  s.advance_to(milliseconds{5000});
+  EXPECT_EQ(s.plans_computed(), plans + 1);  // a new plan at t_early
+  EXPECT_TRUE(s.plan().bundle_granted[later]);
+  EXPECT_EQ(s.revoke_deadline(now), milliseconds{10000});  // given back from 5000 ms on
+  s.yield(now);
+  EXPECT_TRUE(s.active(later));
+}
+
+// Seed §4.5.1: t_finish is the latest end of the access. When it passes, the request is withdrawn
+// and the applet told (kDeadlineExpired): a waiting request is dropped, a bundle in use is given
+// back through its reassigners like any other.
+TEST(Scheduler, RequestExpiresWhenItsFinishPasses) {
+  Model m;
+  const ServiceId a = m.add_service("A");
+  const ServiceId b = m.add_service("B");
+  const BundleId holder = m.add_bundle(m.add_applet("Holder"), "a", {{a, kX}}, kPriorityHigh);
+  const BundleId waiting = m.add_bundle(m.add_applet("Waiting"), "a", {{a, kX}});
+  const BundleId using_b = m.add_bundle(m.add_applet("User"), "b", {{b, kX}});
+  Scheduler s(m);
+  s.request(holder);
+  s.request(waiting);
+  s.set_deadline(waiting, Deadline{milliseconds{0}, milliseconds{1000}, milliseconds{3000}});
+  s.request(using_b);
+  s.set_deadline(using_b, Deadline{milliseconds{0}, milliseconds{100}, milliseconds{2000}});
+  EXPECT_TRUE(s.active(using_b));
+  s.take_notifications();
+  s.advance_to(milliseconds{2500});
+  EXPECT_FALSE(s.requested(using_b));
+  EXPECT_TRUE(s.revoke_deadline(using_b).has_value());  // still in use until it yields
+  auto notes = s.take_notifications();
+  ASSERT_GE(notes.size(), 2u);
+  EXPECT_EQ(notes[0].kind, Notification::Kind::kDeadlineExpired);
+  EXPECT_EQ(notes[0].bundle, using_b);
+  EXPECT_EQ(notes[0].until, milliseconds{2000});
+  EXPECT_EQ(notes[1].kind, Notification::Kind::kRevokeRequested);
+  EXPECT_EQ(notes[1].until, milliseconds{7000});  // the wait started at 2000 ms, not 2500 ms
+  EXPECT_TRUE(s.requested(waiting));
+  s.advance_to(milliseconds{3000});
+  EXPECT_FALSE(s.requested(waiting));
+  EXPECT_FALSE(s.deadline(waiting).has_value());
+  s.release(holder);
+  EXPECT_EQ(s.holder(a), "undef");  // the expired request is not granted later
 }
 
 TEST(Scheduler, PlanTakenBackCancelsTheRevocation) {
@@ -189,6 +292,52 @@ TEST(Scheduler, CrashReleasesOnlyTheCrashedAppletsBundles) {
   EXPECT_TRUE(s.active(waiting));
   EXPECT_TRUE(s.active(good));
   EXPECT_FALSE(s.requested(ba));
+}
+
+// Seed §4.6.1 (cascading effects): when a service applet crashes, its services are gone. Its
+// resources used to be granted again through inheritance, and the users of its service kept
+// their grant; now the users lose it at once (told, naming the service), keep their request,
+// and what the service applet held is free for others.
+TEST(Scheduler, CrashedServiceAppletsServicesBecomeUnavailableAndTheirUsersLoseThem) {
+  Model m;
+  const ServiceId monitor = m.add_service("Monitor", true);
+  const ServiceId ui = m.add_service("UI", true);
+  const ServiceId menu_view = m.add_service("MenuView");
+  m.add_dependency(menu_view, ui);  // down the hierarchy: MenuView needs UI
+  const AppletId provider = m.add_applet("UIService");
+  m.provide(provider, ui);
+  const BundleId io = m.add_bundle(provider, "io", {{monitor, kX}});
+  const BundleId menu = m.add_bundle(m.add_applet("Menu"), "ui", {{ui, kX}}, kPriorityHigh);
+  const BundleId viewer = m.add_bundle(m.add_applet("Viewer"), "v", {{menu_view, kX}});
+  const BundleId screen = m.add_bundle(m.add_applet("Screen"), "m", {{monitor, kX}}, kPriorityLow);
+  Scheduler s(m);
+  s.request(menu);
+  s.request(screen);
+  EXPECT_TRUE(s.active(menu));
+  EXPECT_TRUE(s.active(io));       // inherited
+  EXPECT_FALSE(s.active(screen));  // the service applet holds the monitor
+  s.take_notifications();
+  s.crash(provider);
+  EXPECT_TRUE(s.crashed(provider));
+  EXPECT_FALSE(s.available(ui));
+  EXPECT_FALSE(s.active(menu));
+  EXPECT_TRUE(s.requested(menu));
+  EXPECT_FALSE(s.plan().bundle_granted[io]);
+  EXPECT_FALSE(s.active(io));
+  EXPECT_EQ(s.holder(ui), "unavailable");
+  EXPECT_TRUE(s.active(screen));  // the monitor is free again
+  EXPECT_EQ(s.holder(monitor), "Screen");
+  bool told = false;
+  for (const Notification& n : s.take_notifications()) {
+    told = told ||
+           (n.kind == Notification::Kind::kRevokedByForce && n.bundle == menu && n.service == ui);
+  }
+  EXPECT_TRUE(told);
+  s.request(viewer);  // needs UI down the hierarchy: cannot be granted
+  EXPECT_FALSE(s.plan().bundle_granted[viewer]);
+  EXPECT_EQ(s.holder(menu_view), "blocked");
+  EXPECT_THAT(error_of([&] { s.request(io); }),
+              HasSubstr("applet 'UIService' requests bundle 'io' but it crashed"));
 }
 
 }  // namespace

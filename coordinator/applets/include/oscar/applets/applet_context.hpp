@@ -38,7 +38,12 @@ class AppletContext {
   void request(const std::string& bundle);
   void release(const std::string& bundle);
   void yield(const std::string& bundle);
+  /// Raises the bundle above its level for one plan (seed §4.5.2).
+  /// @throws std::invalid_argument from an interrupt handler for a revocation notice
+  /// (kRevokeRequested, kNegotiationAccepted/Rejected, kRevokedByForce) or a negotiation round:
+  /// an applet never re-prioritises in reaction to a revocation (seed footnote 11).
   void trigger(const std::string& bundle);
+  /// Changes the bundle's priority. @throws std::invalid_argument as trigger() does.
   void set_priority(const std::string& bundle, int priority);
   void set_deadline(const std::string& bundle, std::optional<Deadline> deadline);
   /// Answers a revocation with one round's answer only (no code, no follow-up).
@@ -67,6 +72,8 @@ class AppletContext {
 
  private:
   BundleId bundle_id(const std::string& bundle) const;
+  // Throws while the applet reacts to a revocation (seed footnote 11).
+  void refuse_reprioritising(const std::string& bundle, const char* what) const;
   Runtime& runtime_;
   AppletId applet_;
 };

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -117,14 +118,41 @@ class Model {
 
   /// What granting `service` needs directly: its configured dependencies (used by the service)
   /// and all resources of its providing service applet (neededServices(s), seed Abb. 4.21).
-  const std::vector<Use>& needs(ServiceId service) const;
+  /// Valid after the last change to the model.
+  std::span<const Use> needs(ServiceId service) const {
+    ensure_analysed();
+    const std::uint32_t begin = needs_begin_.at(service);
+    return {needs_.data() + begin, needs_begin_[service + 1] - begin};
+  }
+  /// The bundle's resources as uses of their services, in bundle order. Valid after the last
+  /// change to the model.
+  std::span<const Use> bundle_uses(BundleId bundle) const {
+    ensure_analysed();
+    const std::uint32_t begin = bundle_uses_begin_.at(bundle);
+    return {bundle_uses_.data() + begin, bundle_uses_begin_[bundle + 1] - begin};
+  }
 
   /// Bundles that lie on a dependency cycle together with `bundle` (including itself), or empty
   /// if it lies on none (seed §4.2.3, Abb. 4.9). Valid after the last change to the model.
   const std::vector<BundleId>& cycle_of(BundleId bundle) const;
+  /// The number of such cycles, and which one a bundle lies on (none: not on a cycle).
+  std::size_t cycle_count() const {
+    ensure_analysed();
+    return cycles_.size();
+  }
+  std::optional<std::uint32_t> cycle_index(BundleId bundle) const {
+    ensure_analysed();
+    const std::uint32_t index = cycle_index_.at(bundle);
+    if (index == kNoCycle) return std::nullopt;
+    return index;
+  }
 
  private:
   void invalidate() { analysed_ = false; }
+  // The accessors above are inline: the plan calls them for every bundle.
+  void ensure_analysed() const {
+    if (!analysed_) analyse();
+  }
   void analyse() const;
 
   std::vector<Service> services_;
@@ -135,8 +163,15 @@ class Model {
   std::unordered_map<std::string, AppletId> applet_ids_;
 
   mutable bool analysed_ = false;
-  mutable std::vector<std::vector<Use>> needs_;
-  mutable std::vector<std::vector<BundleId>> cycles_;  // per bundle
+  // Flat tables (offsets per service / per bundle, then the uses one after the other): the plan
+  // walks them at random places, so each lookup is two loads, not a chain of pointers.
+  mutable std::vector<std::uint32_t> needs_begin_;
+  mutable std::vector<Use> needs_;
+  mutable std::vector<std::uint32_t> bundle_uses_begin_;
+  mutable std::vector<Use> bundle_uses_;
+  mutable std::vector<std::vector<BundleId>> cycles_;  // members per cycle
+  mutable std::vector<std::uint32_t> cycle_index_;     // per bundle; kNoCycle if none
+  static constexpr std::uint32_t kNoCycle = ~std::uint32_t{0};
 };
 
 /// "shared" or "exclusive".

@@ -34,8 +34,21 @@ struct GrantedUse {
   BundleId root = 0;
 };
 
+/// What a plan needs besides the bundles' state.
+struct PlanContext {
+  /// The time the plan is made for: a bundle whose deadline's t_early lies after it is not
+  /// considered yet (seed §4.5.1: access from the earliest start on); a plan at t_early grants it.
+  std::chrono::milliseconds now{0};
+  std::chrono::milliseconds context_switch{0};  ///< c of eq. 4.9–4.11.
+  /// Per service (or empty: none): the service is gone (its service applet crashed); nothing
+  /// that needs it can be granted (seed §4.6.1, cascading effects).
+  std::vector<char> unavailable;
+};
+
 /// The result of one plan.
 struct Plan {
+  /// The time it was made for (PlanContext::now).
+  std::chrono::milliseconds time{0};
   /// The sorted working set W_t (requested bundles); the next plan starts from it.
   std::vector<BundleId> order;
   std::vector<char> bundle_granted;           ///< Per bundle: all its resources are granted.
@@ -45,19 +58,27 @@ struct Plan {
   std::vector<std::pair<BundleId, BundleId>> deadline_overlaps;
   /// Per bundle: the priority it was sorted with (cycles take their highest, seed §4.5.1).
   std::vector<int> effective_priority;
+  /// PlanContext::unavailable, kept for can_grant.
+  std::vector<char> unavailable;
 };
 
 /// Computes the plan (seed Abb. 4.19): the working set `previous_order` extended by new requests,
 /// stably sorted by priority (descending; a triggered bundle just above its level), then EDF on
 /// the relative deadline, then held bundles first; walked greedily, each bundle granted with
-/// everything it needs down the service hierarchy (priority inheritance) or not at all.
+/// everything it needs down the service hierarchy (priority inheritance) or not at all. A
+/// requested bundle whose t_early lies after `context.now` keeps its place in the working set
+/// but is not granted (it waits, taking nothing from others).
 /// Runs in O(n log n) for n bundles when the service hierarchy is bounded.
 Plan calculate_assignments(const Model& model, const std::vector<BundleState>& state,
                            const std::vector<BundleId>& previous_order,
                            const std::vector<char>& previously_granted,
-                           std::chrono::milliseconds context_switch = std::chrono::milliseconds{0});
+                           const PlanContext& context = {});
 
-/// Whether a new use of `service` with `access` could be granted beside `plan` (with all it needs).
+/// Whether a bundle's request waits for its earliest start: t_early later than `now`.
+bool waits_for_t_early(const BundleState& state, std::chrono::milliseconds now);
+
+/// Whether a new use of `service` with `access` could be granted beside `plan` (with all it needs,
+/// none of it unavailable).
 bool can_grant(const Model& model, const Plan& plan, ServiceId service, Access access);
 
 /// Eq. 4.11 with the context-switch time c: min(t_early) + d_i + d_j + c > max(t_finish).

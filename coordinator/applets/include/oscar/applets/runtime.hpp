@@ -1,9 +1,10 @@
 #pragma once
 // The threaded runtime (seed 000 §4.4, §4.6.2): every applet in its own thread inside a wrapper
 // that contains crashes; interrupt handlers queued to the applet and run between its main-loop
-// steps (Abb. 4.12), with negotiation rounds spread over the steps (§4.5.3); a thread that lets
-// the scheduler's per-service reassigners revoke by force when a wait limit passes. The
-// decisions are the deterministic Scheduler's, driven by the steady clock.
+// steps (Abb. 4.12), with negotiation rounds spread over the steps (§4.5.3); a thread that moves
+// the scheduler's clock at its next event (a wait limit passed: revoke by force; a t_early
+// reached or a t_finish passed: plan again). The decisions are the deterministic Scheduler's,
+// driven by the steady clock.
 
 #include <chrono>
 #include <condition_variable>
@@ -12,6 +13,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -78,8 +80,12 @@ class Runtime {
       int rounds = 0;
     };
     std::map<BundleId, Chain> negotiations;  // applet thread only
-    std::uint64_t steps = 0;                 // main-loop steps so far; applet thread only
-    std::condition_variable cv;              // wakes this applet only (no thundering herd)
+    /// The bundle whose revocation the applet's code is reacting to (an interrupt handler for a
+    /// revocation notice, or a negotiation round), if any: no re-prioritising meanwhile (seed
+    /// §4.5.2, footnote 11). Applet thread only.
+    std::optional<BundleId> reacting_to_revocation;
+    std::uint64_t steps = 0;     // main-loop steps so far; applet thread only
+    std::condition_variable cv;  // wakes this applet only (no thundering herd)
     std::thread thread;
   };
   using Clock = std::chrono::steady_clock;
@@ -99,8 +105,8 @@ class Runtime {
   void reassigner_main();
 
   mutable std::mutex mutex_;
-  std::condition_variable changed_;                // wakes the force thread
-  milliseconds forcing_at_ = milliseconds::max();  // the wait limit the force thread waits for
+  std::condition_variable changed_;                // wakes the clock thread
+  milliseconds forcing_at_ = milliseconds::max();  // the event the clock thread waits for
   std::vector<Slot*> to_wake_;
   Scheduler scheduler_;
   std::vector<std::unique_ptr<Slot>> slots_;

@@ -30,7 +30,10 @@ struct SchedulerOptions {
 struct Negotiation {
   milliseconds min_needed{0};  ///< Least time the applet still needs the bundle.
   milliseconds max_needed{0};  ///< Most time it needs.
-  bool accept = false;         ///< Vote: agrees to the revocation (after the time it needs).
+  /// Vote: true agrees to the revocation after the time it needs (granted max_needed if that
+  /// fits, else min_needed); false objects to it (upheld with max_needed if that fits, else
+  /// rejected). Either way within the round limits and new holders' deadlines.
+  bool accept = false;
 };
 
 /// What the scheduler tells an applet; delivered through the applet's interrupt queue.
@@ -42,6 +45,9 @@ struct Notification {
     kNegotiationRejected,  ///< No more time; yield before `until`.
     kRevokedByForce,       ///< The wait limit passed: the bundle is gone.
     kDeadlineOverlap,      ///< Its deadline overlaps `other`'s (eq. 4.11); best effort.
+    /// t_finish (`until`) passed: the access window is over, the request is withdrawn (a bundle
+    /// still in use is given back through its reassigners like any other).
+    kDeadlineExpired,
   };
   Kind kind = Kind::kGranted;
   AppletId applet = 0;
@@ -76,12 +82,15 @@ class Scheduler {
   const SchedulerOptions& options() const { return options_; }
   milliseconds now() const { return now_; }
 
-  /// Moves the logical clock forward and revokes by force where the wait limit passed.
+  /// Moves the logical clock forward. What falls due on the way happens at its own time, in
+  /// order: requests whose t_finish passed expire (kDeadlineExpired), requests whose t_early is
+  /// reached are planned (a new plan), wait limits that passed revoke by force.
   /// @throws std::invalid_argument if `t` lies before now().
   void advance_to(milliseconds t);
 
   /// Asks for a bundle (again). @throws std::invalid_argument if another requested bundle of the
-  /// same applet uses one of its services and either asks for exclusive access.
+  /// same applet uses one of its services and either asks for exclusive access, or if the
+  /// applet crashed.
   void request(BundleId bundle);
   /// Gives a bundle back and withdraws the request.
   void release(BundleId bundle);
@@ -89,14 +98,22 @@ class Scheduler {
   void yield(BundleId bundle);
   /// Changes a bundle's priority. @throws std::invalid_argument if negative.
   void set_priority(BundleId bundle, int priority);
-  /// Sets or clears a deadline (eq. 4.9–4.10 with the context-switch time).
+  /// Sets or clears a deadline (eq. 4.9–4.10 with the context-switch time). The bundle is not
+  /// granted before t_early, and its request expires at t_finish (seed §4.5.1).
   /// @throws std::invalid_argument naming the violated inequality.
   void set_deadline(BundleId bundle, std::optional<Deadline> deadline);
   /// Raises a requested bundle just above its priority level for one plan, then restores it
   /// (seed §4.5.2, Abb. 4.18). @throws std::invalid_argument if the bundle is not requested.
   void trigger(BundleId bundle);
-  /// An applet crashed: all its bundles are released at once, nothing else is touched.
+  /// An applet crashed (seed §4.6.1): all its bundles are released at once, and the services it
+  /// provides become unavailable for good — the bundles using them (directly or down the
+  /// hierarchy) lose them at once (kRevokedByForce naming the service) and keep their request,
+  /// which cannot be granted while the service is gone. Nothing else is touched.
   void crash(AppletId applet);
+  /// Whether the applet crashed.
+  bool crashed(AppletId applet) const { return crashed_.at(applet) != 0; }
+  /// Whether the service can be used: false once its service applet crashed.
+  bool available(ServiceId service) const { return plan_context_.unavailable.at(service) == 0; }
   /// An applet answers a revocation: every reassigner taking a service of the bundle decides on
   /// its own (it gets one notification per service). Returns the summary: accepted if all
   /// accepted, `until` the earliest time by which the bundle must be yielded.
@@ -112,13 +129,20 @@ class Scheduler {
   std::optional<milliseconds> revoke_deadline(BundleId bundle) const;
   /// The earliest wait limit of any running reassigner (when advance_to next revokes by force).
   std::optional<milliseconds> next_forced_revocation() const;
+  /// The earliest time at which advance_to changes something: a forced revocation, a t_early
+  /// reached or a t_finish passed. The threaded Runtime wakes then.
+  std::optional<milliseconds> next_event() const;
   /// The reassigner of a service; `giving` is empty when none runs.
   const Reassignment& reassignment(ServiceId service) const { return reassigners_.at(service); }
   bool requested(BundleId bundle) const { return state_.at(bundle).requested; }
   int priority(BundleId bundle) const { return state_.at(bundle).priority; }
+  const std::optional<Deadline>& deadline(BundleId bundle) const {
+    return state_.at(bundle).deadline;
+  }
 
   /// The planned holder of a service for people: applet names (sorted, joined by ','), "blocked"
-  /// (requested but not granted, or held up by a dependency) or "undef" (nobody asked).
+  /// (requested but not granted, or held up by a dependency), "unavailable" (its service applet
+  /// crashed) or "undef" (nobody asked).
   std::string holder(ServiceId service) const;
   /// Who may use a service right now (handed over, seed Abb. 4.2): applet names joined by ',',
   /// or "none". Differs from holder() while a reassignment is under way.
@@ -144,6 +168,8 @@ class Scheduler {
   Notification notice(Notification::Kind kind, BundleId bundle,
                       std::optional<ServiceId> service = std::nullopt) const;
   void replan();
+  // Expiries, t_early reached and forced revocations due at now_.
+  void handle_due();
   void update_handover();
   const std::vector<FootUse>& footprint(BundleId bundle) const;
   const std::vector<ServiceId>& services_of(BundleId bundle) const;
@@ -166,6 +192,8 @@ class Scheduler {
   std::vector<char> active_;
   std::vector<char> revoking_;             // per bundle: in some reassigner's `giving`
   std::vector<Reassignment> reassigners_;  // per service
+  std::vector<char> crashed_;              // per applet
+  PlanContext plan_context_;               // unavailable: per service
   std::vector<Notification> notifications_;
   std::uint64_t plans_ = 0;
   mutable std::vector<std::optional<std::vector<FootUse>>> footprint_cache_;  // sorted by service
