@@ -83,10 +83,16 @@ void Registry::on_monitor_beat(const MonitorBeat& beat) {
   spdlog::info("registry: monitor of host '{}' is {} (pid {})", beat.host(), back ? "back" : "up",
                beat.pid());
   for (auto& m : modules_) {
-    if (m->spec->spec.host != beat.host() || m->process_gone || m->incarnation == 0 ||
-        m->status == "running" || m->status == "starting") {
+    if (m->spec->spec.host != beat.host() || m->process_gone || m->incarnation == 0) continue;
+    if (m->status == "running" && m->spec->debug.holds_process() && m->launched_by != beat.pid()) {
+      // Its heartbeat did not count (on_module_lost): it died with the monitor that started it.
+      fail(*m,
+           fmt::format("host '{}' lost (its monitor, pid {}, was replaced)", beat.host(),
+                       m->launched_by),
+           true);
       continue;
     }
+    if (m->status == "running" || m->status == "starting") continue;
     if (m->launched_by == beat.pid()) {
       // The monitor was only slow: a failed module of it may still run. Kill it; the restart
       // follows its reported exit.
@@ -128,9 +134,12 @@ void Registry::on_process_event(const ProcessEvent& e) {
     return;
   }
   if (m->status != "running" && m->status != "starting") return;  // already handled
+  // Under gdbserver the monitor's child is gdbserver: it exits (code 0) when the module ends,
+  // however that was; its last line says how ("Child terminated with signal = 0xb (SIGSEGV)").
+  const std::string who = m->spec->debug.holds_process() ? "gdbserver " : "";
   std::string reason = e.kind() == PROC_START_FAILED ? "could not start: " + e.detail()
-                       : e.signal() != 0 ? fmt::format("killed by signal {}", e.signal())
-                                         : fmt::format("exited with code {}", e.exit_code());
+                       : e.signal() != 0 ? fmt::format("{}killed by signal {}", who, e.signal())
+                                         : fmt::format("{}exited with code {}", who, e.exit_code());
   if (e.kind() == PROC_EXITED && !e.detail().empty()) {
     const auto last = e.detail().substr(e.detail().rfind('\n') + 1);
     if (!last.empty()) reason += " (last output: " + last + ")";
@@ -147,6 +156,22 @@ void Registry::on_module_lost(const std::string& module, unsigned incarnation) {
   // with a 300 ms lease). Such a report is ignored; tick() still sees a real lapse. (A real one
   // comes a lease after the last beat, give or take the timer's millisecond.)
   if (beat != Clock::time_point{} && Clock::now() - beat < system_.lease / 2) return;
+  const auto& host = m->spec->spec.host;
+  // Under gdbserver a silent module is most likely stopped at a breakpoint: no hang, and killing
+  // it would end the debugging session. Its exit or crash still ends gdbserver, which its monitor
+  // reports (on_process_event); if the monitor itself dies, a new one tells (on_monitor_beat).
+  // Not "only while the monitor answers": a module stopped in gdb made its monitor's heartbeat
+  // lapse here for a moment too (tests/integration/debugger_test.cpp), which would kill it.
+  if (m->spec->debug.holds_process()) {
+    if (!m->held) {
+      m->held = true;
+      spdlog::info(
+          "registry: module '{}' sends no heartbeat; it runs under {} (stopped in the "
+          "debugger?), so it is not taken for hung",
+          module, m->spec->debug.describe());
+    }
+    return;
+  }
   const auto reason = fmt::format(
       "heartbeat lost for {} (hung or stopped; {})", format_duration(system_.lease),
       beat == Clock::time_point{}
@@ -154,7 +179,6 @@ void Registry::on_module_lost(const std::string& module, unsigned incarnation) {
           : fmt::format("last one {} ago",
                         format_duration(std::chrono::duration_cast<std::chrono::milliseconds>(
                             Clock::now() - beat))));
-  const auto& host = m->spec->spec.host;
   fail(*m, monitors_[host].alive ? reason : fmt::format("host '{}' lost ({})", host, reason),
        false);
 }

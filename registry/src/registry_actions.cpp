@@ -28,6 +28,7 @@ void Registry::launch(Tracked& m, unsigned incarnation) {
   m.status = "starting";
   m.process_gone = false;
   m.has_state = false;
+  m.held = false;
   auto argv = module_command(system_, *m.spec, incarnation, "oscar-run", mon.log_dir);
   if (m.config) argv.insert(argv.end(), {"--restore", restore_text(*m.config)});
   io_->send(LAUNCH_START, host, mon.pid, m.spec->spec.name, incarnation, argv,
@@ -65,6 +66,9 @@ void Registry::tick() {
         beat == Clock::time_point{} ? std::max(system_.lease * 2, kFirstBeatGrace) : system_.lease;
     if (now - std::max(m->running_since, beat) > allowed) {
       on_module_lost(m->spec->spec.name, m->incarnation);
+    } else if (m->held && beat != Clock::time_point{}) {
+      m->held = false;
+      spdlog::info("registry: module '{}' sends its heartbeat again", m->spec->spec.name);
     }
   }
   if (state_ == "booting") {
@@ -243,6 +247,7 @@ void Registry::publish() {
     e.restarts(m->restarts);
     e.last_failure(m->last_failure);
     e.cues_per_s(m->cues_per_s);
+    e.debug(m->spec->debug.describe());
     if (m->has_state) e.state(m->state);
     s.modules().push_back(std::move(e));
   }

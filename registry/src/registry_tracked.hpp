@@ -19,6 +19,7 @@ struct Registry::Tracked {
   std::string last_failure;
   bool process_gone = true;  // the current incarnation's process is known to have ended
   bool suspended = false;    // the registry suspended it and has not resumed it yet
+  bool held = false;         // under gdbserver, its heartbeat lapsed (said once per lapse)
   Clock::time_point restart_at{};
   Clock::time_point running_since{};
   std::string replaced_by;  // set when a replacement takes over

@@ -156,6 +156,11 @@ void check_replace_chains(const SystemSpec& s) {
 
 }  // namespace
 
+std::string DebugSpec::describe() const {
+  if (gdbserver_port > 0) return fmt::format("gdbserver 127.0.0.1:{}", gdbserver_port);
+  return valgrind ? "valgrind" : "";
+}
+
 SystemSpec SystemSpec::load(const std::string& path) { return parse(load_yaml_file(path), path); }
 
 SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {

@@ -60,5 +60,19 @@ TEST(LaunchCommand, ValgrindWritesItsLogBesideTheModules) {
       (Argv{"valgrind", "--log-file=/logs/cam.2.valgrind.log", "--leak-check=full", "oscar-run"}));
 }
 
+// The registry exempts a module from the hang watchdog by this, and `oscar ps` shows describe().
+TEST(LaunchCommand, OnlyGdbserverHoldsTheProcessAndEachWrapperIsNamedForPs) {
+  const auto gdb = one_module(", debug: { gdbserver: 2345 }").modules[0].debug;
+  EXPECT_TRUE(gdb.holds_process());
+  EXPECT_EQ(gdb.describe(), "gdbserver 127.0.0.1:2345");
+  // valgrind slows a module down but never stops it: a silent one under valgrind is hung.
+  const auto valgrind = one_module(", debug: { valgrind: [--leak-check=full] }").modules[0].debug;
+  EXPECT_FALSE(valgrind.holds_process());
+  EXPECT_EQ(valgrind.describe(), "valgrind");
+  const auto plain = one_module("").modules[0].debug;
+  EXPECT_FALSE(plain.holds_process());
+  EXPECT_EQ(plain.describe(), "");
+}
+
 }  // namespace
 }  // namespace oscar

@@ -1,4 +1,5 @@
-// oscar ps: the modules of the running system — host, pid, mode, state, restarts, cue rates.
+// oscar ps: the modules of the running system — host, pid, mode, state, restarts, cue rates,
+// and whether one runs under a debugger.
 #include <cstdio>
 
 #include <fmt/format.h>
@@ -53,6 +54,7 @@ nlohmann::json to_json(const oscar::SystemState& s) {
                             {"restarts", m.restarts()},
                             {"last_failure", m.last_failure()},
                             {"cues_per_s", m.cues_per_s()},
+                            {"debug", m.debug()},
                             {"suspended", m.state().suspended()},
                             {"kernels", kernels}});
   }
@@ -91,10 +93,11 @@ int main(int argc, char** argv) {
                 "STATE", "RESTARTS", "CUES/S", "MODES");
     for (const auto& m : s->modules()) {
       std::printf(
-          "%-16s %-10s %-8d %-4u %-11s %-8u %9.1f  %s%s\n", m.name().c_str(), m.host().c_str(),
+          "%-16s %-10s %-8d %-4u %-11s %-8u %9.1f  %s%s%s\n", m.name().c_str(), m.host().c_str(),
           m.pid(), m.incarnation(),
           (m.state().suspended() && m.status() == "running" ? "suspended" : m.status().c_str()),
           m.restarts(), m.cues_per_s(), modes(m.state()).c_str(),
+          m.debug().empty() ? "" : ("  debug: " + m.debug()).c_str(),
           m.last_failure().empty() ? "" : ("  last failure: " + m.last_failure()).c_str());
       for (const auto& k : m.state().kernels()) {
         if (k.failures() == 0) continue;

@@ -38,6 +38,12 @@ struct DebugSpec {
   int gdbserver_port = 0;  ///< >0: gdbserver listening on 127.0.0.1:<port>
   bool valgrind = false;
   std::vector<std::string> valgrind_args;
+
+  /// True under a debugger that holds the process at breakpoints (gdbserver). Such a module's
+  /// silent heartbeat is no hang: the registry does not kill it for that (its exit still counts).
+  bool holds_process() const { return gdbserver_port > 0; }
+  /// What `oscar ps` shows: "gdbserver 127.0.0.1:PORT", "valgrind", or "" when started plainly.
+  std::string describe() const;
 };
 
 struct SystemModule {
