@@ -169,6 +169,29 @@ TEST(CueFlow, BlockPullsAcrossProcessesReturnTheProducersNewestCuesAndATimeRange
   EXPECT_THROW(in.pull_range(stamp(held[9]), stamp(held[5])), std::invalid_argument);
 }
 
+TEST(CueFlow, ABlockOfImagesCrossesProcessesInOneReply) {
+  // 16 images of 442 KB: one reply of 7 MB, larger than a shared-memory segment or a datagram.
+  auto src = run("src", {"-k", "bench_source:src", "-p", "src.type=GvImage", "-p", "src.count=16",
+                         "-m", "continuous:20ms"});
+  auto consumer = local_module(R"(
+name: consumer
+mode: deactivated
+kernels:
+  - { type: test_gv, name: sink, inputs: { in: { source: src/out, transfer: pull } } }
+)");
+  auto& in = dynamic_cast<test::CollectImage&>(consumer->kernel("sink").kernel()).in_;
+  ASSERT_TRUE(eventually([&] {
+    const auto now = in.pull();
+    return now && now->header().seq() == 16;
+  })) << src->output();
+  const auto block = in.pull_latest(16, 10s);
+  ASSERT_EQ(block.size(), 16u);
+  for (std::size_t i = 0; i < block.size(); ++i) {
+    EXPECT_EQ(block[i]->header().seq(), i + 1);
+    EXPECT_EQ(block[i]->image().size(), 768u * 576u);
+  }
+}
+
 TEST(CueFlow, TwoPullersOfOneProducerAcrossProcessesReceiveOnlyTheirOwnReplies) {
   auto src = run("src", {"-k", "bench_source:src", "-p", "src.type=Bool", "-m", "continuous:5ms"});
   // Two consumers, as two modules would have them: a participant and an input each.
