@@ -147,7 +147,7 @@ void DdsPullServer::on_data_available(dds::DataReader* reader) {
     reply.requester(request.requester());
     reply.id(request.id());
     for (const auto& e : answer(output_.buffer(), request)) {
-      reply.cues().push_back(output_.type().serialize(e.cue.get()));
+      reply.cues().emplace_back().cdr(output_.type().serialize(e.cue.get()));
     }
     replies_->write(&reply);
   }
@@ -255,7 +255,7 @@ void DdsPullSource::on_data_available(dds::DataReader* reader) {
     }
     CueBlock cues;
     try {
-      for (const auto& cdr : reply.cues()) cues.push_back(input_.type().deserialize(cdr));
+      for (const auto& c : reply.cues()) cues.push_back(input_.type().deserialize(c.cdr()));
     } catch (const std::exception&) {
       cues.clear();  // a malformed reply answers "nothing", never garbage
     }
