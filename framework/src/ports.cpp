@@ -57,7 +57,7 @@ void InputPort::set_pull_source(std::shared_ptr<PullSource> source) {
   pull_source_ = std::move(source);
 }
 
-std::shared_future<std::shared_ptr<const void>> InputPort::request(PullQuery query, Stamp t) {
+std::shared_ptr<PullSource> InputPort::pull_source() {
   std::shared_ptr<PullSource> source;
   {
     std::lock_guard lock(hooks_mutex_);
@@ -67,7 +67,16 @@ std::shared_future<std::shared_ptr<const void>> InputPort::request(PullQuery que
     throw std::logic_error(fmt::format(
         "input '{}/{}' cannot pull: it is not connected to a producer", kernel_, name_));
   }
-  return source->request(query, t);
+  return source;
+}
+
+std::shared_future<std::shared_ptr<const void>> InputPort::request(PullQuery query, Stamp t) {
+  return pull_source()->request(query, t);
+}
+
+std::shared_future<CueBlock> InputPort::request(const PullBlock& block) {
+  if (block.kind == PullBlock::Kind::kRange) check_time_range(block.t0, block.t1);
+  return pull_source()->request(block);
 }
 
 OutputPort::OutputPort(std::string kernel, std::string name, const CueTypeInfo& type,

@@ -7,6 +7,13 @@
 
 namespace oscar {
 
+void check_time_range(Stamp t0, Stamp t1) {
+  if (t0 > t1) {
+    throw std::invalid_argument(
+        fmt::format("inverted time range [{}, {}]: the start must not be after the end", t0, t1));
+  }
+}
+
 RingBuffer::RingBuffer(std::size_t depth) : slots_(depth) {
   if (depth == 0) throw std::invalid_argument("ring buffer depth must be at least 1, got 0");
 }
@@ -79,10 +86,7 @@ std::optional<RingEntry> RingBuffer::nearest(Stamp t) const {
 }
 
 std::vector<RingEntry> RingBuffer::range(Stamp t0, Stamp t1) const {
-  if (t0 > t1) {
-    throw std::invalid_argument(
-        fmt::format("inverted time range [{}, {}]: the start must not be after the end", t0, t1));
-  }
+  check_time_range(t0, t1);
   std::lock_guard lock(mutex_);
   std::vector<RingEntry> out;
   for (auto& e : held_locked()) {

@@ -34,6 +34,21 @@ class RingPullSource final : public PullSource {
     return answer.get_future().share();
   }
 
+  std::shared_future<CueBlock> request(const PullBlock& block) override {
+    const auto entries = block.kind == PullBlock::Kind::kLatest
+                             ? producer_.latest(block.n)
+                             : producer_.range(block.t0, block.t1);
+    CueBlock cues;
+    cues.reserve(entries.size());
+    for (const auto& e : entries) {
+      consumer_.buffer().push(e.cue, e.t, wall_now());
+      cues.push_back(e.cue);
+    }
+    std::promise<CueBlock> answer;
+    answer.set_value(std::move(cues));
+    return answer.get_future().share();
+  }
+
  private:
   const RingBuffer& producer_;
   InputPort& consumer_;

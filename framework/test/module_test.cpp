@@ -277,6 +277,44 @@ kernels:
   EXPECT_FALSE(in.pull_at(all[0].t - 1)) << "nothing at or before a time older than the ring";
 }
 
+std::vector<std::uint64_t> seqs(const std::vector<Input<Bool>::Ptr>& cues) {
+  std::vector<std::uint64_t> out;
+  for (const auto& c : cues) out.push_back(c->header().seq());
+  return out;
+}
+
+TEST(Module, BlockPullsAskTheProducersRingForItsNewestCuesAndForATimeRange) {
+  Module m(spec(R"(
+name: pulling
+mode: single_step
+kernels:
+  - { type: test_counter, name: src, mode: { single_step: { trigger: command } } }
+  - { type: test_collect, name: sink, inputs: { in: { source: src/out, transfer: pull } }, mode: deactivated }
+)"),
+           {});
+  m.start(-1);
+  auto& src_ring = m.kernel("src").ports().find_output("out")->buffer();
+  for (int i = 0; i < 5; ++i) {
+    m.apply(command(CMD_TRIGGER, {"src"}));
+    ASSERT_TRUE(eventually([&] { return src_ring.pushed() == static_cast<std::uint64_t>(i + 1); }));
+  }
+  auto& in = kernel_of<test::Collect>(m, "sink").in_;
+  const auto all = src_ring.latest(5);
+  EXPECT_THAT(seqs(in.pull_latest(3)), testing::ElementsAre(3u, 4u, 5u)) << "oldest first";
+  EXPECT_EQ(in.buffer().pushed(), 3u) << "the answer lands in the input's ring too";
+  EXPECT_THAT(seqs(in.pull_latest(100)), testing::ElementsAre(1u, 2u, 3u, 4u, 5u))
+      << "more than the producer holds: what it holds";
+  EXPECT_THAT(seqs(in.pull_range(all[1].t, all[3].t)), testing::ElementsAre(2u, 3u, 4u))
+      << "both ends included";
+  EXPECT_THAT(seqs(in.pull_range(all[1].t + 1, all[3].t - 1)), testing::ElementsAre(3u));
+  EXPECT_TRUE(in.pull_range(0, all[0].t - 1).empty()) << "nothing before the ring";
+  EXPECT_THAT(seqs(in.prefetch(PullBlock::latest(2)).get()), testing::ElementsAre(4u, 5u));
+  EXPECT_THAT([&] { in.pull_range(all[3].t, all[1].t); },
+              ThrowsMessage<std::invalid_argument>(
+                  HasSubstr("inverted time range [" + std::to_string(all[3].t) + ", " +
+                            std::to_string(all[1].t) + "]: the start must not be after the end")));
+}
+
 // --- the seed's multi-core rules (seed 004 §2.2) and bad input ---
 
 TEST(ModuleRules, AtMostOneContinuousKernel) {

@@ -9,10 +9,12 @@
 #include <nlohmann/json.hpp>
 
 #include "oscar/config_client.hpp"
+#include "oscar/cue_type_info.hpp"
 #include "oscar/module.hpp"
 #include "oscar/topic_io.hpp"
 
 #include <oscar/configPubSubTypes.h>
+#include "dds_pull.hpp"  // framework/src
 #include "oscar/testing/eventually.hpp"
 #include "process.hpp"  // tests/common
 #include "test_kernels.hpp"
@@ -132,6 +134,88 @@ TEST(CueFlow, PullAcrossProcessesForAGivenTime) {
   const auto exact = in.pull_at(t);
   ASSERT_TRUE(exact);
   EXPECT_EQ(exact->header().seq(), now->header().seq()) << "at-or-before t finds the cue at t";
+}
+
+std::vector<std::uint64_t> seqs(const std::vector<Input<Bool>::Ptr>& cues) {
+  std::vector<std::uint64_t> out;
+  for (const auto& c : cues) out.push_back(c->header().seq());
+  return out;
+}
+Stamp stamp(const Input<Bool>::Ptr& cue) { return static_cast<Stamp>(cue->header().stamps()[0]); }
+
+TEST(CueFlow, BlockPullsAcrossProcessesReturnTheProducersNewestCuesAndATimeRange) {
+  // 30 cues, then quiet: the producer's ring (depth 16) holds cues 15 to 30.
+  auto src = run("src", {"-k", "bench_source:src", "-p", "src.type=Bool", "-p", "src.count=30",
+                         "-m", "continuous:5ms"});
+  auto consumer = local_module(kPullConsumer);
+  auto& in = collect(*consumer, "sink").in_;
+  ASSERT_TRUE(eventually([&] {
+    const auto now = in.pull();
+    return now && now->header().seq() == 30;
+  })) << src->output();
+  EXPECT_THAT(seqs(in.pull_latest(3)), testing::ElementsAre(28u, 29u, 30u)) << "oldest first";
+  const auto held = in.pull_latest(100);
+  ASSERT_EQ(held.size(), 16u) << "more than the producer holds: what it holds";
+  for (std::size_t i = 0; i < held.size(); ++i) EXPECT_EQ(held[i]->header().seq(), 15 + i);
+
+  EXPECT_THAT(seqs(in.pull_range(stamp(held[5]), stamp(held[9]))),
+              testing::ElementsAre(20u, 21u, 22u, 23u, 24u))
+      << "both ends included";
+  EXPECT_THAT(seqs(in.pull_range(stamp(held[5]) + 1, stamp(held[9]) - 1)),
+              testing::ElementsAre(21u, 22u, 23u));
+  EXPECT_TRUE(in.pull_range(0, stamp(held[0]) - 1).empty()) << "nothing before the ring";
+  const auto block = in.prefetch(PullBlock::latest(2));
+  EXPECT_THAT(seqs(block.get()), testing::ElementsAre(29u, 30u));
+  EXPECT_THROW(in.pull_range(stamp(held[9]), stamp(held[5])), std::invalid_argument);
+}
+
+TEST(CueFlow, ABlockOfImagesCrossesProcessesInOneReply) {
+  // 16 images of 442 KB: one reply of 7 MB, larger than a shared-memory segment or a datagram.
+  auto src = run("src", {"-k", "bench_source:src", "-p", "src.type=GvImage", "-p", "src.count=16",
+                         "-m", "continuous:20ms"});
+  auto consumer = local_module(R"(
+name: consumer
+mode: deactivated
+kernels:
+  - { type: test_gv, name: sink, inputs: { in: { source: src/out, transfer: pull } } }
+)");
+  auto& in = dynamic_cast<test::CollectImage&>(consumer->kernel("sink").kernel()).in_;
+  ASSERT_TRUE(eventually([&] {
+    const auto now = in.pull();
+    return now && now->header().seq() == 16;
+  })) << src->output();
+  const auto block = in.pull_latest(16, 10s);
+  ASSERT_EQ(block.size(), 16u);
+  for (std::size_t i = 0; i < block.size(); ++i) {
+    EXPECT_EQ(block[i]->header().seq(), i + 1);
+    EXPECT_EQ(block[i]->image().size(), 768u * 576u);
+  }
+}
+
+TEST(CueFlow, TwoPullersOfOneProducerAcrossProcessesReceiveOnlyTheirOwnReplies) {
+  auto src = run("src", {"-k", "bench_source:src", "-p", "src.type=Bool", "-m", "continuous:5ms"});
+  // Two consumers, as two modules would have them: a participant and an input each.
+  struct Puller {
+    DdsParticipant participant;
+    Input<Bool> in;
+    std::shared_ptr<internal::DdsPullSource> source;
+    explicit Puller(const std::string& name)
+        : participant(test::test_domain(), "test:" + name),
+          in(name, "in", cue_type_info<Bool>(), {.transfer = Transfer::kPull}),
+          source(
+              std::make_shared<internal::DdsPullSource>(participant, in, "src/out", name + "/in")) {
+      in.set_pull_source(source);
+    }
+  };
+  Puller a("a"), b("b");
+  ASSERT_TRUE(eventually([&] { return a.in.pull() && b.in.pull(); })) << src->output();
+  for (int i = 0; i < 20; ++i) ASSERT_TRUE(a.in.pull());
+  ASSERT_EQ(a.in.pull_latest(4).size(), 4u);
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(b.in.pull());
+  std::this_thread::sleep_for(200ms);  // a reply sent to the other puller would be there by now
+  EXPECT_EQ(b.source->others_replies_seen(), 0u)
+      << "the producer sends b only b's replies, none of the 21 to a";
+  EXPECT_EQ(a.source->others_replies_seen(), 0u);
 }
 
 TEST(CueFlow, PrefetchReturnsAtOnceAndDeliversLater) {

@@ -30,6 +30,23 @@ Transfer parse_transfer(std::string_view text);
 /// Which cue of the producer's ring a pull asks for.
 enum class PullQuery { kLatest, kAtOrBefore, kNearest };
 
+/// Which cues of the producer's ring a block pull asks for: its n newest, or those generated in
+/// [t0, t1]. The answer is oldest first.
+struct PullBlock {
+  enum class Kind { kLatest, kRange };
+  Kind kind = Kind::kLatest;
+  std::size_t n = 0;  ///< kLatest: how many (fewer come if the producer's ring holds fewer)
+  Stamp t0 = 0;       ///< kRange: the start
+  Stamp t1 = 0;       ///< kRange: the end
+  /// The producer's n newest cues.
+  static PullBlock latest(std::size_t n) { return {Kind::kLatest, n, 0, 0}; }
+  /// The producer's cues generated in [t0, t1] (a pull checks t0 <= t1).
+  static PullBlock range(Stamp t0, Stamp t1) { return {Kind::kRange, 0, t0, t1}; }
+};
+
+/// The answer to a block pull: type-erased cues, oldest first.
+using CueBlock = std::vector<std::shared_ptr<const void>>;
+
 /// What delivery an input asks of its producer's output (docs/architecture.md, "Topics and QoS
 /// classes").
 enum class Reliability {
@@ -62,6 +79,8 @@ class PullSource {
   virtual ~PullSource() = default;
   /// Resolves to the cue, or to nullptr if the producer holds none that matches.
   virtual std::shared_future<std::shared_ptr<const void>> request(PullQuery query, Stamp t) = 0;
+  /// Resolves to the cues of the block, oldest first (none if the producer holds none).
+  virtual std::shared_future<CueBlock> request(const PullBlock& block) = 0;
 };
 
 /// The type-independent part of an input; the framework works with this.
@@ -88,11 +107,17 @@ class InputPort {
   /// Asks the producer; the answer is also stored in the ring buffer.
   /// @throws std::logic_error if the input is not connected to a producer.
   std::shared_future<std::shared_ptr<const void>> request(PullQuery query, Stamp t);
+  /// Asks the producer for a block of cues; the answer is also stored in the ring buffer.
+  /// @throws std::logic_error if the input is not connected to a producer.
+  /// @throws std::invalid_argument for a range whose start is after its end.
+  std::shared_future<CueBlock> request(const PullBlock& block);
 
  protected:
   std::uint64_t seen_index_ = 0;  // newest entry handed out by wait_next
 
  private:
+  std::shared_ptr<PullSource> pull_source();  // @throws std::logic_error if there is none
+
   std::string kernel_, name_;
   const CueTypeInfo& type_;
   Transfer transfer_;
@@ -118,6 +143,29 @@ class CueFuture {
 
  private:
   std::shared_future<std::shared_ptr<const void>> f_;
+};
+
+/// The cues a block prefetch will deliver.
+template <CueType T>
+class CueBlockFuture {
+ public:
+  explicit CueBlockFuture(std::shared_future<CueBlock> f) : f_(std::move(f)) {}
+  /// True once the answer is there (then get() does not block).
+  bool ready() const { return f_.wait_for(std::chrono::seconds(0)) == std::future_status::ready; }
+  /// Waits up to `timeout`: the cues, oldest first; none if the producer had none or did not
+  /// answer in time.
+  std::vector<std::shared_ptr<const T>> get(
+      std::chrono::nanoseconds timeout = std::chrono::seconds(1)) const {
+    std::vector<std::shared_ptr<const T>> out;
+    if (f_.wait_for(timeout) != std::future_status::ready) return out;
+    const auto& cues = f_.get();
+    out.reserve(cues.size());
+    for (const auto& c : cues) out.push_back(std::static_pointer_cast<const T>(c));
+    return out;
+  }
+
+ private:
+  std::shared_future<CueBlock> f_;
 };
 
 /// A typed input handle, as KernelSetup::input<T>() returns it.
@@ -173,6 +221,21 @@ class Input final : public InputPort {
   CueFuture<T> prefetch(PullQuery query = PullQuery::kLatest, Stamp t = 0) {
     return CueFuture<T>(request(query, t));
   }
+  /// Pulls the producer's n newest cues, oldest first (fewer if its ring holds fewer); none if it
+  /// has none or did not answer in time.
+  std::vector<Ptr> pull_latest(std::size_t n,
+                               std::chrono::nanoseconds timeout = std::chrono::seconds(1)) {
+    return prefetch(PullBlock::latest(n)).get(timeout);
+  }
+  /// Pulls the producer's cues generated in [t0, t1], oldest first.
+  /// @throws std::invalid_argument if t0 > t1.
+  std::vector<Ptr> pull_range(Stamp t0, Stamp t1,
+                              std::chrono::nanoseconds timeout = std::chrono::seconds(1)) {
+    return prefetch(PullBlock::range(t0, t1)).get(timeout);
+  }
+  /// Starts a block pull and returns at once (prefetch transfer).
+  /// @throws std::invalid_argument for a range whose start is after its end.
+  CueBlockFuture<T> prefetch(const PullBlock& block) { return CueBlockFuture<T>(request(block)); }
 
  private:
   static Ptr cast(const std::optional<RingEntry>& e) {

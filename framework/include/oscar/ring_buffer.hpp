@@ -22,6 +22,10 @@ struct RingEntry {
 };
 
 /// A fixed-depth buffer of the newest cues of one channel end, with access by time.
+/// Checks a time range [t0, t1] as every query by range does.
+/// @throws std::invalid_argument if t0 > t1 (an inverted time range), naming both.
+void check_time_range(Stamp t0, Stamp t1);
+
 /// Thread-safe: one or more producers, any number of readers. Queries by time assume nothing
 /// about order (a rewired input may receive older stamps), so they scan at most `depth` entries.
 class RingBuffer {

@@ -2,18 +2,25 @@
 
 #include <thread>
 
+#include <fastcdr/Cdr.h>
+#include <fastcdr/FastBuffer.h>
 #include <fmt/format.h>
 #include <oscar/pullPubSubTypes.h>
+#include <fastdds/dds/topic/IContentFilter.hpp>
+#include <fastdds/dds/topic/IContentFilterFactory.hpp>
 
 namespace oscar::internal {
 namespace dds = eprosima::fastdds::dds;
 
 namespace {
+// Data sharing would make the writer leave content filtering to the readers (so would
+// intra-process delivery and multicast, which OSCAR's participants do not use across processes).
 dds::DataWriterQos reliable_writer() {
   dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
   q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
   q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
   q.history().depth = 16;
+  q.data_sharing().off();
   return q;
 }
 dds::DataReaderQos reliable_reader() {
@@ -21,7 +28,87 @@ dds::DataReaderQos reliable_reader() {
   q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
   q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
   q.history().depth = 16;
+  q.data_sharing().off();
   return q;
+}
+
+// The reply filter: a reply passes if its first member, `requester`, is the filter expression.
+// Fast DDS's SQL filter would deserialize every reply (cues included) into a dynamic type; this
+// one reads one string. Both sides register it: the consumer's participant to create the
+// filtered topic, the producer's so its writer evaluates it and sends a reply to its asker only.
+constexpr const char* kRequesterFilter = "OSCAR_PULL_REQUESTER";
+
+class RequesterFilter final : public dds::IContentFilter {
+ public:
+  explicit RequesterFilter(std::string requester) : requester_(std::move(requester)) {}
+  bool evaluate(const SerializedPayload& payload, const FilterSampleInfo&,
+                const GUID_t&) const override {
+    try {
+      eprosima::fastcdr::FastBuffer buffer(reinterpret_cast<char*>(payload.data), payload.length);
+      eprosima::fastcdr::Cdr cdr(buffer, eprosima::fastcdr::Cdr::DEFAULT_ENDIAN,
+                                 eprosima::fastcdr::Cdr::DDS_CDR);
+      cdr.read_encapsulation();
+      std::string requester;
+      cdr >> requester;
+      return requester == requester_;
+    } catch (const std::exception&) {
+      return false;  // not a PullReply: nobody asked for it
+    }
+  }
+
+ private:
+  std::string requester_;
+};
+
+class RequesterFilterFactory final : public dds::IContentFilterFactory {
+ public:
+  ReturnCode_t create_content_filter(const char*, const char*, const dds::TopicDataType*,
+                                     const char* filter_expression, const ParameterSeq&,
+                                     dds::IContentFilter*& filter_instance) override {
+    if (!filter_expression) {  // new parameters only: it has none
+      return filter_instance ? ReturnCode_t::RETCODE_OK : ReturnCode_t::RETCODE_BAD_PARAMETER;
+    }
+    delete static_cast<RequesterFilter*>(filter_instance);  // only ever one of ours
+    filter_instance = new RequesterFilter(filter_expression);
+    return ReturnCode_t::RETCODE_OK;
+  }
+  ReturnCode_t delete_content_filter(const char*, dds::IContentFilter* filter_instance) override {
+    delete static_cast<RequesterFilter*>(filter_instance);  // only ever one of ours
+    return ReturnCode_t::RETCODE_OK;
+  }
+};
+
+void register_requester_filter(DdsParticipant& participant) {
+  static RequesterFilterFactory factory;  // stateless; outlives every participant
+  static std::mutex mutex;
+  std::lock_guard lock(mutex);
+  auto& p = participant.get();
+  if (!p.lookup_content_filter_factory(kRequesterFilter) &&
+      p.register_content_filter_factory(kRequesterFilter, &factory) != ReturnCode_t::RETCODE_OK) {
+    throw std::runtime_error("cannot register the pull reply filter");
+  }
+}
+
+std::vector<RingEntry> answer(const RingBuffer& ring, const PullRequest& request) {
+  const auto t = static_cast<Stamp>(request.t_ns());
+  const auto one = [](std::optional<RingEntry> e) {
+    return e ? std::vector<RingEntry>{std::move(*e)} : std::vector<RingEntry>{};
+  };
+  switch (request.query()) {
+    case PULL_LATEST:
+      return one(ring.latest());
+    case PULL_AT_OR_BEFORE:
+      return one(ring.at_or_before(t));
+    case PULL_NEAREST:
+      return one(ring.nearest(t));
+    case PULL_LATEST_N:
+      return ring.latest(static_cast<std::size_t>(request.n()));
+    case PULL_RANGE: {
+      const auto t1 = static_cast<Stamp>(request.t1_ns());
+      return t <= t1 ? ring.range(t, t1) : std::vector<RingEntry>{};  // inverted: nothing
+    }
+  }
+  return {};  // a kind this version does not know
 }
 }  // namespace
 
@@ -34,6 +121,7 @@ std::string pull_reply_topic(const std::string& address) {
 
 DdsPullServer::DdsPullServer(DdsParticipant& participant, OutputPort& output)
     : participant_(participant), output_(output) {
+  register_requester_filter(participant);  // before the writer meets a filtered reader
   replies_ = participant.publisher().create_datawriter(
       &participant.topic(pull_reply_topic(output.address()), new PullReplyPubSubType()),
       reliable_writer());
@@ -55,46 +143,54 @@ void DdsPullServer::on_data_available(dds::DataReader* reader) {
   dds::SampleInfo info;
   while (reader->take_next_sample(&request, &info) == ReturnCode_t::RETCODE_OK) {
     if (!info.valid_data) continue;
-    std::optional<RingEntry> e;
-    const auto t = static_cast<Stamp>(request.t_ns());
-    switch (request.query()) {
-      case PULL_LATEST:
-        e = output_.buffer().latest();
-        break;
-      case PULL_AT_OR_BEFORE:
-        e = output_.buffer().at_or_before(t);
-        break;
-      case PULL_NEAREST:
-        e = output_.buffer().nearest(t);
-        break;
-    }
     PullReply reply;
     reply.requester(request.requester());
     reply.id(request.id());
-    reply.found(e.has_value());
-    if (e) reply.cdr(output_.type().serialize(e->cue.get()));
+    for (const auto& e : answer(output_.buffer(), request)) {
+      reply.cues().emplace_back().cdr(output_.type().serialize(e.cue.get()));
+    }
     replies_->write(&reply);
   }
 }
 
 DdsPullSource::DdsPullSource(DdsParticipant& participant, InputPort& input,
-                             const std::string& source, std::string requester)
-    : participant_(participant), input_(input), requester_(std::move(requester)) {
+                             const std::string& source, const std::string& requester)
+    : participant_(participant), input_(input) {
+  // A rewire makes the new source before it drops the old one, possibly to the same producer:
+  // each source has a name of its own, for its filtered topic and its replies.
+  static std::atomic<std::uint64_t> sources{0};
+  requester_ = fmt::format("{}#{}", requester, ++sources);
+  register_requester_filter(participant);
   requests_ = participant.publisher().create_datawriter(
       &participant.topic(pull_request_topic(source), new PullRequestPubSubType()),
       reliable_writer());
-  replies_ = participant.subscriber().create_datareader(
-      &participant.topic(pull_reply_topic(source), new PullReplyPubSubType()), reliable_reader(),
-      this, dds::StatusMask::data_available());
-  if (!replies_ || !requests_)
+  my_replies_ = participant.get().create_contentfilteredtopic(
+      pull_reply_topic(source) + "/" + requester_,
+      &participant.topic(pull_reply_topic(source), new PullReplyPubSubType()), requester_, {},
+      kRequesterFilter);
+  if (my_replies_) {
+    replies_ = participant.subscriber().create_datareader(my_replies_, reliable_reader(), this,
+                                                          dds::StatusMask::data_available());
+  }
+  if (!replies_ || !requests_) {
+    if (requests_) participant.publisher().delete_datawriter(requests_);
+    if (my_replies_) participant.get().delete_contentfilteredtopic(my_replies_);
     throw std::runtime_error("cannot create pull endpoints for " + source);
+  }
 }
 
 DdsPullSource::~DdsPullSource() {
   participant_.subscriber().delete_datareader(replies_);
+  participant_.get().delete_contentfilteredtopic(my_replies_);
   participant_.publisher().delete_datawriter(requests_);
   std::lock_guard lock(mutex_);
-  for (auto& [id, promise] : pending_) promise.set_value(nullptr);
+  for (auto& [id, pending] : pending_) {
+    if (auto* one = std::get_if<std::promise<std::shared_ptr<const void>>>(&pending)) {
+      one->set_value(nullptr);
+    } else {
+      std::get<std::promise<CueBlock>>(pending).set_value(CueBlock{});
+    }
+  }
 }
 
 bool DdsPullSource::wait_matched(std::chrono::milliseconds timeout) const {
@@ -110,20 +206,41 @@ bool DdsPullSource::wait_matched(std::chrono::milliseconds timeout) const {
   }
 }
 
+void DdsPullSource::send(PullRequest& request, Pending pending) {
+  request.requester(requester_);
+  {
+    std::lock_guard lock(mutex_);
+    request.id(next_id_++);
+    pending_.emplace(request.id(), std::move(pending));
+  }
+  requests_->write(&request);
+}
+
 std::shared_future<std::shared_ptr<const void>> DdsPullSource::request(PullQuery query, Stamp t) {
   PullRequest request;
-  request.requester(requester_);
   request.query(query == PullQuery::kLatest       ? PULL_LATEST
                 : query == PullQuery::kAtOrBefore ? PULL_AT_OR_BEFORE
                                                   : PULL_NEAREST);
   request.t_ns(static_cast<unsigned long long>(t));
-  std::shared_future<std::shared_ptr<const void>> answer;
-  {
-    std::lock_guard lock(mutex_);
-    request.id(next_id_++);
-    answer = pending_[request.id()].get_future().share();
+  std::promise<std::shared_ptr<const void>> promise;
+  auto answer = promise.get_future().share();
+  send(request, std::move(promise));
+  return answer;
+}
+
+std::shared_future<CueBlock> DdsPullSource::request(const PullBlock& block) {
+  PullRequest request;
+  if (block.kind == PullBlock::Kind::kLatest) {
+    request.query(PULL_LATEST_N);
+    request.n(block.n);
+  } else {
+    request.query(PULL_RANGE);
+    request.t_ns(static_cast<unsigned long long>(block.t0));
+    request.t1_ns(static_cast<unsigned long long>(block.t1));
   }
-  requests_->write(&request);
+  std::promise<CueBlock> promise;
+  auto answer = promise.get_future().share();
+  send(request, std::move(promise));
   return answer;
 }
 
@@ -131,19 +248,27 @@ void DdsPullSource::on_data_available(dds::DataReader* reader) {
   PullReply reply;
   dds::SampleInfo info;
   while (reader->take_next_sample(&reply, &info) == ReturnCode_t::RETCODE_OK) {
-    if (!info.valid_data || reply.requester() != requester_) continue;
-    std::shared_ptr<const void> cue;
-    if (reply.found()) {
-      try {
-        cue = input_.type().deserialize(reply.cdr());
-        input_.buffer().push(cue, generation_stamp(input_.type().header(cue.get())), wall_now());
-      } catch (const std::exception&) {
-        cue = nullptr;  // a malformed reply answers "nothing", never garbage
-      }
+    if (!info.valid_data) continue;
+    if (reply.requester() != requester_) {  // the filter lets none through; be sure
+      ++others_replies_seen_;
+      continue;
+    }
+    CueBlock cues;
+    try {
+      for (const auto& c : reply.cues()) cues.push_back(input_.type().deserialize(c.cdr()));
+    } catch (const std::exception&) {
+      cues.clear();  // a malformed reply answers "nothing", never garbage
+    }
+    for (const auto& cue : cues) {
+      input_.buffer().push(cue, generation_stamp(input_.type().header(cue.get())), wall_now());
     }
     std::lock_guard lock(mutex_);
     if (auto it = pending_.find(reply.id()); it != pending_.end()) {
-      it->second.set_value(cue);
+      if (auto* one = std::get_if<std::promise<std::shared_ptr<const void>>>(&it->second)) {
+        one->set_value(cues.empty() ? nullptr : cues.front());
+      } else {
+        std::get<std::promise<CueBlock>>(it->second).set_value(std::move(cues));
+      }
       pending_.erase(it);
     }
   }
