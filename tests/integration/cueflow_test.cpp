@@ -14,7 +14,7 @@
 #include "oscar/topic_io.hpp"
 
 #include <oscar/configPubSubTypes.h>
-#include "dds_pull.hpp"  // framework/src
+#include "dds/pull.hpp"  // framework/src/dds
 #include "oscar/testing/eventually.hpp"
 #include "process.hpp"  // tests/common
 #include "test_kernels.hpp"
