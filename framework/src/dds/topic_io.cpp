@@ -16,64 +16,46 @@ constexpr auto kDynamic = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE
 eprosima::fastrtps::Duration_t seconds(std::chrono::milliseconds d) {
   return eprosima::fastrtps::Duration_t(static_cast<double>(d.count()) / 1000.0);
 }
+
+// Reliable, with the given durability and history, samples allocated as large as they are.
+template <class Qos>
+Qos reliable(Qos q, dds::DurabilityQosPolicyKind durability, dds::HistoryQosPolicyKind history,
+             int depth = 1) {
+  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  q.durability().kind = durability;
+  q.history().kind = history;
+  q.history().depth = depth;
+  q.endpoint().history_memory_policy = kDynamic;
+  return q;
+}
+constexpr auto kTransientLocal = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
+constexpr auto kVolatile = dds::VOLATILE_DURABILITY_QOS;
+constexpr auto kKeepLast = dds::KEEP_LAST_HISTORY_QOS;
+constexpr auto kKeepAll = dds::KEEP_ALL_HISTORY_QOS;
 }  // namespace
 
 dds::DataWriterQos state_writer(int depth) {
-  dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
-  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  q.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
-  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-  q.history().depth = depth;
-  q.endpoint().history_memory_policy = kDynamic;
-  return q;
+  return reliable(dds::DATAWRITER_QOS_DEFAULT, kTransientLocal, kKeepLast, depth);
 }
 
 dds::DataReaderQos state_reader(int depth) {
-  dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
-  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  q.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
-  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-  q.history().depth = depth;
-  q.endpoint().history_memory_policy = kDynamic;
-  return q;
+  return reliable(dds::DATAREADER_QOS_DEFAULT, kTransientLocal, kKeepLast, depth);
 }
 
 dds::DataWriterQos stream_writer(int depth) {
-  dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
-  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
-  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-  q.history().depth = depth;
-  q.endpoint().history_memory_policy = kDynamic;
-  return q;
-}
-
-dds::DataWriterQos command_writer() {
-  dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
-  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
-  q.history().kind = dds::KEEP_ALL_HISTORY_QOS;
-  q.endpoint().history_memory_policy = kDynamic;
-  return q;
-}
-
-dds::DataReaderQos command_reader() {
-  dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
-  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
-  q.history().kind = dds::KEEP_ALL_HISTORY_QOS;
-  q.endpoint().history_memory_policy = kDynamic;
-  return q;
+  return reliable(dds::DATAWRITER_QOS_DEFAULT, kVolatile, kKeepLast, depth);
 }
 
 dds::DataReaderQos stream_reader(int depth) {
-  dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
-  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
-  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-  q.history().depth = depth;
-  q.endpoint().history_memory_policy = kDynamic;
-  return q;
+  return reliable(dds::DATAREADER_QOS_DEFAULT, kVolatile, kKeepLast, depth);
+}
+
+dds::DataWriterQos command_writer() {
+  return reliable(dds::DATAWRITER_QOS_DEFAULT, kVolatile, kKeepAll);
+}
+
+dds::DataReaderQos command_reader() {
+  return reliable(dds::DATAREADER_QOS_DEFAULT, kVolatile, kKeepAll);
 }
 
 dds::DataWriterQos beat_writer(std::chrono::milliseconds lease) {
