@@ -1,10 +1,16 @@
 # Build helpers shared by every folder: warnings, sanitizers, libraries, tests, executables.
 
+# Sanitizer builds compile at -O1 with line tables only (-g1): enough for symbolized reports, and
+# half the compile time of -O2 -g. UBSan's null and alignment checks are left out: they instrument
+# every pointer access in Fast DDS's header templates and made a translation unit 2.5x slower to
+# compile; a null access still faults and ASan reports it with its stack, and x86 tolerates
+# misalignment.
 if(OSCAR_SANITIZE STREQUAL "address")
-  add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  add_compile_options(-O1 -g1 -fsanitize=address,undefined -fno-sanitize=null,alignment
+                      -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
 elseif(OSCAR_SANITIZE STREQUAL "thread")
-  add_compile_options(-fsanitize=thread -fno-omit-frame-pointer)
+  add_compile_options(-O1 -g1 -fsanitize=thread -fno-omit-frame-pointer)
   add_link_options(-fsanitize=thread)
 elseif(NOT OSCAR_SANITIZE STREQUAL "")
   message(FATAL_ERROR "OSCAR_SANITIZE='${OSCAR_SANITIZE}': use '', 'address' or 'thread'")
