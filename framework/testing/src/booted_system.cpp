@@ -171,10 +171,9 @@ FreeDomain::FreeDomain() {
   fs::permissions(locks, fs::perms::all, ec);  // every user's tests share it
   std::set<int> booted;
   for (const auto& s : running_systems()) booted.insert(s.domain);
-  // Start somewhere else in each process, so parallel tests rarely try the same lock first.
-  const int start = static_cast<int>(getpid() % kLastDomain);
-  for (int i = 0; i < kLastDomain; ++i) {
-    const int domain = 1 + (start + i) % kLastDomain;  // 0 is what tools use when told nothing
+  // From the top down: systems and tools use low domains (0 when told nothing, the examples 42
+  // to 44), and OSCAR's own older tests 1 to 200 by their pid.
+  for (int domain = kLastDomain; domain >= 1; --domain) {
     if (booted.count(domain)) continue;
     const auto path = fmt::format("{}/domain-{}.lock", locks, domain);
     const int fd = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);

@@ -36,7 +36,8 @@ namespace oscar::testing {
 /// A DDS domain that no system booted on this machine uses and no other test holds, reserved
 /// for as long as the object lives (a lock file in $OSCAR_TEST_DOMAINS_DIR, default
 /// /tmp/oscar/test-domains, that the kernel releases when the process ends, however it ends).
-/// Parallel tests get different domains.
+/// Parallel tests get different domains. It takes the highest free one (232 down to 1): systems
+/// and tools use low domains.
 class FreeDomain {
  public:
   /// @throws std::runtime_error if every domain from 1 to 232 is taken.
