@@ -67,15 +67,16 @@ function(oscar_add_test)
   oscar_warnings(${A_NAME})
   gtest_discover_tests(${A_NAME}
     DISCOVERY_TIMEOUT 60
-    PROPERTIES TIMEOUT ${A_TIMEOUT}
-    ENVIRONMENT "OSCAR_BUILD_DIR=${PROJECT_BINARY_DIR}")
-  # Labels are set by a file ctest reads after the discovered tests: gtest_discover_tests flattens
-  # list-valued PROPERTIES, so "LABELS unit;swarm" there became LABELS=unit plus a property named
-  # "swarm", and `ctest -L swarm` missed every unit test.
+    PROPERTIES TIMEOUT ${A_TIMEOUT})
+  # Labels and the environment are set by a file ctest reads after the discovered tests:
+  # gtest_discover_tests flattens list-valued PROPERTIES, so "LABELS unit;swarm" there became
+  # LABELS=unit plus a property named "swarm", and `ctest -L swarm` missed every unit test.
+  # OSCAR_BIN_DIR is where oscar::testing::SystemUnderTest finds oscar-boot.
   set(label_file "${CMAKE_CURRENT_BINARY_DIR}/${A_NAME}_labels.cmake")
   file(WRITE "${label_file}"
        "if(${A_NAME}_TESTS)\n"
-       "  set_tests_properties(\${${A_NAME}_TESTS} PROPERTIES LABELS \"${A_LABELS}\")\n"
+       "  set_tests_properties(\${${A_NAME}_TESTS} PROPERTIES LABELS \"${A_LABELS}\"\n"
+       "    ENVIRONMENT \"OSCAR_BUILD_DIR=${PROJECT_BINARY_DIR};OSCAR_BIN_DIR=${PROJECT_BINARY_DIR}/bin\")\n"
        "endif()\n")
   set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${label_file}")
 endfunction()

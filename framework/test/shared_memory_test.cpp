@@ -11,6 +11,7 @@
 #include <ctime>
 
 #include <fstream>
+#include <set>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -95,6 +96,27 @@ TEST_F(SharedMemoryDir, RemovesPortsNobodyOwnsAndLocksOfPortsThatAreGone) {
   EXPECT_TRUE(fs::exists(dir_ / "fastrtps_port9003"));
   EXPECT_TRUE(fs::exists(dir_ / "sem.fastrtps_port9003_mutex"));
   EXPECT_TRUE(fs::exists(dir_ / "fastrtps_port7400"));
+}
+
+// A test that shut its own system down sweeps that system's files only, at once: another
+// system's dead files still have their grace (senders may still write to them).
+TEST_F(SharedMemoryDir, WithAFilterOnlyTheNamedFilesAreLookedAt) {
+  for (const auto* name : {"fastrtps_mine", "fastrtps_theirs"}) {
+    touch(name);
+    touch(std::string(name) + "_el");
+  }
+  touch("sem.fastrtps_port9004_mutex");  // a port of mine that is gone
+  touch("sem.fastrtps_port9005_mutex");  // one of theirs
+  const std::set<std::string> mine{"fastrtps_mine_el", "sem.fastrtps_port9004_mutex"};
+  DeadSharedMemorySweeper sweeper(std::chrono::seconds(0), dir_,
+                                  [&](const std::string& name) { return mine.count(name) > 0; });
+  EXPECT_EQ(sweeper.sweep(), 2u);
+  EXPECT_FALSE(fs::exists(dir_ / "fastrtps_mine"));
+  EXPECT_FALSE(fs::exists(dir_ / "fastrtps_mine_el"));
+  EXPECT_FALSE(fs::exists(dir_ / "sem.fastrtps_port9004_mutex"));
+  EXPECT_TRUE(fs::exists(dir_ / "fastrtps_theirs"));
+  EXPECT_TRUE(fs::exists(dir_ / "fastrtps_theirs_el"));
+  EXPECT_TRUE(fs::exists(dir_ / "sem.fastrtps_port9005_mutex"));
 }
 
 TEST_F(SharedMemoryDir, TheGraceStartsWhenTheOwnerIsSeenGone) {

@@ -22,7 +22,7 @@ namespace {
 using namespace std::chrono_literals;
 using test::BootedSystem;
 using test::entry;
-using testing::HasSubstr;
+using ::testing::HasSubstr;
 
 constexpr const char* kTwoSources = R"(
 system: NAME
@@ -103,8 +103,8 @@ TEST(Boot, RefusesADomainWhereASystemRunsAndLeavesThatSystemAlone) {
   const auto after = first.running();
   EXPECT_EQ(pids(after), pids(before)) << "the running system's modules were touched";
   for (const auto& m : after.modules()) EXPECT_EQ(m.incarnation(), 1u) << m.name();
-  EXPECT_EQ(first.shut_down(), 0) << first.boot().output();
-  EXPECT_THAT(first.boot().output(), testing::Not(HasSubstr(" error ")))
+  EXPECT_EQ(first.shut_down(), 0) << first.boot_output();
+  EXPECT_THAT(first.boot_output(), ::testing::Not(HasSubstr(" error ")))
       << "Ctrl-C's orderly shutdown is no error";
 }
 
@@ -115,10 +115,10 @@ TEST(Boot, ExitsWhenTheSystemIsShutDownFromAnotherTerminal) {
       {test::bin("oscar-shutdown"), "--domain", std::to_string(test::test_domain())},
       test::temp_path("shutdown_cmd.log"));
   EXPECT_EQ(shutdown.wait(20s), 0) << shutdown.output();
-  EXPECT_EQ(sys.boot().wait(20s), 0) << sys.boot().output();
-  EXPECT_THAT(sys.boot().output(), HasSubstr("the system was shut down (oscar shutdown)"));
-  EXPECT_THAT(sys.boot().output(), HasSubstr("all processes stopped"));
-  EXPECT_THAT(sys.boot().output(), testing::Not(HasSubstr(" error ")))
+  EXPECT_EQ(sys.boot_exit_code(20s), 0) << sys.boot_output();
+  EXPECT_THAT(sys.boot_output(), HasSubstr("the system was shut down (oscar shutdown)"));
+  EXPECT_THAT(sys.boot_output(), HasSubstr("all processes stopped"));
+  EXPECT_THAT(sys.boot_output(), ::testing::Not(HasSubstr(" error ")))
       << "an orderly shutdown is no error";
   for (const auto pid : pids(s)) EXPECT_FALSE(test::alive(pid)) << "module pid " << pid;
   EXPECT_TRUE(test::processes_mentioning(sys.file()).empty()) << "a process of the system is left";
@@ -162,10 +162,10 @@ TEST(Boot, CtrlCDuringBootIsAcknowledgedAtOnceAndStopsWhatHasStarted) {
   BootedSystem sys("ctrlc_boot", kUnreachableHost);
   const auto s = src_running_while_booting(sys);
   const long src = entry(s, "src")->pid();
-  ASSERT_EQ(kill(sys.boot().pid(), SIGINT), 0);
-  EXPECT_EQ(sys.boot().wait(10s), 0) << sys.boot().output();
-  EXPECT_THAT(sys.boot().output(), HasSubstr("Ctrl-C during boot: stopping what has started"));
-  EXPECT_THAT(sys.boot().output(), HasSubstr("all processes stopped"));
+  ASSERT_EQ(kill(sys.boot_pid(), SIGINT), 0);
+  EXPECT_EQ(sys.boot_exit_code(10s), 0) << sys.boot_output();
+  EXPECT_THAT(sys.boot_output(), HasSubstr("Ctrl-C during boot: stopping what has started"));
+  EXPECT_THAT(sys.boot_output(), HasSubstr("all processes stopped"));
   EXPECT_FALSE(test::alive(src)) << "the module that had started was left running";
   EXPECT_TRUE(test::processes_mentioning(sys.file()).empty()) << "a process of the system is left";
 }
@@ -184,12 +184,12 @@ TEST(Boot, ASecondCtrlCAbortsAShutdownThatHangs) {
   }
   ASSERT_EQ(registry.size(), 1u);
   ASSERT_EQ(kill(static_cast<pid_t>(registry[0]), SIGSTOP), 0);
-  ASSERT_EQ(kill(sys.boot().pid(), SIGINT), 0);
+  ASSERT_EQ(kill(sys.boot_pid(), SIGINT), 0);
   std::this_thread::sleep_for(300ms);
-  EXPECT_FALSE(sys.boot().wait(0ms)) << "boot did not wait for the registry";
-  ASSERT_EQ(kill(sys.boot().pid(), SIGINT), 0);
-  EXPECT_EQ(sys.boot().wait(5s), 130) << sys.boot().output();
-  EXPECT_THAT(sys.boot().output(), HasSubstr("aborted: killing every process of the system"));
+  EXPECT_FALSE(sys.boot_exit_code(0ms)) << "boot did not wait for the registry";
+  ASSERT_EQ(kill(sys.boot_pid(), SIGINT), 0);
+  EXPECT_EQ(sys.boot_exit_code(5s), 130) << sys.boot_output();
+  EXPECT_THAT(sys.boot_output(), HasSubstr("aborted: killing every process of the system"));
   for (int i = 0; i < 100 && test::alive(src); ++i) std::this_thread::sleep_for(20ms);
   EXPECT_FALSE(test::alive(src)) << "the module outlived the abort";
   EXPECT_TRUE(test::processes_mentioning(sys.file()).empty()) << "a process of the system is left";
@@ -244,7 +244,7 @@ TEST(Registry, ACommandsTransitionReachesTheSystemStateAtOnce) {
   // The registry also republishes the whole state once a second; each change must show long
   // before that (three in a row: by chance all three would fall early in that second 1 in 8).
   for (const auto* cycle : {"30ms", "40ms", "50ms"}) {
-    const auto reply = sys.config().send("src", CMD_SET_CYCLE, {"src", cycle});
+    const auto reply = sys.configure("src", CMD_SET_CYCLE, {"src", cycle});
     ASSERT_TRUE(reply.ok()) << reply.error();
     const auto cycle_ns = parse_duration(cycle).count();
     const auto seen = sys.registry().wait_for(
@@ -282,11 +282,13 @@ TEST(Tools, FindTheSystemBootedOnThisMachineWithoutFlagsAndAskWhenThereAreSevera
     std::this_thread::sleep_for(1500ms);
     kill(record.pid(), SIGINT);
     EXPECT_EQ(record.wait(20s), 0) << record.output();
-    EXPECT_THAT(record.output(), testing::ContainsRegex("received [1-9][0-9]*")) << record.output();
+    EXPECT_THAT(record.output(), ::testing::ContainsRegex("received [1-9][0-9]*"))
+        << record.output();
     std::filesystem::remove(file);
   }
-  const auto other_domain = std::to_string(1 + (test::test_domain() + 100) % 200);
-  BootedSystem two("found_too", two_sources("found_too"), other_domain);
+  const testing::FreeDomain other;
+  const auto other_domain = std::to_string(other.domain());
+  BootedSystem two("found_too", two_sources("found_too"), other.domain());
   for (int i = 0; i < 500 && running_systems().size() < 2; ++i) std::this_thread::sleep_for(10ms);
   EXPECT_EQ(ps(output), 2) << output;
   EXPECT_THAT(output, HasSubstr("2 systems are running on this machine; name one with -d DOMAIN"));

@@ -1,20 +1,16 @@
 #pragma once
-// A system booted by `oscar boot` for a test: the YAML written to a file, boot running as a
-// child, and a registry client on the same domain to watch the system state.
-
-#include <signal.h>
+// A system booted for an integration test from YAML text: oscar::testing::SystemUnderTest (the
+// fixture users get, docs/testing.md) on the YAML written to a file, on this test's domain.
 
 #include <filesystem>
 #include <fstream>
 #include <functional>
-#include <memory>
 #include <string>
-#include <thread>
 
 #include <gtest/gtest.h>
 
-#include "oscar/config_client.hpp"
 #include "oscar/registry/registry_client.hpp"
+#include "oscar/testing/booted_system.hpp"
 #include "process.hpp"  // tests/common
 
 namespace oscar::test {
@@ -24,62 +20,41 @@ inline std::string temp_path(const std::string& name) {
       .string();
 }
 
-class BootedSystem {
+class BootedSystem : public testing::SystemUnderTest {
  public:
-  /// Writes `yaml` (without domain: the test's own is used) and runs oscar-boot on it.
-  BootedSystem(const std::string& name, const std::string& yaml, std::string domain_flag = "")
-      : file_(temp_path(name) + ".yaml"), log_dir_(temp_path(name) + "_logs") {
-    std::filesystem::remove_all(log_dir_);
-    std::ofstream(file_) << yaml;
-    participant_ = std::make_unique<DdsParticipant>(test_domain(), "test:" + name);
-    client_ = std::make_unique<RegistryClient>(*participant_, "test");
-    config_ = std::make_unique<ConfigClient>(*participant_, "coordinator");
-    boot_ = std::make_unique<Process>(
-        std::vector<std::string>{bin("oscar-boot"), file_, "--domain",
-                                 domain_flag.empty() ? std::to_string(test_domain()) : domain_flag,
-                                 "--log-dir", log_dir_, "--timeout", "30"},
-        temp_path(name) + "_boot.log");
-  }
+  /// Writes `yaml` to a file and boots it on `domain` (default: test_domain(); the file's own
+  /// is ignored).
+  BootedSystem(const std::string& name, const std::string& yaml, int domain = -1)
+      : SystemUnderTest(write(name, yaml), {.domain = domain < 0 ? test_domain() : domain,
+                                            .log_dir = temp_path(name) + "_logs"}) {}
   ~BootedSystem() {
-    if (boot_) boot_->stop();
+    shut_down();
+    std::error_code ec;
+    std::filesystem::remove(file(), ec);
   }
-
-  const std::string& file() const { return file_; }
-  const std::string& log_dir() const { return log_dir_; }
-  Process& boot() { return *boot_; }
-  RegistryClient& registry() { return *client_; }
-  ConfigClient& config() { return *config_; }
 
   /// The first state satisfying `pred` within `timeout`; fails the test otherwise.
   SystemState wait_for(const std::function<bool(const SystemState&)>& pred,
                        std::chrono::milliseconds timeout = std::chrono::seconds(30)) {
-    auto s = client_->wait_for(pred, timeout);
-    if (!s) {
-      const auto last = client_->latest();
-      ADD_FAILURE() << "the system did not reach the expected state; last: "
-                    << (last ? last->state() + " (" + last->message() + ")" : "none")
-                    << "\nboot output:\n"
-                    << boot_->output();
-      return last.value_or(SystemState{});
-    }
-    return *s;
+    if (auto s = SystemUnderTest::wait_for(pred, timeout)) return *s;
+    const auto last = registry().latest();
+    ADD_FAILURE() << "the system did not reach the expected state; last: "
+                  << (last ? last->state() + " (" + last->message() + ")" : "none")
+                  << "\nboot output:\n"
+                  << boot_output();
+    return last.value_or(SystemState{});
   }
   SystemState running() {
     return wait_for([](const SystemState& s) { return s.state() == "running"; });
   }
 
-  /// Stops boot as Ctrl-C would and returns its exit code.
-  std::optional<int> shut_down() {
-    kill(boot_->pid(), SIGINT);
-    return boot_->wait(std::chrono::seconds(40));
-  }
-
  private:
-  std::string file_, log_dir_;
-  std::unique_ptr<DdsParticipant> participant_;
-  std::unique_ptr<RegistryClient> client_;
-  std::unique_ptr<ConfigClient> config_;
-  std::unique_ptr<Process> boot_;
+  static std::string write(const std::string& name, const std::string& yaml) {
+    const auto file = temp_path(name) + ".yaml";
+    std::filesystem::remove_all(temp_path(name) + "_logs");
+    std::ofstream(file) << yaml;
+    return file;
+  }
 };
 
 inline const ModuleEntry* entry(const SystemState& s, const std::string& module) {

@@ -18,7 +18,7 @@ namespace {
 using namespace std::chrono_literals;
 using test::BootedSystem;
 using test::Process;
-using testing::HasSubstr;
+using ::testing::HasSubstr;
 
 // Runs a tool to its end and returns its output (stdout and stderr); fails if it hangs.
 std::string run(std::vector<std::string> argv, int expected_exit = 0) {
@@ -36,7 +36,7 @@ std::string domain() { return std::to_string(test::test_domain()); }
 void activate(BootedSystem& system, const std::string& module,
               const std::vector<std::string>& kernels, const std::string& mode) {
   for (const auto& k : kernels) {
-    const auto reply = system.config().send(module, CMD_ACTIVATE, {k, mode});
+    const auto reply = system.configure(module, CMD_ACTIVATE, {k, mode});
     ASSERT_TRUE(reply.ok()) << k << ": " << reply.error();
   }
 }
@@ -67,7 +67,7 @@ modules:
   activate(system, "sig_source", {"sig"}, "continuous:20ms");
   activate(system, "cam_source", {"cam"}, "continuous:20ms");
   std::this_thread::sleep_for(40 * 20ms + 1500ms);
-  ASSERT_EQ(system.shut_down(), 0) << system.boot().output();
+  ASSERT_EQ(system.shut_down(), 0) << system.boot_output();
 
   mcap::Reader reader(file);
   std::map<std::string, std::vector<std::uint64_t>> seqs;
@@ -104,7 +104,7 @@ modules:
 
 // One system for the inspection tools: a 50 Hz Bool source, a 10 Hz image source, a relay and
 // a sink.
-class Inspect : public testing::Test {
+class Inspect : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     system_ = new BootedSystem("inspect", R"(
@@ -148,14 +148,14 @@ TEST_F(Inspect, TopicsListsEveryCueTopicWithItsTypeAndRate) {
   EXPECT_NEAR(by_name["oscar/cue/cam/out"]["rate_hz"].get<double>(), 10, 3);
   EXPECT_EQ(by_name["oscar/cue/sig_relay/out"]["type"], "oscar::Bool");
   const auto table = run({"oscar-topics", "-d", domain(), "--duration", "2"});
-  EXPECT_THAT(table, testing::ContainsRegex("oscar/cue/cam/out +oscar::GvImage +[0-9]+\\.[0-9]"));
+  EXPECT_THAT(table, ::testing::ContainsRegex("oscar/cue/cam/out +oscar::GvImage +[0-9]+\\.[0-9]"));
 }
 
 TEST_F(Inspect, EchoPrintsSamplesReadablyWithTheirHeaders) {
   const auto out = run({"oscar-echo", "sig_relay/out", "-n", "3", "-d", domain()});
   EXPECT_THAT(out, HasSubstr("--- oscar/cue/sig_relay/out (oscar::Bool) received "));
   EXPECT_THAT(out, HasSubstr("  source: \"sig_relay/out\"\n"));
-  EXPECT_THAT(out, testing::ContainsRegex("  stamps: \\[[0-9]+, [0-9]+\\]  # generated 20"))
+  EXPECT_THAT(out, ::testing::ContainsRegex("  stamps: \\[[0-9]+, [0-9]+\\]  # generated 20"))
       << "a relayed cue carries two stamps";
   EXPECT_THAT(out, HasSubstr("value: true"));
   std::vector<std::uint64_t> seqs;
@@ -168,7 +168,7 @@ TEST_F(Inspect, EchoPrintsSamplesReadablyWithTheirHeaders) {
   const auto image = run({"oscar-echo", "cam/out", "-n", "1", "--max-items", "4", "-d", domain()});
   EXPECT_THAT(
       image,
-      testing::ContainsRegex(
+      ::testing::ContainsRegex(
           "dx: 32\ndy: 8\nimage: \\[[0-9]+, [0-9]+, [0-9]+, [0-9]+, \\.\\.\\.\\]  # 256 items"));
 }
 
@@ -196,7 +196,7 @@ TEST_F(Inspect, GraphShowsModulesKernelsChannelsAndWiring) {
   const auto dot = run({"oscar-graph", "-d", domain()});
   EXPECT_THAT(dot, HasSubstr("digraph \"inspected\""));
   EXPECT_THAT(dot, HasSubstr("subgraph \"cluster_sources\""));
-  EXPECT_THAT(dot, testing::ContainsRegex("sources @localhost pid [0-9]+ \\[running\\]"));
+  EXPECT_THAT(dot, ::testing::ContainsRegex("sources @localhost pid [0-9]+ \\[running\\]"));
   EXPECT_THAT(dot, HasSubstr("\"k:sig\" -> \"c:sig/out\""));
   EXPECT_THAT(dot, HasSubstr("\"c:sig/out\" -> \"k:sig_relay\" [label=\"in\"]"));
   EXPECT_THAT(dot, HasSubstr("\"c:sig_relay/out\" -> \"k:sig_sink\" [label=\"in\"]"));

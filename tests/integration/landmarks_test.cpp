@@ -92,7 +92,7 @@ TEST(Landmarks, OneHostDetectsTheTagsOncePerCycleAndFusesThePoseOfTheGroundTruth
   for (const auto& c : got_poses) {
     EXPECT_TRUE(c.valid());
     EXPECT_EQ(c.estimates(), 2u);
-    EXPECT_THAT(c.cameras(), testing::ElementsAre("cam_a", "cam_b"));
+    EXPECT_THAT(c.cameras(), ::testing::ElementsAre("cam_a", "cam_b"));
     // A's grab and detection, B's grab and detection, the fusion: five stamps, in time order.
     ASSERT_EQ(c.header().stamps().size(), 5u);
     EXPECT_TRUE(std::is_sorted(c.header().stamps().begin(), c.header().stamps().end()));
@@ -104,8 +104,7 @@ TEST(Landmarks, OneHostDetectsTheTagsOncePerCycleAndFusesThePoseOfTheGroundTruth
 
   // Frame mode by configuration: the coordinator tells the sequencer, which sets both grabbers.
   for (const auto& [mode, width] : {std::pair{"half", 320}, std::pair{"quarter", 160}}) {
-    const auto reply =
-        sys.config().send("landmarks", CMD_SET_PARAM, {"control", "frame_mode", mode});
+    const auto reply = sys.configure("landmarks", CMD_SET_PARAM, {"control", "frame_mode", mode});
     ASSERT_TRUE(reply.ok()) << reply.error();
     bool seen = false;
     for (int i = 0; i < 50 && !seen; ++i) {

@@ -74,13 +74,13 @@ modules:
       << rec.output();
   std::this_thread::sleep_for(1s);
   for (const auto* k : {"flag", "lines", "img"}) {
-    const auto reply = system.config().send(k, CMD_ACTIVATE, {k, "continuous:20ms"});
+    const auto reply = system.configure(k, CMD_ACTIVATE, {k, "continuous:20ms"});
     ASSERT_TRUE(reply.ok()) << k << ": " << reply.error();
   }
   std::this_thread::sleep_for(kCount * 20ms + 2s);
   kill(rec.pid(), SIGINT);
   ASSERT_EQ(rec.wait(20s), 0) << rec.output();
-  EXPECT_THAT(rec.output(), testing::HasSubstr("received 90, written 90, dropped 0"));
+  EXPECT_THAT(rec.output(), ::testing::HasSubstr("received 90, written 90, dropped 0"));
   ASSERT_EQ(system.shut_down(), 0);  // nothing else publishes on these topics now
 
   // The recording: per topic seq 1..kCount in order.

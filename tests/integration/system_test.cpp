@@ -13,7 +13,7 @@ namespace {
 using namespace std::chrono_literals;
 using test::BootedSystem;
 using test::entry;
-using testing::HasSubstr;
+using ::testing::HasSubstr;
 
 // Five modules, one of them multi-core (three kernels in one process).
 constexpr const char* kFiveModules = R"(
@@ -63,8 +63,8 @@ TEST(Boot, BootsFiveModulesLetsCuesFlowAndShutsDownLeavingNoProcess) {
            entry(st, "image_view")->state().kernels()[0].cycles() > 2 &&
            entry(st, "camera")->cues_per_s() > 0;
   });
-  EXPECT_EQ(sys.shut_down(), 0) << sys.boot().output();
-  EXPECT_THAT(sys.boot().output(), HasSubstr("all processes stopped"));
+  EXPECT_EQ(sys.shut_down(), 0) << sys.boot_output();
+  EXPECT_THAT(sys.boot_output(), HasSubstr("all processes stopped"));
   for (const auto pid : pids) EXPECT_FALSE(test::alive(pid)) << "module pid " << pid << " left";
   EXPECT_TRUE(test::processes_mentioning(sys.file()).empty()) << "a process of the system is left";
 }
@@ -91,8 +91,8 @@ TEST(Registry, KillNineRestartsTheModuleWithItsConfigurationAndWiring) {
   BootedSystem sys("kill9", kRestartable);
   auto s = sys.running();
   // The coordinator changes the sink's wiring and a parameter; both must survive a restart.
-  ASSERT_TRUE(sys.config().send("sink", CMD_REWIRE, {"sink", "in", "alt/out"}).ok());
-  ASSERT_TRUE(sys.config().send("sink", CMD_SET_PARAM, {"sink", "log_every", "700ms"}).ok());
+  ASSERT_TRUE(sys.configure("sink", CMD_REWIRE, {"sink", "in", "alt/out"}).ok());
+  ASSERT_TRUE(sys.configure("sink", CMD_SET_PARAM, {"sink", "log_every", "700ms"}).ok());
   s = sys.wait_for([](const SystemState& st) {
     const auto* k = test::kernel_state(*entry(st, "sink"), "sink");
     return k && k->params().find("700ms") != std::string::npos;
@@ -119,7 +119,7 @@ TEST(Registry, ARestartedSourceNeitherRepeatsNorCorruptsItsCues) {
   BootedSystem sys("seq", kRestartable);
   auto s = sys.running();
   // The coordinator sets the source's cycle; the restart must give it back.
-  ASSERT_TRUE(sys.config().send("src", CMD_SET_CYCLE, {"src", "10ms"}).ok());
+  ASSERT_TRUE(sys.configure("src", CMD_SET_CYCLE, {"src", "10ms"}).ok());
   // Watch src/out from this process.
   auto watcher = std::make_unique<Module>(ModuleSpec::from_yaml(YAML::Load(R"(
 name: watcher
@@ -282,7 +282,7 @@ struct BadSystem {
   std::string name, yaml, message;
 };
 
-class BootRefuses : public testing::TestWithParam<BadSystem> {};
+class BootRefuses : public ::testing::TestWithParam<BadSystem> {};
 
 TEST_P(BootRefuses, BadSystemFilesWithAClearErrorAndStartsNothing) {
   const auto& bad = GetParam();
@@ -301,7 +301,7 @@ TEST_P(BootRefuses, BadSystemFilesWithAClearErrorAndStartsNothing) {
 
 INSTANTIATE_TEST_SUITE_P(
     Registry, BootRefuses,
-    testing::Values(
+    ::testing::Values(
         BadSystem{"malformed", "system: x\nmodules:\n  - name: [a\n", ":4:1: malformed YAML"},
         BadSystem{"unknown_type",
                   "modules: [ { name: m, kernels: [ { type: warp_drive, name: k } ] } ]",
@@ -324,7 +324,7 @@ INSTANTIATE_TEST_SUITE_P(
                   "hosts: { a: { local: true }, b: { netns: oscar_no_such_ns } }\nmodules: [ { "
                   "name: m, host: b, kernels: [ { type: relay } ] } ]",
                   "network namespace 'oscar_no_such_ns' does not exist"}),
-    [](const testing::TestParamInfo<BadSystem>& param) { return param.param.name; });
+    [](const ::testing::TestParamInfo<BadSystem>& param) { return param.param.name; });
 
 }  // namespace
 }  // namespace oscar

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -22,7 +23,10 @@ namespace oscar {
 class DeadSharedMemorySweeper {
  public:
   using Clock = std::chrono::steady_clock;
-  explicit DeadSharedMemorySweeper(Clock::duration grace, std::filesystem::path dir = "/dev/shm");
+  /// With `only`, it looks only at the files for whose name (in `dir`) it returns true: a test
+  /// that shut its system down removes that system's files and no other's.
+  explicit DeadSharedMemorySweeper(Clock::duration grace, std::filesystem::path dir = "/dev/shm",
+                                   std::function<bool(const std::string&)> only = {});
   /// Notes what died since the last call and removes what has been dead for `grace`: segments
   /// and ports of dead owners, ports no reader owns (a sender created them while sending to a
   /// dead participant), and port semaphores whose port is gone (Fast DDS leaves them). Returns
@@ -32,6 +36,7 @@ class DeadSharedMemorySweeper {
  private:
   Clock::duration grace_;
   std::filesystem::path dir_;
+  std::function<bool(const std::string&)> only_;
   std::map<std::string, Clock::time_point> dead_since_;  ///< lock file name -> first seen dead
 };
 

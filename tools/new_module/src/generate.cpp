@@ -246,9 +246,93 @@ TEST({cls}, StubWritesEveryOutput) {{
                      fmt::arg("stub_check", stub_check));
 }
 
+// The parameters with which bench_source publishes a cue of each standard type.
+std::string source_params(const std::string& type) {
+  if (type == "GvImage") return "type: GvImage, dx: 64, dy: 48";
+  if (type == "LineSeg3DSeq") return "type: LineSeg3DSeq, lines: 10";
+  return "type: " + type;
+}
+
+// A small system for the system test: one bench_source module per input feeds the kernel.
+std::string system_file(const ModuleSpec& s) {
+  std::string sources, wiring;
+  for (const auto& p : s.inputs) {
+    sources += fmt::format(
+        "  - name: {0}_source\n"
+        "    kernels: [ {{ type: bench_source, name: {0}_source, params: {{ {1} }} }} ]\n"
+        "    mode: {{ continuous: 50ms }}\n",
+        p.name, source_params(p.type));
+    wiring += fmt::format("{}{}: {}_source/out", wiring.empty() ? "" : ", ", p.name, p.name);
+  }
+  return fmt::format(
+      R"(# The {name} module in a small system, booted by test/{name}_system_test.cpp on a DDS
+# domain of the test's own.{fed}
+system: {name}_test
+lease: 1s
+modules:
+{sources}  - name: {name}
+    kernels: [ {{ type: {name}, name: {name}{inputs} }} ]
+    mode: {{ continuous: 50ms }}
+)",
+      fmt::arg("name", s.name), fmt::arg("sources", sources),
+      fmt::arg("fed", s.inputs.empty() ? "" : "\n# A bench_source feeds each input."),
+      fmt::arg("inputs", wiring.empty() ? "" : ", inputs: { " + wiring + " }"));
+}
+
+std::string system_test(const ModuleSpec& s, const std::string& ns) {
+  std::string channels;
+  for (const auto& p : s.outputs)
+    channels += fmt::format("{}\"{}/{}\"", channels.empty() ? "" : ", ", s.name, p.name);
+  const auto& first = s.outputs.front();
+  return fmt::format(
+      R"(// The {name} module in a booted system (docs/testing.md): boots test/{name}_system.yaml{fed},
+// waits until the module runs, reads its cues and reconfigures it; the fixture shuts the system
+// down and fails the test if a process or a shared-memory file of it is left.
+#include <gtest/gtest.h>
+#include <oscar/cue_types.hpp>
+#include <oscar/testing/booted_system.hpp>
+
+namespace {ns} {{
+namespace {{
+
+using {cls}System = oscar::testing::BootedSystem;
+
+TEST_F({cls}System, RunsInABootedSystemAndPublishes) {{
+  boot();  // the SYSTEM file of oscar_add_system_test, on a free DDS domain
+  ASSERT_TRUE(wait_until_running({{"{name}"}}));
+  ASSERT_TRUE(wait_for_cues({{{channels}}}));
+
+  const auto cues = read_cues<oscar::{type}>("{name}/{out}", 3);
+  ASSERT_EQ(cues.size(), 3u);
+  for (const auto& cue : cues) {{
+    EXPECT_EQ(cue.header().source(), "{name}/{out}");
+    EXPECT_GE(cue.header().stamps().size(), {stamps}u){why};
+  }}
+
+  // Configuration with boot's authority, as the coordinator would send it.
+  const auto reply = configure("{name}", oscar::CMD_SET_CYCLE, {{"{name}", "100ms"}});
+  ASSERT_TRUE(reply.ok()) << reply.error();
+  ASSERT_EQ(reply.state().kernels().size(), 1u);
+  EXPECT_EQ(reply.state().kernels()[0].cycle_ns(), 100'000'000);
+}}
+
+}}  // namespace
+}}  // namespace {ns}
+)",
+      fmt::arg("name", s.name), fmt::arg("ns", ns), fmt::arg("cls", s.class_name()),
+      fmt::arg("fed", s.inputs.empty() ? "" : " (a bench_source feeds each input)"),
+      fmt::arg("channels", channels), fmt::arg("type", first.type), fmt::arg("out", first.name),
+      fmt::arg("stamps", s.inputs.empty() ? 1 : 2),
+      fmt::arg("why", s.inputs.empty() ? "" : " << \"an input's stamp and its own\""));
+}
+
 std::string cmake(const ModuleSpec& s) {
   const auto line = fmt::format(
-      "oscar_add_module(NAME {0} SOURCES {0}_kernel.cpp TEST test/{0}_kernel_test.cpp)\n", s.name);
+      "oscar_add_module(NAME {0} SOURCES {0}_kernel.cpp TEST test/{0}_kernel_test.cpp)\n"
+      "oscar_add_system_test(NAME oscar_kernel_{0}_system_test SOURCES test/{0}_system_test.cpp\n"
+      "  SYSTEM test/{0}_system.yaml{1} DEPENDS oscar_kernel_{0}{2})\n",
+      s.name, s.out_of_tree ? "" : " LABELS integration",
+      s.out_of_tree || s.inputs.empty() ? "" : " oscar_kernel_bench_source");
   if (!s.out_of_tree) return line;
   return fmt::format(R"(# The {0} module, built against an installed OSCAR (find_package(oscar)).
 cmake_minimum_required(VERSION 3.25)
@@ -317,9 +401,12 @@ modules:
 ## Tests
 
 `test/{name}_kernel_test.cpp`: the conformance suite, the outputs with their stamps, stub mode.
+`test/{name}_system_test.cpp`: the module in a booted system
+(`test/{name}_system.yaml`{fed}), its cues read and its cycle changed by configuration.
 )",
                      fmt::arg("name", s.name), fmt::arg("ports", ports), fmt::arg("params", params),
-                     fmt::arg("wiring", wiring), fmt::arg("build", build));
+                     fmt::arg("wiring", wiring), fmt::arg("build", build),
+                     fmt::arg("fed", s.inputs.empty() ? "" : ", a bench_source per input"));
 }
 
 }  // namespace
@@ -330,6 +417,8 @@ std::map<std::string, std::string> generate(const ModuleSpec& spec) {
           {spec.name + "_kernel.hpp", header(spec, ns)},
           {spec.name + "_kernel.cpp", source(spec, ns)},
           {"test/" + spec.name + "_kernel_test.cpp", unit_test(spec, ns)},
+          {"test/" + spec.name + "_system_test.cpp", system_test(spec, ns)},
+          {"test/" + spec.name + "_system.yaml", system_file(spec)},
           {"README.md", readme(spec)}};
 }
 

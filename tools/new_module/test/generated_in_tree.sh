@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Generates a module in tree — into modules/ of a copy of this repository (the source tree is not
 # touched) — and builds it with the project: only the targets the module needs, then its unit
-# test, which must pass. Uses ccache when the project build does.
+# test and its system test (the module booted with a bench_source per input), which must pass.
+# Uses ccache when the project build does.
 set -euo pipefail
 source_dir="$1"
 build_dir="$2"
@@ -20,7 +21,10 @@ launcher="$(grep -E '^CMAKE_CXX_COMPILER_LAUNCHER:' "$build_dir/CMakeCache.txt" 
 cmake -S . -B "$work/build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   ${launcher:+-DCMAKE_CXX_COMPILER_LAUNCHER=$launcher} >/dev/null
 cmake --build "$work/build" -j2 --target oscar_kernel_fuse_pair oscar_kernel_fuse_pair_test \
+  oscar_kernel_fuse_pair_system_test \
   >"$work/build.log" 2>&1 || { tail -30 "$work/build.log"; fail "the in-tree build failed"; }
 "$work/build/bin/oscar_kernel_fuse_pair_test"
+ctest --test-dir "$work/build" -R '^FusePairSystem\.' --output-on-failure ||
+  fail "the generated system test failed"
 [ -f "$work/build/lib/oscar/plugins/liboscar_kernel_fuse_pair.so" ] || fail "no plugin"
-echo "generated module: built in tree with the project, unit test passed"
+echo "generated module: built in tree with the project, unit and system tests passed"

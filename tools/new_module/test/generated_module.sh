@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The walkthrough of docs/tutorial.md, step by step: generates a module with two inputs, an
 # output and two params with the installed oscar-new-module; builds it out of tree against an
-# install of this build (find_package(oscar)); runs its unit test; boots a system that names its
+# install of this build (find_package(oscar)); runs its unit and system tests; boots a system that names its
 # plugin folder under plugins: and feeds it; inspects it (oscar ps, oscar echo); records every
 # cue; then boots the module alone and replays the recorded inputs into it.
 set -euo pipefail
@@ -38,7 +38,11 @@ grep -q "input 'x': unknown cue type 'Image'" err.txt || fail "$(cat err.txt)"
 cmake -S fuse_pair -B build -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" \
   -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j2 >/dev/null
-ctest --test-dir build --output-on-failure
+# Its unit test and its system test (the module booted with a bench_source per input).
+tests="$(ctest --test-dir build --output-on-failure)" || fail "ctest: $tests"
+echo "$tests"
+grep -Eq 'FusePairSystem\.RunsInABootedSystemAndPublishes \.+ +Passed' <<<"$tests" ||
+  fail "the generated system test did not run"
 
 domain=$(( $$ % 200 + 1 ))
 cat > system.yaml <<YAML

@@ -77,10 +77,26 @@ TEST(ModuleSpec, RejectsBadNamesClashesTypesAndDefaults) {
 TEST(ModuleSpec, GeneratesTheFolderOfAModule) {
   auto s = valid();
   const auto files = generate(s);
-  ASSERT_EQ(files.size(), 5u);
+  ASSERT_EQ(files.size(), 7u);
   EXPECT_EQ(files.at("CMakeLists.txt"),
             "oscar_add_module(NAME line_fuser SOURCES line_fuser_kernel.cpp TEST "
-            "test/line_fuser_kernel_test.cpp)\n");
+            "test/line_fuser_kernel_test.cpp)\n"
+            "oscar_add_system_test(NAME oscar_kernel_line_fuser_system_test SOURCES "
+            "test/line_fuser_system_test.cpp\n"
+            "  SYSTEM test/line_fuser_system.yaml LABELS integration DEPENDS "
+            "oscar_kernel_line_fuser oscar_kernel_bench_source)\n");
+  // The system test boots a small system: a bench_source per input feeds the kernel.
+  const auto& yaml = files.at("test/line_fuser_system.yaml");
+  EXPECT_THAT(yaml, HasSubstr("  - name: trigger_source\n"
+                              "    kernels: [ { type: bench_source, name: trigger_source, "
+                              "params: { type: Bool } } ]\n"));
+  EXPECT_THAT(yaml, HasSubstr("params: { type: LineSeg3DSeq, lines: 10 }"));
+  EXPECT_THAT(yaml, HasSubstr("    kernels: [ { type: line_fuser, name: line_fuser, inputs: { "
+                              "left: left_source/out, trigger: trigger_source/out"));
+  const auto& system_test = files.at("test/line_fuser_system_test.cpp");
+  EXPECT_THAT(system_test, HasSubstr("using LineFuserSystem = oscar::testing::BootedSystem;"));
+  EXPECT_THAT(system_test, HasSubstr("read_cues<oscar::LineSeg3DSeq>(\"line_fuser/fused\", 3)"));
+  EXPECT_THAT(system_test, HasSubstr("configure(\"line_fuser\", oscar::CMD_SET_CYCLE"));
   const auto& hpp = files.at("line_fuser_kernel.hpp");
   EXPECT_THAT(hpp, HasSubstr("class LineFuser final : public oscar::Kernel"));
   EXPECT_THAT(hpp, HasSubstr("    double gain = 1.5;\n"));
@@ -94,6 +110,8 @@ TEST(ModuleSpec, GeneratesTheFolderOfAModule) {
   EXPECT_THAT(files.at("README.md"), HasSubstr("| `period` | duration | `33ms` |"));
   s.out_of_tree = true;
   EXPECT_THAT(generate(s).at("CMakeLists.txt"), HasSubstr("find_package(oscar REQUIRED)"));
+  EXPECT_THAT(generate(s).at("CMakeLists.txt"),
+              HasSubstr("SYSTEM test/line_fuser_system.yaml DEPENDS oscar_kernel_line_fuser)"));
   EXPECT_THAT(generate(s).at("line_fuser_kernel.cpp"), HasSubstr("namespace line_fuser_module {"));
 }
 

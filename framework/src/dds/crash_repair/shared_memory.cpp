@@ -36,8 +36,9 @@ bool abandoned(const std::filesystem::path& lock_file) {
 
 }  // namespace
 
-DeadSharedMemorySweeper::DeadSharedMemorySweeper(Clock::duration grace, std::filesystem::path dir)
-    : grace_(grace), dir_(std::move(dir)) {}
+DeadSharedMemorySweeper::DeadSharedMemorySweeper(Clock::duration grace, std::filesystem::path dir,
+                                                 std::function<bool(const std::string&)> only)
+    : grace_(grace), dir_(std::move(dir)), only_(std::move(only)) {}
 
 std::size_t DeadSharedMemorySweeper::sweep(Clock::time_point now) {
   std::map<std::string, Clock::time_point> still_dead;
@@ -57,6 +58,7 @@ std::size_t DeadSharedMemorySweeper::sweep(Clock::time_point now) {
   std::error_code ec, ignore;
   for (const auto& entry : std::filesystem::directory_iterator(dir_, ec)) {
     const auto name = entry.path().filename().string();
+    if (only_ && !only_(name)) continue;
     if (name.starts_with(kPrefix) && name.ends_with(kLockSuffix)) {
       // A segment or port whose owner is gone.
       if (!abandoned(entry.path()) || !due(name)) continue;
