@@ -56,6 +56,13 @@ void KernelHarness::feed_erased(InputPort& port, std::shared_ptr<const void> cue
   if (port.transfer() == Transfer::kPush) port.deliver(std::move(cue));
 }
 
+CommandAnswer KernelHarness::command_cdr(const std::string& name, const std::string& type,
+                                         const std::vector<std::uint8_t>& cdr) {
+  const auto& port = instance_->command(name);
+  const auto request = port.decode(type, cdr);
+  return port.call(request.get());
+}
+
 std::vector<std::shared_ptr<const void>> KernelHarness::take_erased(const std::string& output) {
   const auto it = captured_.find(output);
   if (it == captured_.end()) {

@@ -48,6 +48,13 @@ OutputPort* KernelPorts::find_output(std::string_view name) const {
   return nullptr;
 }
 
+CommandPort* KernelPorts::find_command(std::string_view name) const {
+  for (const auto& c : commands) {
+    if (c->name() == name) return c.get();
+  }
+  return nullptr;
+}
+
 KernelSetup::KernelSetup(std::string kernel_name, std::string kernel_type, KernelPorts& ports,
                          YAML::Node params, std::map<std::string, InputOverrides> input_options)
     : name_(std::move(kernel_name)),
@@ -66,6 +73,19 @@ void KernelSetup::check_port_name(const std::string& name) const {
     throw std::invalid_argument(fmt::format(
         "kernel '{}' ({}): port '{}' is declared twice; port names are unique per kernel", name_,
         type_, name));
+  }
+}
+
+void KernelSetup::check_command_name(const std::string& name) const {
+  if (!is_identifier(name)) {
+    throw std::invalid_argument(fmt::format(
+        "kernel '{}' ({}): command name '{}' must be an identifier (letters, digits, _)", name_,
+        type_, name));
+  }
+  if (ports_.find_command(name)) {
+    throw std::invalid_argument(fmt::format(
+        "kernel '{}' ({}): command '{}' is declared twice; command names are unique per kernel",
+        name_, type_, name));
   }
 }
 

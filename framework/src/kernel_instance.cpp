@@ -38,6 +38,20 @@ KernelInstance::KernelInstance(const KernelTypeInfo& type, std::string name, YAM
   }
 }
 
+CommandPort& KernelInstance::command(const std::string& name) {
+  if (auto* port = ports_->find_command(name)) return *port;
+  if (ports_->commands.empty()) {
+    throw std::invalid_argument(fmt::format(
+        "kernel '{}' ({}) has no command '{}': it declares no commands", name_, type_, name));
+  }
+  std::string known;
+  for (const auto& c : ports_->commands) {
+    known += fmt::format("{}{} ({})", known.empty() ? "" : ", ", c->name(), c->type().name);
+  }
+  throw std::invalid_argument(fmt::format("kernel '{}' ({}) has no command '{}'; its commands: {}",
+                                          name_, type_, name, known));
+}
+
 void KernelInstance::run(Stamp now, Trigger trigger, bool stub) {
   Cycle cycle(now, ++cycles_, trigger, *log_);
   if (stub) {

@@ -482,6 +482,12 @@ ModuleState Module::state_locked() const {
     k.published(published);
     k.params(s->instance->ports().params.to_yaml());
     for (const auto& [input, source] : s->sources) k.inputs().push_back(input + "=" + source);
+    for (const auto& c : s->instance->ports().commands) {
+      DeclaredCommand d;
+      d.name(c->name());
+      d.type(c->type().name);
+      k.commands().push_back(std::move(d));
+    }
     st.kernels().push_back(std::move(k));
   }
   return st;

@@ -39,15 +39,19 @@ const char* kind_name(CommandKind k) {
       return "stub";
     case CMD_SHUTDOWN:
       return "shutdown";
+    case CMD_COMMAND:
+      return "command";
   }
   return "?";
 }
 
 // Seed 004 §2.4: only the coordinator configures modules; the registry suspends, resumes and
 // re-applies a restarted module's configuration; boot applies the initial configuration.
+// Kernels' command ports are the coordinator's (and boot's) too: the registry restores
+// configuration, it does not command actuators.
 bool authorised(const std::string& sender, CommandKind kind) {
   if (sender == "coordinator" || sender == "boot") return true;
-  if (sender == "registry") return kind != CMD_TRIGGER;
+  if (sender == "registry") return kind != CMD_TRIGGER && kind != CMD_COMMAND;
   return false;
 }
 
@@ -97,6 +101,11 @@ ConfigReply Module::apply(const ConfigCommand& c) {
     return reply;
   }
   try {
+    if (c.kind() != CMD_COMMAND && (!c.payload_type().empty() || !c.payload().empty())) {
+      throw std::invalid_argument(fmt::format(
+          "only a command (CMD_COMMAND) carries a payload; this one has {} bytes of '{}'",
+          c.payload().size(), c.payload_type()));
+    }
     std::string transition;
     switch (c.kind()) {
       case CMD_ACTIVATE: {
@@ -238,6 +247,23 @@ ConfigReply Module::apply(const ConfigCommand& c) {
         transition = "shutdown requested";
         request_stop();
         break;
+      case CMD_COMMAND: {
+        need_args(c, 2, "kernel, command name");
+        auto& s = slot_for(c.args()[0], kind);
+        const auto& port = s.instance->command(c.args()[1]);
+        const auto request = port.decode(c.payload_type(), c.payload());
+        const auto answer = deliver_command(s, port, request.get());
+        reply.answered(true);
+        reply.answer(answer.text);
+        reply.ok(answer.accepted);
+        if (!answer.accepted) {
+          reply.error(fmt::format("command '{}' refused by kernel '{}': {}", port.name(),
+                                  port.kernel(), answer.text));
+          log_->warn("{}", reply.error());
+        }
+        reply.state(state());
+        return reply;  // not a transition: no report
+      }
     }
     if (!transition.empty()) report(transition);
     reply.ok(true);
@@ -248,6 +274,47 @@ ConfigReply Module::apply(const ConfigCommand& c) {
   }
   reply.state(state());
   return reply;
+}
+
+// Runs the kernel's handler on the processing thread, between its cycles (docs/kernels.md,
+// "Command ports"). A deactivated kernel and a suspended module refuse commands; a kernel that
+// is activated but has not run yet gets its on_activate() first, as before its first cycle.
+CommandAnswer Module::deliver_command(Slot& slot, const CommandPort& port, const void* request) {
+  CommandAnswer answer;
+  post_and_wait([&] {
+    {
+      std::lock_guard lock(mutex_);
+      if (suspended_) {
+        throw std::invalid_argument(
+            fmt::format("module '{}' is suspended; its kernels take commands again once it resumes",
+                        spec_.name));
+      }
+      if (slot.mode.kind == ModeSpec::Kind::kDeactivated) {
+        throw std::invalid_argument(fmt::format(
+            "kernel '{}' is deactivated; a kernel takes commands only while it is activated",
+            slot.instance->name()));
+      }
+    }
+    const auto call = fmt::format("command {}", port.name());
+    try {
+      if (!slot.active) {
+        slot.instance->kernel().on_activate();
+        slot.active = true;
+      }
+      busy_since_ns_.store(std::chrono::steady_clock::now().time_since_epoch().count(),
+                           std::memory_order_relaxed);
+      answer = port.call(request);
+      busy_since_ns_.store(0, std::memory_order_relaxed);
+    } catch (const std::exception& e) {
+      busy_since_ns_.store(0, std::memory_order_relaxed);
+      const auto failure =
+          fmt::format("{}: {}", slot.active ? call : std::string("on_activate()"), e.what());
+      kernel_failed(slot, failure);
+      throw std::runtime_error(
+          fmt::format("kernel '{}' failed in {}", slot.instance->name(), failure));
+    }
+  });
+  return answer;
 }
 
 std::string Module::rewire(Slot& slot, const std::string& input_name, const std::string& source,

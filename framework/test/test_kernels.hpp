@@ -5,8 +5,10 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include "oscar/command_types.hpp"
 #include "oscar/cue_types.hpp"
 #include "oscar/kernel.hpp"
 
@@ -187,4 +189,47 @@ class Failing final : public Kernel {
   Params params_;
 };
 
+}  // namespace oscar::test
+
+namespace oscar::test {
+/// Takes commands (docs/kernels.md, "Command ports"): `hold` (a Bool; refused when false) and
+/// `mode` (a SetFrameMode; "boom" throws). Each answer says whether the command ran on the
+/// thread that runs process() and whether it came while process() ran. Publishes a Bool a cycle.
+class Commanded final : public Kernel {
+ public:
+  explicit Commanded(KernelSetup& setup) : out_(setup.output<Bool>("out")) {
+    setup.command<Bool>("hold", [this](const Bool& b) { return hold(b); });
+    setup.command<SetFrameMode>("mode", [this](const SetFrameMode& m) {
+      if (m.mode() == "boom") throw std::runtime_error("boom");
+      mode_ = m.mode();
+      return CommandAnswer::accept("mode " + m.mode());
+    });
+  }
+  void process(Cycle&) override {
+    in_process_ = true;
+    process_thread_ = std::this_thread::get_id();
+    Bool b;
+    b.value(++cycles_ % 2 == 1);
+    out_.publish(b);
+    in_process_ = false;
+  }
+  void stub(Cycle& c) override { process(c); }
+  void on_activate() override { ++activations_; }
+  CommandAnswer hold(const Bool& b) {
+    ++commands_;
+    const bool during_process = in_process_;
+    const bool same_thread = process_thread_.load() == std::this_thread::get_id();
+    if (!b.value()) return CommandAnswer::refuse("told not to hold");
+    return CommandAnswer::accept(std::string("held; on the processing thread: ") +
+                                 (same_thread ? "yes" : "no") +
+                                 "; during process(): " + (during_process ? "yes" : "no"));
+  }
+  std::atomic<int> cycles_{0}, commands_{0}, activations_{0};
+  std::string mode_;  // written and read on the processing thread only
+
+ private:
+  Output<Bool>& out_;
+  std::atomic<bool> in_process_{false};
+  std::atomic<std::thread::id> process_thread_{};
+};
 }  // namespace oscar::test

@@ -9,6 +9,9 @@ namespace {
 int scale_divisor(const std::string& mode) {
   return mode == "quarter" ? 4 : mode == "half" ? 2 : 1;
 }
+bool is_frame_mode(const std::string& mode) {
+  return mode == "full" || mode == "half" || mode == "quarter";
+}
 }  // namespace
 
 void Framegrabber::Params::describe(ParamSpec& spec) {
@@ -58,6 +61,9 @@ void Framegrabber::Params::describe(ParamSpec& spec) {
 Framegrabber::Framegrabber(KernelSetup& setup)
     : image_(setup.output<GvImage>("image")), frame_(setup.output<CameraImage>("frame")) {
   setup.params(params_);
+  setup.command<SetFrameMode>("frame_mode",
+                              [this](const SetFrameMode& r) { return set_frame_mode(r); });
+  frame_mode_ = param_frame_mode_ = params_.frame_mode;
   name_ = params_.camera_id.empty() ? setup.kernel_name() : params_.camera_id;
   // Validate now (bad YAML is refused at load time); devices and files open on activation.
   source_ = parse_source(params_.source);
@@ -106,6 +112,24 @@ void Framegrabber::open() {
   params_.cy = scene_->options().cy;
 }
 
+// The command changes only the kernel's own mode: the parameter values belong to the frame,
+// which reads them from other threads (oscar ps).
+CommandAnswer Framegrabber::set_frame_mode(const SetFrameMode& request) {
+  if (!is_frame_mode(request.mode())) {
+    return CommandAnswer::refuse(
+        fmt::format("frame mode '{}' is not full, half or quarter", request.mode()));
+  }
+  auto text = fmt::format("frame mode {} -> {}", frame_mode(), request.mode());
+  frame_mode_ = request.mode();
+  return CommandAnswer::accept(std::move(text));
+}
+
+// A set_param that changes the parameter wins over an earlier command, and the other way round.
+const std::string& Framegrabber::frame_mode() {
+  if (params_.frame_mode != param_frame_mode_) frame_mode_ = param_frame_mode_ = params_.frame_mode;
+  return frame_mode_;
+}
+
 void Framegrabber::process(Cycle& cycle) {
   open();
   if (ended_) return;
@@ -130,7 +154,7 @@ void Framegrabber::process(Cycle& cycle) {
 }
 
 void Framegrabber::publish(const cv::Mat& full, GroundTruth truth, Stamp acquired) {
-  const int div = scale_divisor(params_.frame_mode);
+  const int div = scale_divisor(frame_mode());
   cv::Mat img = full;
   if (div > 1) cv::resize(full, img, {full.cols / div, full.rows / div}, 0, 0, cv::INTER_AREA);
   if (!img.isContinuous()) img = img.clone();

@@ -4,6 +4,7 @@
 #include <memory>
 #include <string>
 
+#include <oscar/command_types.hpp>
 #include <oscar/cue_types.hpp>
 #include <oscar/kernel.hpp>
 #include <oscar/perception_types.hpp>
@@ -15,7 +16,8 @@ namespace oscar::modules {
 
 /// Grabs grey images from a V4L2 camera, a video file, an image directory or a synthetic scene
 /// of AprilTag markers with known poses (seed 004 §4.2: the framegrabber modules), in full,
-/// half or quarter frame mode (seed 004 §4.2, MARVIN's framegrabber).
+/// half or quarter frame mode (seed 004 §4.2, MARVIN's framegrabber), switched by the parameter
+/// `frame_mode` or the command `frame_mode`.
 class Framegrabber final : public Kernel {
  public:
   struct Params {
@@ -45,6 +47,8 @@ class Framegrabber final : public Kernel {
 
  private:
   void open();
+  CommandAnswer set_frame_mode(const SetFrameMode& request);
+  const std::string& frame_mode();
   void publish(const cv::Mat& full, GroundTruth truth, Stamp acquired);
 
   Output<GvImage>& image_;
@@ -57,6 +61,8 @@ class Framegrabber final : public Kernel {
   std::unique_ptr<SyntheticScene> scene_;
   std::uint64_t frames_ = 0;
   bool ended_ = false;
+  std::string frame_mode_;        // what it grabs: the parameter or the command, the later one
+  std::string param_frame_mode_;  // the parameter as last seen
 };
 
 }  // namespace oscar::modules

@@ -2,7 +2,10 @@
 #include <cstdio>
 #include <iostream>
 
+#include <yaml-cpp/yaml.h>
+
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <CLI/CLI.hpp>
 #include <oscar/command_line.hpp>
 
@@ -11,13 +14,89 @@
 #include <oscar/registry/system_options.hpp>
 #include <oscar/time.hpp>
 
+#include "idl_texts.hpp"  // tools/record
+#include "idl_types.hpp"  // tools/inspect
+
+namespace {
+
+// `command KERNEL NAME [YAML]`: the request is encoded from YAML as the IDL type the kernel
+// declares for NAME, which the module's published state names. Only types whose IDL OSCAR
+// embeds (idl/oscar/*.idl) can be encoded here; a program sends others with
+// ConfigClient::command().
+int send_command(oscar::ConfigClient& client, const std::string& module,
+                 const std::vector<std::string>& args, std::chrono::milliseconds timeout) {
+  if (args.size() < 2 || args.size() > 3) {
+    throw std::invalid_argument(fmt::format(
+        "command takes KERNEL NAME [YAML] (the request as a YAML map, e.g. '{{mode: half}}'), "
+        "got {} argument(s)",
+        args.size()));
+  }
+  const auto& kernel = args[0];
+  const auto& name = args[1];
+  const auto state = client.module_state(module, timeout);
+  const oscar::KernelState* k = nullptr;
+  std::vector<std::string> kernels;
+  for (const auto& ks : state.kernels()) {
+    if (ks.name() == kernel) k = &ks;
+    kernels.push_back(ks.name());
+  }
+  if (!k) {
+    throw std::invalid_argument(fmt::format("module '{}' has no kernel '{}' (kernels: {})", module,
+                                            kernel, fmt::join(kernels, ", ")));
+  }
+  std::string type, known;
+  for (const auto& c : k->commands()) {
+    if (c.name() == name) type = c.type();
+    known += fmt::format("{}{} ({})", known.empty() ? "" : ", ", c.name(), c.type());
+  }
+  if (type.empty()) {
+    throw std::invalid_argument(
+        known.empty() ? fmt::format("kernel '{}' ({}) has no command '{}': it declares no commands",
+                                    kernel, k->type(), name)
+                      : fmt::format("kernel '{}' ({}) has no command '{}'; its commands: {}",
+                                    kernel, k->type(), name, known));
+  }
+  oscar::inspect::IdlTypes types;
+  for (const auto& [t, text] : oscar::record::idl_texts()) types.add(text);
+  if (!types.has(type)) {
+    throw std::invalid_argument(fmt::format(
+        "command '{}' of kernel '{}' takes {}, whose IDL oscar config does not know (it encodes "
+        "the types of idl/oscar/*.idl)",
+        name, kernel, type));
+  }
+  YAML::Node request;
+  try {
+    request = YAML::Load(args.size() == 3 ? args[2] : "{}");
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument(fmt::format("the request is no YAML: {}", e.what()));
+  }
+  std::vector<std::uint8_t> cdr;
+  try {
+    cdr = types.from_yaml(type, request);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(fmt::format("the request is no {}: {}", type, e.what()));
+  }
+  const auto reply = client.send_command(module, kernel, name, type, std::move(cdr), timeout);
+  if (!reply.ok()) {
+    std::fprintf(stderr, "oscar config: %s: %s\n", module.c_str(), reply.error().c_str());
+    return 1;
+  }
+  std::cout << fmt::format("{}: {} accepted {}{}\n", module, kernel, name,
+                           reply.answer().empty() ? "" : ": " + reply.answer());
+  return 0;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{
       "oscar config: send a configuration command to a module (docs/kernels.md).\n"
       "Commands: activate KERNEL|* [MODE], deactivate KERNEL|*, trigger KERNEL|*,\n"
       "set-cycle KERNEL CYCLE, set-param KERNEL NAME VALUE, rewire KERNEL INPUT SOURCE [WAIT]\n"
       "(WAIT: longest wait for the new source's first cue, default 1s),\n"
-      "suspend, resume, stub KERNEL|* on|off, shutdown.\n"
+      "suspend, resume, stub KERNEL|* on|off, shutdown,\n"
+      "command KERNEL NAME [YAML] (a kernel's command port; the request as YAML, e.g.\n"
+      "'{mode: half}', encoded as the IDL type the kernel declares).\n"
       "Only the coordinator configures modules: an operator acts with its authority only with\n"
       "--as coordinator."};
   std::string module, command, as = "operator";
@@ -43,6 +122,9 @@ int main(int argc, char** argv) {
     }
     auto participant = tool.participant("oscar-config");
     oscar::ConfigClient client(*participant, as);
+    if (kind == oscar::CMD_COMMAND) {
+      return send_command(client, module, args, std::chrono::milliseconds(timeout_ms));
+    }
     const auto reply = client.send(module, kind, args, std::chrono::milliseconds(timeout_ms));
     if (!reply.ok()) {
       std::fprintf(stderr, "oscar config: %s: %s\n", module.c_str(), reply.error().c_str());

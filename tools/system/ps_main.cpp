@@ -34,6 +34,9 @@ nlohmann::json to_json(const oscar::SystemState& s) {
   for (const auto& m : s.modules()) {
     nlohmann::json kernels = nlohmann::json::array();
     for (const auto& k : m.state().kernels()) {
+      nlohmann::json commands = nlohmann::json::array();
+      for (const auto& c : k.commands())
+        commands.push_back({{"name", c.name()}, {"type", c.type()}});
       kernels.push_back({{"name", k.name()},
                          {"type", k.type()},
                          {"mode", k.mode()},
@@ -41,6 +44,7 @@ nlohmann::json to_json(const oscar::SystemState& s) {
                          {"stub", k.stub()},
                          {"params", k.params()},
                          {"inputs", k.inputs()},
+                         {"commands", commands},
                          {"published", k.published()},
                          {"failures", k.failures()},
                          {"last_failure", k.last_failure()},

@@ -12,6 +12,7 @@
 #include <oscar/config.h>
 
 #include "oscar/dds_participant.hpp"
+#include "oscar/idl_type_info.hpp"
 
 namespace oscar {
 
@@ -27,7 +28,33 @@ class ConfigClient {
   ConfigReply send(const std::string& module, CommandKind kind, std::vector<std::string> args,
                    std::chrono::milliseconds timeout = std::chrono::milliseconds(3000));
 
+  /// Sends `request` to the command port `command` of `kernel` in `module` (docs/kernels.md,
+  /// "Command ports") and waits for the answer: ok() is true when the kernel accepted it,
+  /// answered() when the kernel's handler ran (ok() is then its verdict), answer() is the
+  /// kernel's text and error() says why the command was refused.
+  /// @throws std::runtime_error as send() does.
+  template <IdlStruct T>
+  ConfigReply command(const std::string& module, const std::string& kernel,
+                      const std::string& command, const T& request,
+                      std::chrono::milliseconds timeout = std::chrono::milliseconds(3000)) {
+    const auto& type = idl_type_info<T>();
+    return send_command(module, kernel, command, type.name, type.serialize(&request), timeout);
+  }
+  /// The same with the request as CDR bytes of the IDL type `type` (what `oscar config ...
+  /// command` sends after encoding its YAML).
+  ConfigReply send_command(const std::string& module, const std::string& kernel,
+                           const std::string& command, const std::string& type,
+                           std::vector<std::uint8_t> cdr,
+                           std::chrono::milliseconds timeout = std::chrono::milliseconds(3000));
+
+  /// The state `module` published last (on oscar/registry/module_state; a module publishes it
+  /// every second and at each transition): its kernels and their command ports.
+  /// @throws std::runtime_error if none arrives within `timeout`.
+  ModuleState module_state(const std::string& module,
+                           std::chrono::milliseconds timeout = std::chrono::milliseconds(3000));
+
  private:
+  ConfigReply send(ConfigCommand command, std::chrono::milliseconds timeout);
   struct Channel;
   Channel& channel(const std::string& module);
 

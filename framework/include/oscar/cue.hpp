@@ -26,6 +26,9 @@ concept CueType = requires(T cue, const T ccue) {
 /// Compile-time facts about a cue type; specialised by OSCAR_DECLARE_CUE_TYPE.
 template <class T>
 struct CueTraits;
+/// Compile-time facts about any IDL struct (oscar/idl_type_info.hpp).
+template <class T>
+struct IdlTraits;
 
 /// What the framework needs to move a cue type it does not know at compile time.
 struct CueTypeInfo {
@@ -57,9 +60,14 @@ inline void append_stamp(CueHeader& h, std::int64_t stamp) {
 
 }  // namespace oscar
 
-/// Declares the IDL type NS::NAME (generated with its NS::NAME##PubSubType) a cue type.
+/// Declares the IDL type NS::NAME (generated with its NS::NAME##PubSubType) a cue type (and an
+/// IDL struct, so a command port may take it too).
 #define OSCAR_DECLARE_CUE_TYPE(NS, NAME)     \
   template <>                                \
   struct oscar::CueTraits<NS::NAME> {        \
+    using PubSubType = NS::NAME##PubSubType; \
+  };                                         \
+  template <>                                \
+  struct oscar::IdlTraits<NS::NAME> {        \
     using PubSubType = NS::NAME##PubSubType; \
   };

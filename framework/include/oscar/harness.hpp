@@ -40,6 +40,20 @@ class KernelHarness {
   /// Runs stub() once.
   void step_stub() { instance_->run(now_, Trigger::kHarness, true); }
 
+  /// Sends a command to the kernel as a module's frame delivers one (docs/kernels.md, "Command
+  /// ports"): CDR-encoded, checked against the declared command, decoded, and handed to the
+  /// kernel's handler now, between steps. The harness has no modes: the kernel always takes it.
+  /// @throws std::invalid_argument as a module refuses the command (no such command, another
+  ///         request type, a payload that does not decode).
+  template <IdlStruct T>
+  CommandAnswer command(const std::string& name, const T& request) {
+    const auto& type = idl_type_info<T>();
+    return command_cdr(name, type.name, type.serialize(&request));
+  }
+  /// The same with the request as it travels: CDR bytes the sender says are a `type`.
+  CommandAnswer command_cdr(const std::string& name, const std::string& type,
+                            const std::vector<std::uint8_t>& cdr);
+
   /// Every cue the output published since the last call, oldest first.
   template <CueType T>
   std::vector<std::shared_ptr<const T>> take(const std::string& output) {

@@ -13,6 +13,7 @@
 #include <spdlog/logger.h>
 #include <yaml-cpp/yaml.h>
 
+#include "oscar/command.hpp"
 #include "oscar/cue_type_info.hpp"
 #include "oscar/input.hpp"
 #include "oscar/output.hpp"
@@ -61,14 +62,17 @@ class Kernel {
   virtual void on_params_changed() {}
 };
 
-/// What the framework builds for one kernel: its ports and parameters, in declaration order.
+/// What the framework builds for one kernel: its ports, parameters and command ports, in
+/// declaration order.
 struct KernelPorts {
   explicit KernelPorts(const std::string& kernel) : params(fmt::format("kernel '{}'", kernel)) {}
   std::deque<std::unique_ptr<InputPort>> inputs;
   std::deque<std::unique_ptr<OutputPort>> outputs;
   ParamSpec params;
+  std::deque<std::unique_ptr<CommandPort>> commands;
   InputPort* find_input(std::string_view name) const;
   OutputPort* find_output(std::string_view name) const;
+  CommandPort* find_command(std::string_view name) const;
 };
 
 /// Handed to a kernel's constructor: declares ports and parameters and returns typed handles.
@@ -108,6 +112,23 @@ class KernelSetup {
     return ref;
   }
 
+  /// Declares a command port (docs/kernels.md, "Command ports"): the kernel accepts commands
+  /// `name` whose request is a T (an IDL struct declared with OSCAR_DECLARE_IDL_TYPE). The frame
+  /// calls `handler(const T&)` on the processing thread, never during process(), and sends its
+  /// CommandAnswer back to the sender.
+  /// @throws std::invalid_argument if the name is taken or not an identifier.
+  template <IdlStruct T, class F>
+  void command(const std::string& name, F handler) {
+    static_assert(std::is_invocable_r_v<CommandAnswer, F&, const T&>,
+                  "a command handler is called as handler(const T& request) and returns an "
+                  "oscar::CommandAnswer (CommandAnswer::accept() or CommandAnswer::refuse(why))");
+    check_command_name(name);
+    ports_.commands.push_back(std::make_unique<CommandPort>(
+        name_, name, idl_type_info<T>(), [h = std::move(handler)](const void* request) mutable {
+          return CommandAnswer(h(*static_cast<const T*>(request)));
+        }));
+  }
+
   /// Binds a Params struct (with `void describe(ParamSpec&)`) and applies the configured values
   /// at once, so the constructor can use them (e.g. to choose an output type).
   /// @throws std::invalid_argument on an unknown parameter or a bad value.
@@ -123,6 +144,7 @@ class KernelSetup {
 
  private:
   void check_port_name(const std::string& name) const;
+  void check_command_name(const std::string& name) const;
 
   std::string name_, type_;
   KernelPorts& ports_;

@@ -27,6 +27,10 @@ class KernelInstance {
   spdlog::logger& log() { return *log_; }
   std::uint64_t cycles() const { return cycles_; }
 
+  /// The command port `name`.
+  /// @throws std::invalid_argument naming the kernel's commands (or saying it declares none).
+  CommandPort& command(const std::string& name);
+
   /// Runs process() (or stub() in stub mode) once.
   void run(Stamp now, Trigger trigger, bool stub);
 

@@ -74,6 +74,7 @@ class Module {
   void report(const std::string& transition);
   Slot& slot_for(const std::string& kernel, const std::string& command);
   std::vector<Slot*> slots_for(const std::string& kernel_or_all, const std::string& command);
+  CommandAnswer deliver_command(Slot& slot, const CommandPort& port, const void* request);
   std::string rewire(Slot& slot, const std::string& input, const std::string& source,
                      std::chrono::milliseconds switch_wait);
   ModuleState state_locked() const;

@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <optional>
 #include <thread>
 
 #include <fmt/format.h>
@@ -60,6 +61,54 @@ ConfigClient::Channel& ConfigClient::channel(const std::string& module) {
 
 ConfigReply ConfigClient::send(const std::string& module, CommandKind kind,
                                std::vector<std::string> args, std::chrono::milliseconds timeout) {
+  ConfigCommand cmd;
+  cmd.target(module);
+  cmd.kind(kind);
+  cmd.args(std::move(args));
+  return send(std::move(cmd), timeout);
+}
+
+ConfigReply ConfigClient::send_command(const std::string& module, const std::string& kernel,
+                                       const std::string& command, const std::string& type,
+                                       std::vector<std::uint8_t> cdr,
+                                       std::chrono::milliseconds timeout) {
+  ConfigCommand cmd;
+  cmd.target(module);
+  cmd.kind(CMD_COMMAND);
+  cmd.args({kernel, command});
+  cmd.payload_type(type);
+  cmd.payload(std::move(cdr));
+  return send(std::move(cmd), timeout);
+}
+
+ModuleState ConfigClient::module_state(const std::string& module,
+                                       std::chrono::milliseconds timeout) {
+  auto* reader = participant_.subscriber().create_datareader(
+      &participant_.topic("oscar/registry/module_state", new ModuleStatePubSubType()),
+      qos::state_reader(64));
+  if (!reader) throw std::runtime_error("cannot read oscar/registry/module_state");
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  std::optional<ModuleState> found;
+  while (!found && std::chrono::steady_clock::now() < until) {
+    ModuleState s;
+    dds::SampleInfo info;
+    while (reader->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
+      if (info.valid_data && s.module_name() == module) found = s;
+    }
+    if (!found) reader->wait_for_unread_message(eprosima::fastrtps::Duration_t(0, 50'000'000));
+  }
+  participant_.subscriber().delete_datareader(reader);
+  if (!found) {
+    throw std::runtime_error(
+        fmt::format("no module named '{}' is running (it published no state "
+                    "on oscar/registry/module_state within {} ms)",
+                    module, timeout.count()));
+  }
+  return *found;
+}
+
+ConfigReply ConfigClient::send(ConfigCommand cmd, std::chrono::milliseconds timeout) {
+  const auto module = cmd.target();
   Channel* channel_ptr = nullptr;
   unsigned long long id = 0;
   {
@@ -85,12 +134,8 @@ ConfigReply ConfigClient::send(const std::string& module, CommandKind kind,
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  ConfigCommand cmd;
   cmd.id(id);
   cmd.sender(sender_);
-  cmd.target(module);
-  cmd.kind(kind);
-  cmd.args(std::move(args));
   // At least once: a module that was just restarted may not read this writer yet while its dead
   // predecessor still counts as matched, so the command is repeated (same id; the module
   // answers a repeat from its memory) until the reply comes.
@@ -116,7 +161,7 @@ CommandKind parse_command_kind(const std::string& text) {
       {"activate", CMD_ACTIVATE},   {"deactivate", CMD_DEACTIVATE}, {"trigger", CMD_TRIGGER},
       {"set_cycle", CMD_SET_CYCLE}, {"set_param", CMD_SET_PARAM},   {"rewire", CMD_REWIRE},
       {"suspend", CMD_SUSPEND},     {"resume", CMD_RESUME},         {"stub", CMD_STUB},
-      {"shutdown", CMD_SHUTDOWN}};
+      {"shutdown", CMD_SHUTDOWN},   {"command", CMD_COMMAND}};
   std::string known, wanted = text;
   std::replace(wanted.begin(), wanted.end(), '-', '_');  // `set-cycle` as well as `set_cycle`
   for (const auto& [name, kind] : kinds) {

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include <oscar/command_types.hpp>
 #include <oscar/cue_types.hpp>
 #include <oscar/harness.hpp>
 #include <oscar/perception_types.hpp>
@@ -76,6 +77,36 @@ TEST(Framegrabber, FrameModeSetAtRunTimeChangesTheImageSizeAndIntrinsics) {
     EXPECT_DOUBLE_EQ(f->fx(), 640.0 * w / 640) << mode;
     EXPECT_EQ(h.take<GvImage>("image").at(0)->dy(), hh) << mode;
   }
+}
+
+SetFrameMode frame_mode(const std::string& mode) {
+  SetFrameMode request;
+  request.mode(mode);
+  return request;
+}
+
+TEST(Framegrabber, TheFrameModeCommandSetsTheFrameSizeAndTheLaterOfCommandAndParameterWins) {
+  KernelHarness h("framegrabber", YAML::Load("{source: synthetic}"));
+  const auto answer = h.command("frame_mode", frame_mode("half"));
+  EXPECT_TRUE(answer.accepted);
+  EXPECT_EQ(answer.text, "frame mode full -> half");
+  h.step();
+  EXPECT_EQ(h.take<CameraImage>("frame").at(0)->width(), 320);
+  h.instance().ports().params.set_text("frame_mode", "quarter");  // set_param after the command
+  h.step();
+  EXPECT_EQ(h.take<CameraImage>("frame").at(0)->width(), 160);
+  EXPECT_TRUE(h.command("frame_mode", frame_mode("full")).accepted);  // and a command after that
+  h.step();
+  EXPECT_EQ(h.take<CameraImage>("frame").at(0)->width(), 640);
+}
+
+TEST(Framegrabber, TheFrameModeCommandRefusesAnUnknownModeAndKeepsItsMode) {
+  KernelHarness h("framegrabber", YAML::Load("{source: synthetic, frame_mode: half}"));
+  const auto answer = h.command("frame_mode", frame_mode("eighth"));
+  EXPECT_FALSE(answer.accepted);
+  EXPECT_EQ(answer.text, "frame mode 'eighth' is not full, half or quarter");
+  h.step();
+  EXPECT_EQ(h.take<CameraImage>("frame").at(0)->width(), 320);
 }
 
 TEST(Framegrabber, ReadsAnImageDirectoryInNameOrderAndLoops) {

@@ -1,7 +1,8 @@
 #pragma once
-// A small reader of OMG IDL (the self-contained `omgidl` texts OSCAR embeds and writes to MCAP)
-// and a decoder that prints a serialized CDR sample of such a type as YAML-like text: how
-// `oscar echo` shows any OSCAR type without compiled code for it.
+// A small reader of OMG IDL (the self-contained `omgidl` texts OSCAR embeds and writes to MCAP),
+// a decoder that prints a serialized CDR sample of such a type as YAML-like text (how
+// `oscar echo` shows any OSCAR type without compiled code for it) and an encoder from YAML to
+// CDR (how `oscar config ... command` sends a kernel any request type).
 
 #include <cstdint>
 #include <map>
@@ -9,6 +10,8 @@
 #include <span>
 #include <string>
 #include <vector>
+
+#include <yaml-cpp/yaml.h>
 
 namespace oscar::inspect {
 
@@ -43,8 +46,19 @@ class IdlTypes {
   std::string to_text(const std::string& type, std::span<const std::uint8_t> payload,
                       const Options& options) const;
 
+  /// The CDR encoding of `type` (XCDR1, little endian, with the 4-byte encapsulation header, as
+  /// Fast DDS 2.9 writes samples) from YAML: a struct is a map of its members by name, and a
+  /// member the map leaves out takes its IDL default (0, false, "", empty, the first
+  /// enumerator); a sequence or array is a list, an enum its enumerator's name.
+  /// @throws std::invalid_argument for an unknown type, or naming the member (e.g.
+  ///         "frame.width") and the rule: an unknown member, a value that is no number of the
+  ///         member's type or out of its range, an array of the wrong length, an unknown
+  ///         enumerator.
+  std::vector<std::uint8_t> from_yaml(const std::string& type, const YAML::Node& value) const;
+
  private:
   friend class Decoder;
+  friend class Encoder;
   std::map<std::string, std::vector<IdlMember>> structs_;
   std::map<std::string, std::vector<std::string>> enums_;
 };

@@ -10,6 +10,7 @@
 #include "idl_texts.hpp"
 #include "oscar/cue_type_info.hpp"
 #include "oscar/cue_types.hpp"
+#include "oscar/perception_types.hpp"
 
 namespace oscar::inspect {
 namespace {
@@ -105,6 +106,84 @@ TEST(IdlTypes, ReportsTruncatedSamplesAndUnknownTypes) {
         t.add("module m { struct S { long a } ; };");
       },
       testing::ThrowsMessage<std::invalid_argument>(HasSubstr("IDL: expected ';', got '}'")));
+}
+
+// The encoder writes what the compiled type support writes: byte for byte.
+TEST(IdlTypes, EncodesYamlAsTheCompiledTypeSupportEncodesTheSameValue) {
+  ConfigCommand c;
+  c.id(1ull << 40);
+  c.sender("coordinator");
+  c.kind(CMD_COMMAND);
+  c.args({"cam", "frame_mode"});
+  c.payload_type("oscar::SetFrameMode");
+  c.payload({0, 1, 0, 0, 255});
+  EXPECT_EQ(
+      oscar_types().from_yaml("oscar::ConfigCommand",
+                              YAML::Load("{id: 1099511627776, sender: coordinator, kind: "
+                                         "CMD_COMMAND, args: [cam, frame_mode], payload_type: "
+                                         "'oscar::SetFrameMode', payload: [0, 1, 0, 0, 255]}")),
+      bytes_of_plain(c));
+}
+
+TEST(IdlTypes, EncodesNestedStructsArraysAndSequencesThatTheCompiledTypeDecodes) {
+  const auto bytes = oscar_types().from_yaml("oscar::CameraImage", YAML::Load(R"(
+header: { stamps: [5, 6], source: cam/frame, seq: 3 }
+camera_id: cam
+width: 2
+height: 1
+fx: 0.5
+position: [1, -2.5, 3]
+data: [7, 8]
+truth: { valid: true, tags: [ { id: -4, pose: { t: [1, 2, 3], q: [1, 0, 0, 0] } } ] }
+)"));
+  const auto decoded = cue_type_info<CameraImage>().deserialize(bytes);
+  const auto& f = *static_cast<const CameraImage*>(decoded.get());
+  ASSERT_EQ(f.header().stamps().size(), 2u);
+  EXPECT_EQ(f.header().stamps()[1], 6u);
+  EXPECT_EQ(f.header().source(), "cam/frame");
+  EXPECT_EQ(f.header().seq(), 3u);
+  EXPECT_EQ(f.camera_id(), "cam");
+  EXPECT_EQ(f.encoding(), "") << "a member the YAML leaves out takes its default";
+  EXPECT_EQ(f.width(), 2);
+  EXPECT_DOUBLE_EQ(f.fx(), 0.5);
+  EXPECT_DOUBLE_EQ(f.fy(), 0);
+  EXPECT_DOUBLE_EQ(f.position()[1], -2.5);
+  EXPECT_EQ(f.data(), (std::vector<std::uint8_t>{7, 8}));
+  EXPECT_TRUE(f.truth().valid());
+  ASSERT_EQ(f.truth().tags().size(), 1u);
+  EXPECT_EQ(f.truth().tags()[0].id(), -4);
+  EXPECT_DOUBLE_EQ(f.truth().tags()[0].pose().t()[2], 3);
+  EXPECT_DOUBLE_EQ(f.truth().tags()[0].corners()[7], 0);
+}
+
+TEST(IdlTypes, YamlThatDoesNotFitTheTypeIsAnErrorNamingTheMemberAndTheRule) {
+  const auto types = oscar_types();
+  const auto error = [&](const std::string& type, const std::string& yaml) -> std::string {
+    try {
+      types.from_yaml(type, YAML::Load(yaml));
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  EXPECT_EQ(error("oscar::SetFrameMode", "{mod: half}"),
+            "oscar::SetFrameMode has no member 'mod' (members: mode)");
+  EXPECT_EQ(error("oscar::SetFrameMode", "half"),
+            "oscar::SetFrameMode is a struct: give a map of its members");
+  EXPECT_EQ(error("oscar::SetFrameMode", "{mode: [half]}"), "mode: expected a string");
+  EXPECT_EQ(error("oscar::CameraImage", "{width: 70000}"),
+            "width: 70000 is out of the range of unsigned short (0..65535)");
+  EXPECT_EQ(error("oscar::CameraImage", "{width: -1}"), "width: '-1' is no unsigned short");
+  EXPECT_EQ(error("oscar::CameraImage", "{fx: wide}"), "fx: 'wide' is no double");
+  EXPECT_EQ(error("oscar::CameraImage", "{position: [1, 2]}"),
+            "position: expected a list of 3 items, got 2");
+  EXPECT_EQ(error("oscar::CameraImage", "{truth: {tags: [{id: 1.5}]}}"),
+            "truth.tags[0].id: '1.5' is no long");
+  EXPECT_EQ(error("oscar::ConfigCommand", "{kind: CMD_JUMP}"),
+            "kind: 'CMD_JUMP' is no enumerator of oscar::CommandKind (CMD_ACTIVATE, "
+            "CMD_DEACTIVATE, CMD_TRIGGER, CMD_SET_CYCLE, CMD_SET_PARAM, CMD_REWIRE, CMD_SUSPEND, "
+            "CMD_RESUME, CMD_STUB, CMD_SHUTDOWN, CMD_COMMAND)");
+  EXPECT_EQ(error("oscar::Nope", "{}"), "unknown IDL type 'oscar::Nope'");
 }
 
 }  // namespace
