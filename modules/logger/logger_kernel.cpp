@@ -9,7 +9,7 @@
 #include <oscar/cue_types.hpp>
 #include <oscar/kernel_registry.hpp>
 
-#include "idl_texts.hpp"  // tools/record: the omgidl schema texts
+#include <oscar/idl_texts.hpp>
 
 namespace oscar::modules {
 
@@ -121,7 +121,7 @@ std::uint16_t Logger::channel(const std::string& source, const std::string& type
   std::uint16_t schema = 0;
   if (auto s = schemas_.find(type); s != schemas_.end()) {
     schema = s->second;
-  } else if (auto idl = record::idl_texts().find(type); idl != record::idl_texts().end()) {
+  } else if (auto idl = idl_texts().find(type); idl != idl_texts().end()) {
     schema = schemas_[type] =
         writer_->add_schema(type, "omgidl", {idl->second.begin(), idl->second.end()});
   }

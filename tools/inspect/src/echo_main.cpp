@@ -10,8 +10,8 @@
 
 #include <fmt/format.h>
 
-#include "idl_texts.hpp"  // tools/record
 #include "idl_types.hpp"
+#include "oscar/idl_texts.hpp"
 #include "oscar/registry/registry_client.hpp"
 #include "raw_tap.hpp"
 #include "recorder.hpp"  // topic_of
@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
     const auto topic = oscar::record::topic_of(topic_arg);
     oscar::inspect::IdlTypes types;
     std::set<std::string> texts;
-    for (const auto& [name, text] : oscar::record::idl_texts()) {
+    for (const auto& [name, text] : oscar::idl_texts()) {
       if (texts.insert(text).second) types.add(text);
     }
     auto participant =

@@ -15,11 +15,11 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
-#include "cue_header_cdr.hpp"
-#include "idl_texts.hpp"
+#include "oscar/cue_header_cdr.hpp"
 #include "oscar/dds_participant.hpp"
+#include "oscar/idl_texts.hpp"
 #include "oscar/mcap/writer.hpp"
-#include "raw_cdr_type.hpp"
+#include "oscar/raw_cdr_type.hpp"
 
 namespace oscar::record {
 namespace dds = eprosima::fastdds::dds;

@@ -1,8 +1,8 @@
-#include "raw_cdr_type.hpp"
+#include "oscar/raw_cdr_type.hpp"
 
 #include <cstring>
 
-namespace oscar::record {
+namespace oscar {
 
 RawCdrType::RawCdrType(const std::string& type_name) {
   setName(type_name.c_str());
@@ -37,4 +37,4 @@ void RawCdrType::deleteData(void* data) { delete static_cast<RawSample*>(data); 
 
 bool RawCdrType::getKey(void*, eprosima::fastrtps::rtps::InstanceHandle_t*, bool) { return false; }
 
-}  // namespace oscar::record
+}  // namespace oscar

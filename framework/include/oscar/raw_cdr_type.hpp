@@ -9,7 +9,7 @@
 
 #include <fastdds/dds/topic/TopicDataType.hpp>
 
-namespace oscar::record {
+namespace oscar {
 
 /// One sample: the payload exactly as it was on the wire.
 struct RawSample {
@@ -28,4 +28,4 @@ class RawCdrType final : public eprosima::fastdds::dds::TopicDataType {
               bool force_md5) override;
 };
 
-}  // namespace oscar::record
+}  // namespace oscar

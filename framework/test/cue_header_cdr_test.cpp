@@ -1,12 +1,12 @@
 // The recorder reads stamps and sequence numbers from serialized cues of any type.
 #include <gtest/gtest.h>
 
-#include "cue_header_cdr.hpp"
-#include "idl_texts.hpp"
+#include "oscar/cue_header_cdr.hpp"
 #include "oscar/cue_type_info.hpp"
 #include "oscar/cue_types.hpp"
+#include "oscar/idl_texts.hpp"
 
-namespace oscar::record {
+namespace oscar {
 namespace {
 
 template <class T>
@@ -57,4 +57,4 @@ TEST(IdlTexts, HoldThePerceptionTypes) {
 }
 
 }  // namespace
-}  // namespace oscar::record
+}  // namespace oscar

@@ -7,7 +7,7 @@
 #include <optional>
 #include <span>
 
-namespace oscar::record {
+namespace oscar {
 
 struct CueHeaderFields {
   std::uint64_t generation_stamp = 0;  ///< stamps[0] in ns, 0 if there is none
@@ -17,4 +17,4 @@ struct CueHeaderFields {
 /// The header fields, or nullopt if the bytes are too short or not a CDR encapsulation.
 std::optional<CueHeaderFields> read_cue_header(std::span<const std::uint8_t> payload);
 
-}  // namespace oscar::record
+}  // namespace oscar

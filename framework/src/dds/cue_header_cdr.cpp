@@ -1,6 +1,6 @@
-#include "cue_header_cdr.hpp"
+#include "oscar/cue_header_cdr.hpp"
 
-namespace oscar::record {
+namespace oscar {
 
 std::optional<CueHeaderFields> read_cue_header(std::span<const std::uint8_t> payload) {
   if (payload.size() < 4 || payload[0] != 0) return std::nullopt;
@@ -35,4 +35,4 @@ std::optional<CueHeaderFields> read_cue_header(std::span<const std::uint8_t> pay
   return h;
 }
 
-}  // namespace oscar::record
+}  // namespace oscar
