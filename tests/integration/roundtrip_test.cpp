@@ -101,7 +101,7 @@ modules:
   inspect::RawTap tap(participant, [&](const std::string& topic, auto bytes, auto) {
     const auto h = read_cue_header(bytes);
     std::lock_guard lock(mutex);
-    replayed[topic].push_back({std::move(bytes), h ? h->seq : 0});
+    replayed[topic].push_back({std::move(bytes), h ? h->seq() : 0});
   });
   Process replay({test::bin("oscar-replay"), file, "--domain", domain},
                  test::temp_path("roundtrip_replay") + ".log");

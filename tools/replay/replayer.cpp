@@ -155,7 +155,7 @@ ReplayCounters Replayer::run(const std::atomic<bool>& stop) {
   const std::uint64_t first = d.info.statistics.message_start_time;
   const std::uint64_t from = first + (d.o.start ? d.o.start->count() : 0);
   const std::uint64_t to = d.o.end ? first + d.o.end->count() : UINT64_MAX;
-  std::map<dds::DataWriter*, RawSample> samples;  // each used by its writer's lane only
+  std::map<dds::DataWriter*, RawCue> samples;  // each used by its writer's lane only
   for (const auto& [id, w] : d.writers) samples[w.second];
   std::function<bool(const Pending&)> step;
   if (d.o.step) {
@@ -195,7 +195,7 @@ ReplayCounters Replayer::run(const std::atomic<bool>& stop) {
         p.due = pass_start + scaled(m.log_time - from);
         p.bytes.assign(m.data.begin(), m.data.end());
         p.publish = [writer, sample = &samples[writer]](auto& bytes) {
-          sample->bytes.swap(bytes);
+          sample->cdr.swap(bytes);
           writer->write(sample);
         };
         if (d.o.step) {

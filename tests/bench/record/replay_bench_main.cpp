@@ -136,7 +136,7 @@ Schedule schedule_of(const std::string& path) {
       throw std::invalid_argument(
           fmt::format("{}: a message on '{}' has no readable cue header", path, ch.topic));
     }
-    schedule.add({ch.topic, type, header->seq, m.log_time});
+    schedule.add({ch.topic, type, header->seq(), m.log_time});
   });
   if (schedule.cues.empty()) throw std::invalid_argument(path + ": the recording holds no cues");
   return schedule;
@@ -166,7 +166,7 @@ Run measure(const std::vector<std::string>& publisher, const Schedule& schedule,
   const auto arrived = [&](const std::string& topic, auto bytes, auto t) {
     const auto h = oscar::read_cue_header(bytes);
     std::lock_guard lock(mutex);
-    arrivals.emplace_back(topic, h ? h->seq : 0, t);
+    arrivals.emplace_back(topic, h ? h->seq() : 0, t);
   };
   std::vector<std::unique_ptr<oscar::DdsParticipant>> participants;
   std::map<std::string, std::unique_ptr<oscar::inspect::RawTap>> taps;

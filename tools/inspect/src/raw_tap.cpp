@@ -26,10 +26,10 @@ struct RawTap::Impl {
    public:
     Listener(const Fn& fn, std::string topic) : fn_(fn), topic_(std::move(topic)) {}
     void on_data_available(dds::DataReader* reader) override {
-      RawSample s;
+      RawCue s;
       dds::SampleInfo info;
       while (reader->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
-        if (info.valid_data) fn_(topic_, std::move(s.bytes), now_ns());
+        if (info.valid_data) fn_(topic_, std::move(s.cdr), now_ns());
       }
     }
 
