@@ -51,9 +51,10 @@ InputPort& KernelHarness::input_port(const std::string& name) {
   return *port;
 }
 
-void KernelHarness::feed_erased(InputPort& port, std::shared_ptr<const void> cue) {
-  produced_.at(port.name())->push(cue, generation_stamp(port.type().header(cue.get())), now_);
-  if (port.transfer() == Transfer::kPush) port.deliver(std::move(cue));
+void KernelHarness::feed_erased(InputPort& port, const CueTypeInfo& type,
+                                std::shared_ptr<const void> cue) {
+  produced_.at(port.name())->push(cue, generation_stamp(type.header(cue.get())), now_);
+  if (port.transfer() == Transfer::kPush) port.deliver_from(type, std::move(cue));
 }
 
 CommandAnswer KernelHarness::command_cdr(const std::string& name, const std::string& type,

@@ -89,6 +89,29 @@ void KernelSetup::check_command_name(const std::string& name) const {
   }
 }
 
+Input<RawCue>& KernelSetup::raw_input(const std::string& name, InputOptions defaults) {
+  check_port_name(name);
+  auto options = defaults;
+  if (auto it = input_options_.find(name); it != input_options_.end()) {
+    options = it->second.applied_to(defaults);
+  }
+  if (options.transfer != Transfer::kPush) {
+    throw std::invalid_argument(fmt::format(
+        "kernel '{}' ({}): input '{}' takes cues of any type, which arrive by push only, not {}",
+        name_, type_, name, to_string(options.transfer)));
+  }
+  auto port = std::make_unique<Input<RawCue>>(name_, name, raw_cue_type(), options);
+  auto& ref = *port;
+  ports_.inputs.push_back(std::move(port));
+  return ref;
+}
+
+std::vector<std::string> KernelSetup::configured_inputs() const {
+  std::vector<std::string> names;
+  for (const auto& [name, options] : input_options_) names.push_back(name);
+  return names;
+}
+
 bool KernelSetup::unbound_params() const {
   return !params_bound_ && params_ && params_.IsMap() && params_.size() > 0;
 }

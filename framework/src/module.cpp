@@ -175,11 +175,7 @@ std::string Module::connect(InputPort& input, const std::string& source,
       throw std::invalid_argument(
           fmt::format("kernel '{}' has no output '{}'", producer, source_channel(source)));
     }
-    if (output->type().name != input.type().name) {
-      throw std::invalid_argument(fmt::format(
-          "cannot wire {} ({}) to input {}/{} ({}): the types differ", output->address(),
-          output->type().name, input.kernel(), input.name(), input.type().name));
-    }
+    check_types(input, output->address(), output->type());
     if (input.transfer() == Transfer::kPush) {
       output->connect(&input);  // also checks the reliability the input declares
     } else {

@@ -5,6 +5,7 @@
 
 #include "oscar/input.hpp"
 #include "oscar/output.hpp"
+#include "oscar/raw_cue.hpp"
 
 namespace oscar {
 
@@ -45,6 +46,13 @@ void InputPort::deliver(std::shared_ptr<const void> cue) {
     hook = arrival_hook_;
   }
   if (hook) hook();
+}
+
+bool InputPort::takes_any_type() const { return &type_ == &raw_cue_type(); }
+
+void InputPort::deliver_from(const CueTypeInfo& producer, std::shared_ptr<const void> cue) {
+  if (takes_any_type() && &producer != &type_) cue = to_raw_cue(producer, cue.get());
+  deliver(std::move(cue));
 }
 
 void InputPort::set_arrival_hook(std::function<void()> hook) {
@@ -99,23 +107,19 @@ void OutputPort::publish_erased(std::shared_ptr<void> cue) {
   std::shared_ptr<const void> frozen = std::move(cue);
   // The cue evicted from the ring is freed at the end, after the cue is on its way.
   const auto evicted = buffer_.push(frozen, generation_stamp(header), wall_now());
-  for (auto* input : consumers_) input->deliver(frozen);
+  for (auto* input : consumers_) input->deliver_from(type_, frozen);
   if (remote_) remote_(frozen.get());
 }
 
 void OutputPort::forward_erased(std::shared_ptr<const void> cue) {
   std::lock_guard lock(mutex_);
   const auto evicted = buffer_.push(cue, generation_stamp(type_.header(cue.get())), wall_now());
-  for (auto* input : consumers_) input->deliver(cue);
+  for (auto* input : consumers_) input->deliver_from(type_, cue);
   if (remote_) remote_(cue.get());
 }
 
 void OutputPort::connect(InputPort* input) {
-  if (input->type().name != type_.name) {
-    throw std::invalid_argument(
-        fmt::format("cannot wire {} ({}) to input {}/{} ({}): the types differ", address(),
-                    type_.name, input->kernel(), input->name(), input->type().name));
-  }
+  check_types(*input, address(), type_);
   // In process every cue arrives anyway; refused all the same, so a module file means the same
   // whether its kernels share a process or not.
   check_reliability(*input, address(), options_);
@@ -123,6 +127,13 @@ void OutputPort::connect(InputPort* input) {
   if (std::find(consumers_.begin(), consumers_.end(), input) == consumers_.end()) {
     consumers_.push_back(input);
   }
+}
+
+void check_types(const InputPort& input, const std::string& source, const CueTypeInfo& type) {
+  if (input.takes_any_type() || input.type().name == type.name) return;
+  throw std::invalid_argument(
+      fmt::format("cannot wire {} ({}) to input {}/{} ({}): the types differ", source, type.name,
+                  input.kernel(), input.name(), input.type().name));
 }
 
 void check_reliability(const InputPort& input, const std::string& source,

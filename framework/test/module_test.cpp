@@ -1,6 +1,7 @@
 // The module frame without DDS: in-process handoff, modes, configuration and the rules.
 #include "oscar/module.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <thread>
@@ -202,6 +203,47 @@ kernels:
   EXPECT_EQ(sink.seen()[1]->header().source(), "b/out");
 }
 
+TEST(Module, ARawInputGetsCuesOfAnyTypeSerializedUnderTheProducersTypeName) {
+  Module m(spec(R"(
+name: raw
+mode: { continuous: 2ms }
+kernels:
+  - { type: test_counter, name: src }
+  - { type: test_lines, name: lines, mode: { single_step: { trigger: module } } }
+  - type: test_raw_collect
+    name: sink
+    inputs: { flags: src/out, lines: lines/out }
+    mode: { single_step: { trigger: module } }
+)"),
+           {});
+  m.start(-1);
+  auto& sink = kernel_of<test::RawCollect>(m, "sink");
+  const auto count = [&](const std::string& type) {
+    const auto seen = sink.seen();
+    return std::count_if(seen.begin(), seen.end(), [&](const auto& c) { return c->type == type; });
+  };
+  ASSERT_TRUE(
+      eventually([&] { return count("oscar::Bool") >= 5 && count("oscar::LineSeg3DSeq") >= 5; }));
+  m.stop();
+  std::uint64_t last_bool = 0;
+  for (const auto& raw : sink.seen()) {
+    if (raw->type == "oscar::Bool") {
+      const auto b = std::static_pointer_cast<Bool>(cue_type_info<Bool>().deserialize(raw->cdr));
+      EXPECT_EQ(b->header(), raw->header()) << "the header travels with the bytes";
+      EXPECT_EQ(b->header().source(), "src/out");
+      EXPECT_EQ(b->value(), b->header().seq() % 2 == 1) << "the counter's value";
+      EXPECT_EQ(b->header().seq(), last_bool + 1) << "every cue, in order";
+      last_bool = b->header().seq();
+    } else {
+      ASSERT_EQ(raw->type, "oscar::LineSeg3DSeq");
+      const auto l = std::static_pointer_cast<LineSeg3DSeq>(
+          cue_type_info<LineSeg3DSeq>().deserialize(raw->cdr));
+      EXPECT_EQ(l->header(), raw->header());
+      EXPECT_EQ(l->header().source(), "lines/out");
+    }
+  }
+}
+
 TEST(Module, APullInputRewiredInsideTheModulePullsFromTheNewProducerAndIsPushedNothing) {
   Module m(spec(R"(
 name: pulling
@@ -398,6 +440,23 @@ kernels:
       },
       ThrowsMessage<std::invalid_argument>(
           HasSubstr("cannot wire lines/out (oscar::LineSeg3DSeq) to input sink/in (oscar::Bool)")));
+}
+
+TEST(ModuleBadInput, AnInputOfAnyTypeAsksForPushOnly) {
+  EXPECT_THAT(
+      [] {
+        Module m(spec(R"(
+name: raw_pull
+mode: single_step
+kernels:
+  - { type: test_counter, name: src }
+  - { type: test_raw_collect, name: sink, inputs: { in: { source: src/out, transfer: pull } } }
+)"),
+                 {});
+      },
+      ThrowsMessage<std::invalid_argument>(
+          HasSubstr("kernel 'sink' (test_raw_collect): input 'in' takes cues of any type, which "
+                    "arrive by push only, not pull")));
 }
 
 TEST(ModuleBadInput, AReliableInputWiredToABestEffortOutputIsRefusedNamingBoth) {

@@ -4,6 +4,7 @@
 
 OSCAR_REGISTER_KERNEL(oscar::test::Counter, "test_counter")
 OSCAR_REGISTER_KERNEL(oscar::test::Collect, "test_collect")
+OSCAR_REGISTER_KERNEL(oscar::test::RawCollect, "test_raw_collect")
 OSCAR_REGISTER_KERNEL(oscar::test::Lines, "test_lines")
 OSCAR_REGISTER_KERNEL(oscar::test::Merge, "test_merge")
 OSCAR_REGISTER_KERNEL(oscar::test::CollectImage, "test_gv")

@@ -66,6 +66,32 @@ class Collect final : public Kernel {
   int runs_ = 0;
 };
 
+/// Keeps every cue of any type that reaches the inputs the configuration names (as the logger).
+class RawCollect final : public Kernel {
+ public:
+  explicit RawCollect(KernelSetup& setup) {
+    for (const auto& name : setup.configured_inputs()) {
+      inputs_.push_back(&setup.raw_input(name, {.depth = 64}));
+    }
+  }
+  void process(Cycle&) override {
+    std::lock_guard lock(mutex_);
+    for (auto* in : inputs_) {
+      for (auto& r : in->take_new()) seen_.push_back(r.cue);
+    }
+  }
+  void stub(Cycle& c) override { process(c); }
+  std::vector<std::shared_ptr<const RawCue>> seen() {
+    std::lock_guard lock(mutex_);
+    return seen_;
+  }
+
+ private:
+  std::vector<Input<RawCue>*> inputs_;
+  std::mutex mutex_;
+  std::vector<std::shared_ptr<const RawCue>> seen_;
+};
+
 /// Publishes Bool cues on an output of the QoS class its parameters declare, `count` of them
 /// (0 = no end): a producer for the cue QoS tests.
 class Emitter final : public Kernel {

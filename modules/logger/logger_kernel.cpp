@@ -5,17 +5,15 @@
 #include <regex>
 #include <set>
 
-#include <oscar/cue_type_info.hpp>
-#include <oscar/cue_types.hpp>
+#include <oscar/idl_texts.hpp>
 #include <oscar/kernel_registry.hpp>
-
-#include "idl_texts.hpp"  // tools/record: the omgidl schema texts
 
 namespace oscar::modules {
 
 void Logger::Params::describe(ParamSpec& spec) {
   spec.field("file", file, "the MCAP file to write (created on the first cue)").fixed();
-  spec.field("inputs", inputs, "inputs to declare: 'name:Type, ...' (Bool, LineSeg3DSeq, GvImage)")
+  spec.field("inputs", inputs,
+             "inputs to declare besides those the configuration wires: 'name, ...' (any cue type)")
       .fixed();
   spec.field("compression", compression, "chunk compression")
       .one_of({"zstd", "lz4", "none"})
@@ -23,41 +21,11 @@ void Logger::Params::describe(ParamSpec& spec) {
   spec.field("flush_every", flush_every, "write the open chunk when its oldest cue is this old");
 }
 
-struct Logger::Port {
-  virtual ~Port() = default;
-  /// Every new cue: (serialised bytes, header, receive time).
-  struct Item {
-    std::vector<std::uint8_t> bytes;
-    const CueHeader* header;
-    Stamp received;
-    std::shared_ptr<const void> keep;
-  };
-  virtual std::vector<Item> take() = 0;
-  virtual const std::string& type() const = 0;
-};
-
-namespace {
-template <class T>
-struct TypedPort final : Logger::Port {
-  TypedPort(KernelSetup& setup, const std::string& name)
-      : in(setup.input<T>(name, {.depth = 256, .transfer = Transfer::kPush})) {}
-  std::vector<Item> take() override {
-    std::vector<Item> out;
-    for (auto& r : in.take_new()) {
-      out.push_back(
-          {cue_type_info<T>().serialize(r.cue.get()), &r.cue->header(), r.received, r.cue});
-    }
-    return out;
-  }
-  const std::string& type() const override { return cue_type_info<T>().name; }
-  Input<T>& in;
-};
-}  // namespace
-
-std::vector<Logger::InputSpec> Logger::parse_inputs(const std::string& text) {
-  static const std::regex entry(
-      R"(\s*([A-Za-z_][A-Za-z0-9_]*)\s*:\s*([A-Za-z_][A-Za-z0-9_:]*)\s*)");
-  std::vector<InputSpec> out;
+std::vector<std::string> Logger::parse_inputs(const std::string& text) {
+  static const std::regex name(R"(\s*([A-Za-z_][A-Za-z0-9_]*)\s*)");
+  static const std::regex typed(R"(\s*([A-Za-z_][A-Za-z0-9_]*)\s*:.*)");
+  std::vector<std::string> out;
+  if (std::regex_match(text, std::regex(R"(\s*)"))) return out;
   std::set<std::string> names;
   std::size_t start = 0;
   while (start <= text.size()) {
@@ -65,15 +33,20 @@ std::vector<Logger::InputSpec> Logger::parse_inputs(const std::string& text) {
     const auto item =
         text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
     std::smatch m;
-    if (!std::regex_match(item, m, entry)) {
+    if (std::regex_match(item, m, typed)) {
       throw std::invalid_argument("logger: parameter 'inputs': '" + item +
-                                  "' is not 'name:Type' (e.g. 'cam:GvImage, flag:Bool')");
+                                  "' names a type; give the input name only ('" + m[1].str() +
+                                  "'): the logger takes each producer's type");
+    }
+    if (!std::regex_match(item, m, name)) {
+      throw std::invalid_argument("logger: parameter 'inputs': '" + item +
+                                  "' is not an input name (e.g. 'cam, flag')");
     }
     if (!names.insert(m[1]).second) {
       throw std::invalid_argument("logger: parameter 'inputs': input '" + m[1].str() +
-                                  "' is declared twice");
+                                  "' is named twice");
     }
-    out.push_back({m[1], m[2]});
+    out.push_back(m[1]);
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
@@ -85,14 +58,16 @@ Logger::Logger(KernelSetup& setup) {
   if (params_.file.empty()) {
     throw std::invalid_argument("logger: parameter 'file' must name the MCAP file to write");
   }
-  if (params_.inputs.empty()) {
+  std::set<std::string> names;
+  for (const auto& name : setup.configured_inputs()) names.insert(name);
+  for (const auto& name : parse_inputs(params_.inputs)) names.insert(name);
+  if (names.empty()) {
     throw std::invalid_argument(
-        "logger: parameter 'inputs' must declare at least one input, e.g. 'cam:GvImage'");
+        "logger: nothing to record: wire inputs in the kernel's inputs: (e.g. inputs: { tags: "
+        "mark_a/tags }) or name them in parameter 'inputs'");
   }
-  for (const auto& spec : parse_inputs(params_.inputs)) {
-    ports_.push_back(visit_standard_type(spec.type, [&]<class T>() -> std::unique_ptr<Port> {
-      return std::make_unique<TypedPort<T>>(setup, spec.name);
-    }));
+  for (const auto& name : names) {
+    inputs_.push_back(&setup.raw_input(name, {.depth = 256, .transfer = Transfer::kPush}));
   }
 }
 
@@ -114,18 +89,19 @@ void Logger::open() {
   schemas_.clear();
 }
 
-std::uint16_t Logger::channel(const std::string& source, const std::string& type) {
+std::uint16_t Logger::channel(const RawCue& cue) {
   // The topic the cue travels on: oscar/cue/<kernel>/<channel> (from its header's source).
+  const auto& source = cue.header().source();
   const auto topic = "oscar/cue/" + source;
   if (auto it = channels_.find(topic); it != channels_.end()) return it->second;
-  std::uint16_t schema = 0;
-  if (auto s = schemas_.find(type); s != schemas_.end()) {
+  std::uint16_t schema = 0;  // none: a type without an IDL text here
+  if (auto s = schemas_.find(cue.type); s != schemas_.end()) {
     schema = s->second;
-  } else if (auto idl = record::idl_texts().find(type); idl != record::idl_texts().end()) {
-    schema = schemas_[type] =
-        writer_->add_schema(type, "omgidl", {idl->second.begin(), idl->second.end()});
+  } else if (auto idl = idl_texts().find(cue.type); idl != idl_texts().end()) {
+    schema = schemas_[cue.type] =
+        writer_->add_schema(cue.type, "omgidl", {idl->second.begin(), idl->second.end()});
   }
-  std::map<std::string, std::string> meta{{"type", type}, {"logger", "true"}};
+  std::map<std::string, std::string> meta{{"type", cue.type}, {"logger", "true"}};
   const auto slash = source.find('/');
   meta["kernel"] = source.substr(0, slash);
   if (slash != std::string::npos) meta["channel"] = source.substr(slash + 1);
@@ -134,21 +110,21 @@ std::uint16_t Logger::channel(const std::string& source, const std::string& type
 
 void Logger::process(Cycle& cycle) {
   // This cycle's cues of all inputs in the order they arrived: the file is in log-time order.
-  std::vector<std::pair<Port::Item, const Port*>> items;
-  for (auto& port : ports_) {
-    for (auto& item : port->take()) items.emplace_back(std::move(item), port.get());
+  std::vector<Input<RawCue>::Received> items;
+  for (auto* input : inputs_) {
+    for (auto& r : input->take_new()) items.push_back(std::move(r));
   }
-  std::stable_sort(items.begin(), items.end(), [](const auto& a, const auto& b) {
-    return a.first.received < b.first.received;
-  });
-  for (const auto& [item, port] : items) {
+  std::stable_sort(items.begin(), items.end(),
+                   [](const auto& a, const auto& b) { return a.received < b.received; });
+  for (const auto& item : items) {
     if (!writer_) open();
+    const auto& header = item.cue->header();
     mcap::MessageView m;
-    m.channel_id = channel(item.header->source(), port->type());
-    m.sequence = static_cast<std::uint32_t>(item.header->seq());
+    m.channel_id = channel(*item.cue);
+    m.sequence = static_cast<std::uint32_t>(header.seq());
     m.log_time = static_cast<std::uint64_t>(item.received);
-    m.publish_time = item.header->stamps().empty() ? m.log_time : item.header->stamps()[0];
-    m.data = item.bytes;
+    m.publish_time = header.stamps().empty() ? m.log_time : header.stamps()[0];
+    m.data = item.cue->cdr;
     writer_->write(m);
     if (!unflushed_since_) unflushed_since_ = cycle.now();
   }

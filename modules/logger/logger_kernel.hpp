@@ -13,23 +13,23 @@ namespace oscar::modules {
 
 /// Records every cue that reaches its inputs into an MCAP file, in the format `oscar record`
 /// writes (seed 004 §3: generic data loggers hung onto input and output channels;
-/// docs/recording.md).
+/// docs/recording.md). Its inputs take cues of any type (raw inputs): it stores each cue's
+/// serialized form and the IDL text of the producer's type.
 class Logger final : public Kernel {
  public:
   struct Params {
     std::string file;                  ///< the MCAP file (required)
-    std::string inputs;                ///< "name:Type, name:Type" (Type: a standard cue type)
+    std::string inputs;                ///< "name, name": inputs to declare besides the wired ones
     std::string compression = "zstd";  ///< zstd, lz4 or none
     std::chrono::nanoseconds flush_every{std::chrono::seconds(1)};  ///< oldest unwritten cue
     void describe(ParamSpec& spec);
   };
-  /// One declared input: its name and cue type.
-  struct InputSpec {
-    std::string name, type;
-  };
-  /// Parses the `inputs` parameter. @throws std::invalid_argument naming the bad entry.
-  static std::vector<InputSpec> parse_inputs(const std::string& text);
+  /// Parses the `inputs` parameter: input names separated by commas.
+  /// @throws std::invalid_argument naming the bad entry.
+  static std::vector<std::string> parse_inputs(const std::string& text);
 
+  /// Declares one raw input per input the configuration names and per name in `inputs`.
+  /// @throws std::invalid_argument without a file or without any input.
   explicit Logger(KernelSetup& setup);
   ~Logger() override;
   void process(Cycle& cycle) override;
@@ -37,14 +37,12 @@ class Logger final : public Kernel {
   void stub(Cycle& cycle) override;
   void on_deactivate() override;
 
-  struct Port;  // a typed input and how to serialise its cues
-
  private:
   void open();
-  std::uint16_t channel(const std::string& source, const std::string& type);
+  std::uint16_t channel(const RawCue& cue);
 
   Params params_;
-  std::vector<std::unique_ptr<Port>> ports_;
+  std::vector<Input<RawCue>*> inputs_;
   std::unique_ptr<mcap::Writer> writer_;
   std::map<std::string, std::uint16_t> channels_;  // by topic
   std::map<std::string, std::uint16_t> schemas_;   // by type name

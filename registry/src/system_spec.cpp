@@ -264,10 +264,12 @@ void SystemSpec::check_modules(const std::vector<std::string>& plugin_path) cons
                                     wiring.source.substr(wiring.source.find('/') + 1)));
         }
         const auto& output = *it->second;
-        if (port && output.type().name != port->type().name) {
-          fail(k.where,
-               fmt::format("cannot wire {} ({}) to input {}/{} ({}): the types differ",
-                           wiring.source, output.type().name, k.name, input, port->type().name));
+        if (port) {
+          try {
+            check_types(*port, wiring.source, output.type());  // a raw input takes any type
+          } catch (const std::invalid_argument& e) {
+            fail(k.where, e.what());
+          }
         }
         // A pull asks over its own reliable topics; only a push reads the output's writer.
         if (port && port->transfer() == Transfer::kPush) {

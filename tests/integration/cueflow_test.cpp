@@ -11,6 +11,7 @@
 #include "oscar/config_client.hpp"
 #include "oscar/cue_type_info.hpp"
 #include "oscar/module.hpp"
+#include "oscar/perception_types.hpp"
 #include "oscar/topic_io.hpp"
 
 #include <oscar/configPubSubTypes.h>
@@ -109,6 +110,37 @@ kernels:
   EXPECT_EQ(r["received"], 4) << "the output's depth";
   EXPECT_EQ(r["last_seq"], 10);
   EXPECT_EQ(r["gaps"], 0) << "cues 7 to 10";
+}
+
+// A type this process does not know (its kernels use none of it): the raw input's reader keeps
+// the bytes (RawCdrType under the type name discovery shows). Its producer starts later, so the
+// input is subscribed only once discovery finds it.
+TEST(CueFlow, ARawInputTakesATypeItsProcessDoesNotKnowFromAProducerThatCameLater) {
+  ASSERT_EQ(find_cue_type("oscar::CameraImage"), nullptr) << "the test's premise";
+  auto sink = local_module(R"(
+name: raw_sink
+mode: { continuous: 10ms }
+kernels: [ { type: test_raw_collect, name: sink, inputs: { img: cam/frame } } ]
+)");
+  auto& collect = dynamic_cast<test::RawCollect&>(sink->kernel("sink").kernel());
+  auto cam = run("cam", {"-k", "framegrabber:cam", "-p", "cam.source=synthetic:static", "-p",
+                         "cam.width=64", "-p", "cam.height=48", "-m", "continuous:20ms"});
+  ASSERT_TRUE(eventually([&] { return collect.seen().size() >= 5; })) << cam->output();
+  const auto seen = collect.seen();
+  for (std::size_t i = 0; i < seen.size(); ++i) {
+    EXPECT_EQ(seen[i]->type, "oscar::CameraImage");
+    EXPECT_EQ(seen[i]->header().source(), "cam/frame");
+    if (i > 0) {
+      EXPECT_EQ(seen[i]->header().seq(), seen[i - 1]->header().seq() + 1);
+    }
+  }
+  ASSERT_EQ(find_cue_type("oscar::CameraImage"), nullptr) << "read without the type";
+  // The bytes are the producer's cue: its type decodes them.
+  const auto image = std::static_pointer_cast<CameraImage>(
+      cue_type_info<CameraImage>().deserialize(seen.back()->cdr));
+  EXPECT_EQ(image->header(), seen.back()->header());
+  EXPECT_EQ(image->width(), 64);
+  EXPECT_EQ(image->height(), 48);
 }
 
 const char* const kPullConsumer = R"(

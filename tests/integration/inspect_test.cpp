@@ -58,7 +58,7 @@ modules:
     kernels:
       - type: logger
         name: log
-        params: { file: )" + file + R"(, inputs: 'flag: Bool, image: GvImage', compression: lz4 }
+        params: { file: )" + file + R"(, compression: lz4 }
         inputs: { flag: sig/out, image: cam/out }
     mode: { continuous: 20ms }
 )");

@@ -1,9 +1,14 @@
 // Seed 004 §4.2 on one host (issue 7): config/landmarks-1host.yaml booted by oscar boot; the
 // test watches MarkADetect's tags and the fused pose over DDS and compares them with the
-// synthetic scene's ground truth; the sequencer switches the frame mode by configuration.
+// synthetic scene's ground truth; the sequencer switches the frame mode by configuration. A
+// logger kernel in another process records the application's own cues.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <map>
 #include <mutex>
+#include <regex>
+#include <set>
 #include <thread>
 
 #include <gmock/gmock.h>
@@ -13,6 +18,9 @@
 
 #include "booted_system.hpp"
 #include "landmark_summary.hpp"  // tests/common
+#include "oscar/cue_type_info.hpp"
+#include "oscar/idl_texts.hpp"
+#include "oscar/mcap/reader.hpp"
 #include "oscar/perception_types.hpp"
 #include "oscar/topic_io.hpp"
 
@@ -120,6 +128,91 @@ TEST(Landmarks, OneHostDetectsTheTagsOncePerCycleAndFusesThePoseOfTheGroundTruth
   ASSERT_GE(summaries.size(), 3u);
   EXPECT_TRUE(summaries[2].truth);
   EXPECT_LT(summaries[2].worst_mm, 10);
+}
+
+// The application's own cue types, which the logger does not name: wired in the system file like
+// any consumer, a logger in a process of its own records MarkADetect's and MarkBDetect's tags and
+// the fused pose with the IDL text of their types, in the MCAP that oscar record writes.
+TEST(Landmarks, ALoggerInAnotherProcessRecordsTheDetectionsAndPosesWithTheirTypes) {
+  const auto file = test::temp_path("landmarks_log") + ".mcap";
+  std::filesystem::remove(file);
+  auto root = YAML::Load(landmark_system("landmarks-1host.yaml"));
+  root["modules"].push_back(YAML::Load(R"(
+name: logbook
+kernels:
+  - type: logger
+    name: log
+    params: { file: )" + file + R"(, compression: lz4 }
+    inputs: { tags_a: mark_a/tags, tags_b: mark_b/tags, pose: pose/pose }
+mode: { continuous: 50ms }
+)"));
+  YAML::Emitter yaml;
+  yaml << root;
+  test::BootedSystem sys("landmarks_log", yaml.c_str());
+  sys.running();
+  std::this_thread::sleep_for(4s);
+  ASSERT_EQ(sys.shut_down(), 0) << sys.boot().output();
+
+  mcap::Reader reader(file);
+  std::map<std::string, std::vector<std::uint64_t>> seqs;  // by topic
+  reader.read_messages([&](const mcap::Channel& c, const mcap::MessageView& m) {
+    const std::vector<std::uint8_t> bytes(m.data.begin(), m.data.end());
+    EXPECT_EQ(c.message_encoding, "cdr");
+    if (c.topic == "oscar/cue/pose/pose") {
+      ASSERT_EQ(c.metadata.at("type"), "oscar::LandmarkPose");
+      const auto pose =
+          std::static_pointer_cast<LandmarkPose>(cue_type_info<LandmarkPose>().deserialize(bytes));
+      EXPECT_TRUE(pose->valid());
+      EXPECT_EQ(pose->estimates(), 2u);
+      EXPECT_EQ(m.sequence, pose->header().seq());
+      EXPECT_EQ(m.publish_time, pose->header().stamps().at(0));
+    } else {
+      ASSERT_EQ(c.metadata.at("type"), "oscar::TagDetections") << c.topic;
+      const auto tags = std::static_pointer_cast<TagDetections>(
+          cue_type_info<TagDetections>().deserialize(bytes));
+      const bool a = c.topic == "oscar/cue/mark_a/tags";
+      EXPECT_TRUE(a || c.topic == "oscar/cue/mark_b/tags") << c.topic;
+      EXPECT_EQ(tags->header().source(), a ? "mark_a/tags" : "mark_b/tags");
+      ASSERT_EQ(tags->detections().size(), 1u);
+      EXPECT_EQ(tags->detections()[0].id(), a ? 0 : 1);
+      EXPECT_EQ(m.sequence, tags->header().seq());
+    }
+    seqs[c.topic].push_back(m.sequence);
+  });
+  ASSERT_EQ(seqs.size(), 3u);
+  for (const auto& [topic, s] : seqs) {
+    EXPECT_GE(s.size(), 5u) << topic;
+    for (std::size_t i = 1; i < s.size(); ++i) {
+      EXPECT_EQ(s[i], s[i - 1] + 1) << topic << ": every cue from the first on, once, in order";
+    }
+  }
+  EXPECT_NEAR(static_cast<double>(seqs["oscar/cue/pose/pose"].size()),
+              static_cast<double>(seqs["oscar/cue/mark_b/tags"].size()), 2.0)
+      << "one pose per pair of detections";
+
+  const auto info = reader.info();
+  EXPECT_TRUE(info.from_summary) << "the logger finished the file when the system shut down";
+  std::set<std::string> types;
+  for (const auto& [id, schema] : info.schemas) {
+    (void)id;
+    EXPECT_EQ(schema.encoding, "omgidl");
+    EXPECT_EQ(std::string(schema.data.begin(), schema.data.end()), idl_texts().at(schema.name));
+    types.insert(schema.name);
+  }
+  EXPECT_EQ(types, (std::set<std::string>{"oscar::LandmarkPose", "oscar::TagDetections"}));
+
+  // oscar info lists each topic with its type and count.
+  test::Process oscar_info({test::bin("oscar-info"), file}, test::temp_path("landmarks_info.log"));
+  ASSERT_EQ(oscar_info.wait(60s), 0) << oscar_info.output();
+  const auto printed = oscar_info.output();
+  for (const auto& [topic, s] : seqs) {
+    const auto type =
+        topic == "oscar/cue/pose/pose" ? "oscar::LandmarkPose" : "oscar::TagDetections";
+    EXPECT_TRUE(std::regex_search(printed, std::regex(topic + " +" + type + " +" +
+                                                      std::to_string(s.size()) + " +cdr / omgidl")))
+        << printed;
+  }
+  std::filesystem::remove(file);
 }
 
 }  // namespace

@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "booted_system.hpp"
-#include "cue_header_cdr.hpp"  // tools/record
+#include "oscar/cue_header_cdr.hpp"
 #include "oscar/cue_type_info.hpp"
 #include "oscar/cue_types.hpp"
 #include "oscar/mcap/reader.hpp"
@@ -99,9 +99,9 @@ modules:
   std::mutex mutex;
   std::map<std::string, std::vector<Message>> replayed;
   inspect::RawTap tap(participant, [&](const std::string& topic, auto bytes, auto) {
-    const auto h = record::read_cue_header(bytes);
+    const auto h = read_cue_header(bytes);
     std::lock_guard lock(mutex);
-    replayed[topic].push_back({std::move(bytes), h ? h->seq : 0});
+    replayed[topic].push_back({std::move(bytes), h ? h->seq() : 0});
   });
   Process replay({test::bin("oscar-replay"), file, "--domain", domain},
                  test::temp_path("roundtrip_replay") + ".log");

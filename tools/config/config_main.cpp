@@ -14,7 +14,7 @@
 #include <oscar/registry/system_options.hpp>
 #include <oscar/time.hpp>
 
-#include "idl_texts.hpp"  // tools/record
+#include "oscar/idl_texts.hpp"
 #include "idl_types.hpp"  // tools/inspect
 
 namespace {
@@ -57,7 +57,7 @@ int send_command(oscar::ConfigClient& client, const std::string& module,
                                     kernel, k->type(), name, known));
   }
   oscar::inspect::IdlTypes types;
-  for (const auto& [t, text] : oscar::record::idl_texts()) types.add(text);
+  for (const auto& [t, text] : oscar::idl_texts()) types.add(text);
   if (!types.has(type)) {
     throw std::invalid_argument(fmt::format(
         "command '{}' of kernel '{}' takes {}, whose IDL oscar config does not know (it encodes "

@@ -14,8 +14,8 @@
 #include "oscar/mcap/reader.hpp"
 #include "oscar/output.hpp"
 #include "oscar/process_util.hpp"
+#include "oscar/raw_cdr_type.hpp"
 #include "oscar/topic_io.hpp"
-#include "raw_cdr_type.hpp"
 #include "reading_priority.hpp"
 #include "recorder.hpp"  // topic_of
 
@@ -77,12 +77,12 @@ struct Replayer::Impl {
     // Let discovery see the running system first: a topic there of another type is an error.
     std::this_thread::sleep_for(std::chrono::milliseconds(1200));
     for (const auto& [id, tt] : selected) {
-      participant->topic(tt.first, new record::RawCdrType(tt.second));  // throws on a mismatch
+      participant->topic(tt.first, new RawCdrType(tt.second));  // throws on a mismatch
       if (lanes.size() < kMaxLaneParticipants) {
         lanes.push_back(std::make_unique<DdsParticipant>(o.domain, "oscar-replay"));
       }
       auto& lane = *lanes[writers.size() % lanes.size()];
-      auto& topic = lane.topic(tt.first, new record::RawCdrType(tt.second));
+      auto& topic = lane.topic(tt.first, new RawCdrType(tt.second));
       auto* w = lane.publisher().create_datawriter(&topic, qos::cue_writer(OutputOptions{}));
       if (!w) throw std::runtime_error("cannot create a writer for " + tt.first);
       writers[id] = {&lane, w};
@@ -155,7 +155,7 @@ ReplayCounters Replayer::run(const std::atomic<bool>& stop) {
   const std::uint64_t first = d.info.statistics.message_start_time;
   const std::uint64_t from = first + (d.o.start ? d.o.start->count() : 0);
   const std::uint64_t to = d.o.end ? first + d.o.end->count() : UINT64_MAX;
-  std::map<dds::DataWriter*, record::RawSample> samples;  // each used by its writer's lane only
+  std::map<dds::DataWriter*, RawCue> samples;  // each used by its writer's lane only
   for (const auto& [id, w] : d.writers) samples[w.second];
   std::function<bool(const Pending&)> step;
   if (d.o.step) {
@@ -195,7 +195,7 @@ ReplayCounters Replayer::run(const std::atomic<bool>& stop) {
         p.due = pass_start + scaled(m.log_time - from);
         p.bytes.assign(m.data.begin(), m.data.end());
         p.publish = [writer, sample = &samples[writer]](auto& bytes) {
-          sample->bytes.swap(bytes);
+          sample->cdr.swap(bytes);
           writer->write(sample);
         };
         if (d.o.step) {

@@ -24,15 +24,17 @@ class KernelHarness {
 
   /// Gives a cue to an input, as a producer would (stamped with the harness time if unstamped).
   /// Pull and prefetch inputs are answered from everything fed so far.
+  /// A raw input (KernelSetup::raw_input) gets the cue serialized, as from a producer of type T.
   template <CueType T>
   void feed(const std::string& input, T cue) {
     auto& port = input_port(input);
-    if (port.type().name != cue_type_info<T>().name) {
+    const auto& type = cue_type_info<T>();
+    if (!port.takes_any_type() && port.type().name != type.name) {
       throw std::invalid_argument("harness: input '" + input + "' takes " + port.type().name +
-                                  ", not " + cue_type_info<T>().name);
+                                  ", not " + type.name);
     }
     if (cue.header().stamps().empty()) append_stamp(cue.header(), now_);
-    feed_erased(port, std::make_shared<const T>(std::move(cue)));
+    feed_erased(port, type, std::make_shared<const T>(std::move(cue)));
   }
 
   /// Runs process() once at the harness time.
@@ -75,7 +77,7 @@ class KernelHarness {
  private:
   struct Captured;
   InputPort& input_port(const std::string& name);
-  void feed_erased(InputPort& port, std::shared_ptr<const void> cue);
+  void feed_erased(InputPort& port, const CueTypeInfo& type, std::shared_ptr<const void> cue);
   std::vector<std::shared_ptr<const void>> take_erased(const std::string& output);
 
   Stamp now_ = 1'000'000'000;  // 1 s after the epoch: stamps are never 0 ("none")

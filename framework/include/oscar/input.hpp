@@ -93,14 +93,21 @@ class InputPort {
 
   const std::string& kernel() const { return kernel_; }
   const std::string& name() const { return name_; }
+  /// The declared cue type; raw_cue_type() for an input that takes cues of any type.
   const CueTypeInfo& type() const { return type_; }
+  /// True for a raw input (KernelSetup::raw_input): it takes cues of any type, as RawCue.
+  bool takes_any_type() const;
   Transfer transfer() const { return transfer_; }
   Reliability reliability() const { return reliability_; }
   RingBuffer& buffer() { return buffer_; }
   const RingBuffer& buffer() const { return buffer_; }
 
-  /// Stores an arriving cue (stamping its receive time) and runs the arrival hook.
+  /// Stores an arriving cue of the input's type (stamping its receive time) and runs the arrival
+  /// hook.
   void deliver(std::shared_ptr<const void> cue);
+  /// Delivers a cue of the producer's type `producer`: a raw input gets it as RawCue, serialized
+  /// (raw_cue.hpp); any other input gets it as it is (the types were checked when wiring).
+  void deliver_from(const CueTypeInfo& producer, std::shared_ptr<const void> cue);
   /// Called after every delivery, on the delivering thread (the frame triggers kernels with it).
   void set_arrival_hook(std::function<void()> hook);
   void set_pull_source(std::shared_ptr<PullSource> source);

@@ -18,6 +18,7 @@
 #include "oscar/input.hpp"
 #include "oscar/output.hpp"
 #include "oscar/params.hpp"
+#include "oscar/raw_cue.hpp"
 #include "oscar/time.hpp"
 
 namespace oscar {
@@ -101,6 +102,18 @@ class KernelSetup {
     ports_.inputs.push_back(std::move(port));
     return ref;
   }
+
+  /// Declares an input that takes cues of any type, as RawCue: the producer's type name, the cue
+  /// serialized, its header. The type is the producer's, found when the input is wired (from its
+  /// output in process, from discovery across processes); each cue is kept as the wire has it.
+  /// For kernels that handle cues without their types (the logger); push transfer only.
+  /// @throws std::invalid_argument if the name is taken or not an identifier, or if the defaults
+  ///         or the configuration ask for pull or prefetch.
+  Input<RawCue>& raw_input(const std::string& name, InputOptions defaults = {});
+
+  /// The inputs the configuration names for this kernel (the keys of its `inputs:`), sorted:
+  /// what a kernel declares whose inputs are the configuration's choice (the logger).
+  std::vector<std::string> configured_inputs() const;
 
   /// Declares an output. @throws std::invalid_argument if the name is taken.
   template <CueType T>

@@ -69,6 +69,11 @@ class OutputPort {
   std::function<Stamp()> clock_;
 };
 
+/// @throws std::invalid_argument naming both ends if `input` does not take the cue type `type` of
+///         the output `source` ("<kernel>/<channel>"): their types differ and the input is no raw
+///         input (which takes any type).
+void check_types(const InputPort& input, const std::string& source, const CueTypeInfo& type);
+
 /// @throws std::invalid_argument naming both ends if `input` declares reliable delivery and the
 ///         output `source` ("<kernel>/<channel>", declared `declared`) is best effort: a reliable
 ///         reader never matches a best-effort writer (docs/architecture.md, "Topics and QoS

@@ -1,6 +1,7 @@
 #include "dds/module_dds.hpp"
 
 #include "dds/log_sink.hpp"
+#include "oscar/raw_cdr_type.hpp"
 #include "oscar/topic_io.hpp"
 
 #include <unistd.h>
@@ -44,13 +45,34 @@ class Module::Dds::OutputWriter final : public dds::DataWriterListener {
   std::atomic<int> matched_{0};
 };
 
+namespace {
+// What a reader of `type` takes from DDS for `input`: the input's own type; for a raw input the
+// type's support if this process knows the type (each cue is then serialized for the input), or
+// nullptr: RawCdrType keeps the bytes. A type the process knows is read with its support, so
+// that a topic of it here never gets RawCdrType and a typed port here the other way round.
+const CueTypeInfo* wire_type(DdsParticipant& p, const InputPort& input, const std::string& type) {
+  if (!input.takes_any_type()) return &input.type();
+  const auto registered = p.get().find_type(type);
+  if (registered.get() && dynamic_cast<RawCdrType*>(registered.get())) return nullptr;
+  return find_cue_type(type);
+}
+}  // namespace
+
 class Module::Dds::CueReader final : public dds::DataReaderListener {
  public:
-  /// `producer`: the source output's declared options, as far as they are known.
-  CueReader(Dds& owner, InputPort& input, const std::string& source, const OutputOptions& producer)
-      : owner_(owner), input_(input), source_(source), producer_(producer) {
+  /// `producer`: the source output's declared options, as far as they are known; `type`: the
+  /// producer's type name.
+  CueReader(Dds& owner, InputPort& input, const std::string& source, const OutputOptions& producer,
+            const std::string& type)
+      : owner_(owner),
+        input_(input),
+        source_(source),
+        type_(type),
+        producer_(producer),
+        wire_(wire_type(owner.participant_, input, type)) {
     auto& p = owner.participant_;
-    auto& topic = p.topic(topics::cue(source), input.type().new_topic_type());
+    auto& topic =
+        p.topic(topics::cue(source), wire_ ? wire_->new_topic_type() : new RawCdrType(type));
     reader_ = p.subscriber().create_datareader(
         &topic, qos::cue_reader(producer, input.buffer().depth(), input.reliability()), this,
         dds::StatusMask::data_available() << dds::StatusMask::subscription_matched()
@@ -58,13 +80,15 @@ class Module::Dds::CueReader final : public dds::DataReaderListener {
     if (!reader_) throw std::runtime_error("cannot create a reader for " + source);
   }
   const std::string& source() const { return source_; }
+  const std::string& type() const { return type_; }
   void on_data_available(dds::DataReader* reader) override {
+    const auto& arriving = wire_ ? *wire_ : raw_cue_type();
     dds::SampleInfo info;
     for (;;) {
-      auto cue = input_.type().make();
+      auto cue = arriving.make();
       if (reader->take_next_sample(cue.get(), &info) != ReturnCode_t::RETCODE_OK) break;
       if (info.valid_data) {
-        input_.deliver(std::move(cue));
+        input_.deliver_from(arriving, std::move(cue));
         received_ = true;
       }
     }
@@ -108,8 +132,9 @@ class Module::Dds::CueReader final : public dds::DataReaderListener {
   std::atomic<bool> received_{false};
   Dds& owner_;
   InputPort& input_;
-  std::string source_;
+  std::string source_, type_;
   OutputOptions producer_;
+  const CueTypeInfo* wire_;  // what the reader takes; nullptr: RawCue from RawCdrType
   std::atomic<int> matched_{0};
 };
 
@@ -172,16 +197,36 @@ std::string Module::Dds::connect_input(InputPort& input, const std::string& sour
   if (seen) {
     producer.reliable = seen->reliable;
     producer.transient_local = seen->transient_local;
+  } else if (input.takes_any_type()) {
+    // No type to read yet: the old source is dropped now (a rewire must not keep reading it),
+    // the new one is subscribed by the configuration thread once discovery shows its writer.
+    disconnect_input(input);
+    {
+      std::lock_guard lock(queue_mutex_);
+      awaiting_type_[&input] = source;
+      queue_cv_.notify_all();
+    }
+    auto note = fmt::format(
+        "input {}/{}: no publisher of {} seen yet, so its type is unknown; it is subscribed once "
+        "discovery finds one",
+        input.kernel(), input.name(), cue_topic(source));
+    module_.log_->warn("{}", note);
+    return note;
   }
-  return subscribe(input, source, producer, switch_wait, until);
+  return subscribe(input, source, producer, seen ? seen->type : input.type().name, switch_wait,
+                   until);
 }
 
 std::string Module::Dds::subscribe(InputPort& input, const std::string& source,
-                                   const OutputOptions& producer,
+                                   const OutputOptions& producer, const std::string& type,
                                    std::optional<std::chrono::milliseconds> switch_wait,
                                    std::chrono::steady_clock::time_point until) {
   check_reliability(input, source, producer);
-  auto reader = std::make_unique<CueReader>(*this, input, source, producer);
+  {
+    std::lock_guard lock(queue_mutex_);
+    awaiting_type_.erase(&input);  // subscribed now
+  }
+  auto reader = std::make_unique<CueReader>(*this, input, source, producer, type);
   std::string note;
   if (!reader->wait_matched(until)) {
     note = fmt::format("input {}/{}: no publisher of {} matched yet; cues arrive once it appears",
@@ -216,20 +261,52 @@ void Module::Dds::follow_producer(InputPort& input, const std::string& source,
 }
 
 void Module::Dds::refollow(const Refollow& r) {
+  std::string type;
   {
     std::lock_guard lock(readers_mutex_);
     const auto it = readers_.find(r.input);
     if (it == readers_.end() || it->second->source() != r.source) return;  // rewired since
+    type = it->second->type();
   }
   try {
-    subscribe(*r.input, r.source, r.offered, std::nullopt,
+    subscribe(*r.input, r.source, r.offered, type, std::nullopt,
               std::chrono::steady_clock::now() + std::chrono::milliseconds(2000));
   } catch (const std::exception& e) {
     module_.log_->error("{}", e.what());
   }
 }
 
+// On the configuration thread: raw inputs whose source discovery has found since.
+void Module::Dds::subscribe_discovered() {
+  std::map<InputPort*, std::string> awaiting;
+  {
+    std::lock_guard lock(queue_mutex_);
+    awaiting = awaiting_type_;
+  }
+  for (const auto& [input, source] : awaiting) {
+    const auto seen = participant_.discovered_writer(cue_topic(source));
+    if (!seen) continue;
+    OutputOptions producer;
+    producer.reliable = seen->reliable;
+    producer.transient_local = seen->transient_local;
+    try {
+      subscribe(*input, source, producer, seen->type, std::nullopt,
+                std::chrono::steady_clock::now() + std::chrono::milliseconds(2000));
+      module_.log_->info("input {}/{}: subscribed to {} ({})", input->kernel(), input->name(),
+                         cue_topic(source), seen->type);
+    } catch (const std::exception& e) {
+      std::lock_guard lock(queue_mutex_);
+      awaiting_type_.erase(input);  // reported once, not every round
+      module_.log_->error("input {}/{}: {}", input->kernel(), input->name(), e.what());
+    }
+  }
+}
+
 void Module::Dds::disconnect_input(InputPort& input) {
+  {
+    std::lock_guard lock(queue_mutex_);
+    awaiting_type_.erase(&input);
+  }
   std::unique_ptr<CueReader> old;
   std::shared_ptr<internal::DdsPullSource> old_pull;  // the input reads elsewhere by now
   {
@@ -280,9 +357,20 @@ void Module::Dds::start_config() {
 // deletes readers, and activate waits for the processing thread.
 void Module::Dds::serve_config() {
   std::unique_lock lock(queue_mutex_);
+  const auto ready = [&] { return !serving_ || !queue_.empty() || !refollow_.empty(); };
   while (true) {
-    queue_cv_.wait(lock, [&] { return !serving_ || !queue_.empty() || !refollow_.empty(); });
+    if (awaiting_type_.empty()) {
+      queue_cv_.wait(lock, ready);
+    } else {
+      // Discovery is polled for raw inputs whose source has not shown up yet.
+      queue_cv_.wait_for(lock, std::chrono::milliseconds(50), ready);
+    }
     if (!serving_) return;
+    if (!awaiting_type_.empty()) {
+      lock.unlock();
+      subscribe_discovered();
+      lock.lock();
+    }
     if (!refollow_.empty()) {
       const auto r = std::move(refollow_.front());
       refollow_.pop_front();
@@ -291,6 +379,7 @@ void Module::Dds::serve_config() {
       lock.lock();
       continue;
     }
+    if (queue_.empty()) continue;
     auto command = std::move(queue_.front());
     queue_.pop_front();
     lock.unlock();

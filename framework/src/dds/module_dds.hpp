@@ -37,7 +37,9 @@ class Module::Dds {
   /// (`switch_wait`) also waits that long for the source's first cue, so that nothing it
   /// publishes after the switch is lost. Only then is an earlier subscription of the input
   /// dropped. The reader's QoS follows the producer's declared class (qos::cue_reader), as
-  /// discovery shows its writer. Returns what did not happen in time, or "".
+  /// discovery shows its writer. A raw input reads the type discovery shows too; while no
+  /// writer of the source is seen it has no reader, and the configuration thread subscribes it
+  /// once one is. Returns what did not happen in time, or "".
   /// @throws std::invalid_argument as check_reliability() does.
   std::string connect_input(InputPort& input, const std::string& source,
                             std::optional<std::chrono::milliseconds> switch_wait);
@@ -57,8 +59,10 @@ class Module::Dds {
     OutputOptions offered;
   };
   std::string subscribe(InputPort& input, const std::string& source, const OutputOptions& producer,
+                        const std::string& type,
                         std::optional<std::chrono::milliseconds> switch_wait,
                         std::chrono::steady_clock::time_point until);
+  void subscribe_discovered();
   void follow_producer(InputPort& input, const std::string& source, const OutputOptions& offered);
   void refollow(const Refollow& r);
   void serve_config();
@@ -81,7 +85,8 @@ class Module::Dds {
   std::condition_variable queue_cv_;
   std::deque<ConfigCommand> queue_;
   std::deque<Refollow> refollow_;  // served by the configuration thread, like queue_
-  std::map<std::string, ConfigReply> last_reply_;  // by sender: answers repeated commands
+  std::map<InputPort*, std::string> awaiting_type_;  // raw inputs whose source is not seen yet
+  std::map<std::string, ConfigReply> last_reply_;    // by sender: answers repeated commands
   bool serving_ = false;
   std::thread config_thread_;
   std::unique_ptr<TopicWriter<ModuleBeat, ModuleBeatPubSubType>> beat_writer_;

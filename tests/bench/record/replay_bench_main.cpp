@@ -20,9 +20,9 @@
 #include <oscar/command_line.hpp>
 
 #include "bench_common.hpp"
-#include "cue_header_cdr.hpp"  // tools/record
-#include "idl_texts.hpp"       // tools/record
+#include "oscar/cue_header_cdr.hpp"
 #include "oscar/cue_type_info.hpp"
+#include "oscar/idl_texts.hpp"
 #include "oscar/mcap/reader.hpp"
 #include "oscar/mcap/writer.hpp"
 #include "oscar/process_util.hpp"
@@ -66,7 +66,7 @@ Schedule write_file(const std::string& path, double seconds, int cameras) {
   o.compression = oscar::mcap::Compression::kNone;
   oscar::mcap::Writer w(path, o);
   const auto schema_of = [&](const std::string& type) {
-    const auto& idl = oscar::record::idl_texts().at(type);
+    const auto& idl = oscar::idl_texts().at(type);
     return w.add_schema(type, "omgidl", {idl.begin(), idl.end()});
   };
   const auto image_schema = schema_of("oscar::GvImage");
@@ -131,12 +131,12 @@ Schedule schedule_of(const std::string& path) {
           "{}: topic '{}' has type '{}'; the bench replays GvImage and Bool topics only", path,
           ch.topic, type));
     }
-    const auto header = oscar::record::read_cue_header(m.data);
+    const auto header = oscar::read_cue_header(m.data);
     if (!header) {
       throw std::invalid_argument(
           fmt::format("{}: a message on '{}' has no readable cue header", path, ch.topic));
     }
-    schedule.add({ch.topic, type, header->seq, m.log_time});
+    schedule.add({ch.topic, type, header->seq(), m.log_time});
   });
   if (schedule.cues.empty()) throw std::invalid_argument(path + ": the recording holds no cues");
   return schedule;
@@ -164,9 +164,9 @@ Run measure(const std::vector<std::string>& publisher, const Schedule& schedule,
   std::vector<std::tuple<std::string, std::uint64_t, std::uint64_t>> arrivals;
   arrivals.reserve(schedule.cues.size());
   const auto arrived = [&](const std::string& topic, auto bytes, auto t) {
-    const auto h = oscar::record::read_cue_header(bytes);
+    const auto h = oscar::read_cue_header(bytes);
     std::lock_guard lock(mutex);
-    arrivals.emplace_back(topic, h ? h->seq : 0, t);
+    arrivals.emplace_back(topic, h ? h->seq() : 0, t);
   };
   std::vector<std::unique_ptr<oscar::DdsParticipant>> participants;
   std::map<std::string, std::unique_ptr<oscar::inspect::RawTap>> taps;

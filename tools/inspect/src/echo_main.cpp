@@ -11,8 +11,8 @@
 #include <fmt/format.h>
 
 #include <oscar/command_line.hpp>
-#include "idl_texts.hpp"  // tools/record
 #include "idl_types.hpp"
+#include "oscar/idl_texts.hpp"
 
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/registry/system_options.hpp"
@@ -44,7 +44,7 @@ int main(int argc, char** argv) {
     const auto topic = oscar::record::topic_of(topic_arg);
     oscar::inspect::IdlTypes types;
     std::set<std::string> texts;
-    for (const auto& [name, text] : oscar::record::idl_texts()) {
+    for (const auto& [name, text] : oscar::idl_texts()) {
       if (texts.insert(text).second) types.add(text);
     }
     auto participant = tool.participant("oscar-echo");

@@ -10,7 +10,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
-#include "raw_cdr_type.hpp"  // tools/record
+#include "oscar/raw_cdr_type.hpp"
 
 namespace oscar::inspect {
 namespace dds = eprosima::fastdds::dds;
@@ -26,10 +26,10 @@ struct RawTap::Impl {
    public:
     Listener(const Fn& fn, std::string topic) : fn_(fn), topic_(std::move(topic)) {}
     void on_data_available(dds::DataReader* reader) override {
-      record::RawSample s;
+      RawCue s;
       dds::SampleInfo info;
       while (reader->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
-        if (info.valid_data) fn_(topic_, std::move(s.bytes), now_ns());
+        if (info.valid_data) fn_(topic_, std::move(s.cdr), now_ns());
       }
     }
 
@@ -59,7 +59,7 @@ std::string RawTap::subscribe(const std::string& topic) {
   const auto writers = impl_->participant.discovered_writers();
   const auto w = writers.find(topic);
   if (w == writers.end()) return "";
-  auto& t = impl_->participant.topic(topic, new record::RawCdrType(w->second.type));
+  auto& t = impl_->participant.topic(topic, new RawCdrType(w->second.type));
   dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
   const bool best_effort = w->second.qos.find("best") != std::string::npos;
   q.reliability().kind =

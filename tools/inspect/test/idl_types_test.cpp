@@ -7,9 +7,9 @@
 
 #include <oscar/config.h>
 #include <oscar/configPubSubTypes.h>
-#include "idl_texts.hpp"
 #include "oscar/cue_type_info.hpp"
 #include "oscar/cue_types.hpp"
+#include "oscar/idl_texts.hpp"
 #include "oscar/perception_types.hpp"
 
 namespace oscar::inspect {
@@ -19,7 +19,7 @@ using testing::HasSubstr;
 IdlTypes oscar_types() {
   IdlTypes types;
   std::set<std::string> seen;
-  for (const auto& [name, text] : record::idl_texts()) {
+  for (const auto& [name, text] : idl_texts()) {
     if (seen.insert(text).second) types.add(text);
   }
   return types;

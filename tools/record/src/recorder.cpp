@@ -15,12 +15,11 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
-#include "cue_header_cdr.hpp"
-#include "idl_texts.hpp"
 #include "oscar/dds_participant.hpp"
+#include "oscar/idl_texts.hpp"
 #include "oscar/mcap/writer.hpp"
+#include "oscar/raw_cdr_type.hpp"
 #include "oscar/topics.hpp"
-#include "raw_cdr_type.hpp"
 
 namespace oscar::record {
 namespace dds = eprosima::fastdds::dds;
@@ -52,7 +51,7 @@ struct Recorder::Impl {
   struct Sample {
     std::size_t topic;
     std::uint64_t log_time;
-    std::vector<std::uint8_t> bytes;
+    RawCue cue;  // its bytes and the header read from them
   };
   struct Topic {
     std::string name, type, qos;
@@ -63,10 +62,10 @@ struct Recorder::Impl {
    public:
     Listener(Impl& impl, std::size_t topic) : impl_(impl), topic_(topic) {}
     void on_data_available(dds::DataReader* reader) override {
-      RawSample s;
+      RawCue s;
       dds::SampleInfo info;
       while (reader->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
-        if (info.valid_data) impl_.push(topic_, std::move(s.bytes));
+        if (info.valid_data) impl_.push(topic_, std::move(s));
       }
     }
     void on_sample_lost(dds::DataReader*, const dds::SampleLostStatus& status) override {
@@ -104,15 +103,15 @@ struct Recorder::Impl {
     }
   }
 
-  void push(std::size_t topic, std::vector<std::uint8_t> payload) {
+  void push(std::size_t topic, RawCue cue) {
     ++received_;
     std::lock_guard lock(mutex);
-    if (queued_bytes + payload.size() > kMaxQueuedBytes) {
+    if (queued_bytes + cue.cdr.size() > kMaxQueuedBytes) {
       ++dropped_;
       return;
     }
-    queued_bytes += payload.size();
-    queue.push_back({topic, now_ns(), std::move(payload)});
+    queued_bytes += cue.cdr.size();
+    queue.push_back({topic, now_ns(), std::move(cue)});
   }
 
   bool wanted(const std::string& topic) const {
@@ -192,16 +191,18 @@ struct Recorder::Impl {
       writer = open_file();
     }
     if (!file_start_time) file_start_time = s.log_time;
-    const auto header = read_cue_header(s.bytes);
+    // A payload without a readable header has an empty one: sequence 0, published when logged.
+    const auto& header = s.cue.header();
     mcap::MessageView m;
     m.channel_id = channel(s.topic);
-    m.sequence = header ? static_cast<std::uint32_t>(header->seq) : 0;
+    m.sequence = static_cast<std::uint32_t>(header.seq());
     m.log_time = s.log_time;
-    m.publish_time = header && header->generation_stamp ? header->generation_stamp : s.log_time;
-    m.data = s.bytes;
+    const auto generated = static_cast<std::uint64_t>(generation_stamp(header));
+    m.publish_time = generated ? generated : s.log_time;
+    m.data = s.cue.cdr;
     writer->write(m);
     ++written;
-    bytes += s.bytes.size();
+    bytes += s.cue.cdr.size();
   }
 
   // Writes what is queued; returns the number of samples written.

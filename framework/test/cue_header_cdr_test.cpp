@@ -1,12 +1,13 @@
-// The recorder reads stamps and sequence numbers from serialized cues of any type.
+// Headers read from serialized cues of any type (what the recorder and raw inputs rely on).
 #include <gtest/gtest.h>
 
-#include "cue_header_cdr.hpp"
-#include "idl_texts.hpp"
+#include "oscar/cue_header_cdr.hpp"
 #include "oscar/cue_type_info.hpp"
 #include "oscar/cue_types.hpp"
+#include "oscar/idl_texts.hpp"
+#include "oscar/perception_types.hpp"
 
-namespace oscar::record {
+namespace oscar {
 namespace {
 
 template <class T>
@@ -17,11 +18,12 @@ void expect_header_read(T cue) {
   const auto bytes = cue_type_info<T>().serialize(&cue);
   const auto h = read_cue_header(bytes);
   ASSERT_TRUE(h) << cue_type_info<T>().name;
-  EXPECT_EQ(h->generation_stamp, 1'700'000'000'123'456'789ull);
-  EXPECT_EQ(h->seq, 77u);
+  EXPECT_EQ(h->stamps(), (std::vector<std::uint64_t>{1'700'000'000'123'456'789ull, 42}));
+  EXPECT_EQ(h->source(), "src/out");
+  EXPECT_EQ(h->seq(), 77u);
 }
 
-TEST(CueHeaderCdr, ReadsStampAndSeqOfEverySeedType) {
+TEST(CueHeaderCdr, ReadsStampsSourceAndSeqOfEverySeedType) {
   expect_header_read(Bool());
   LineSeg3DSeq lines;
   lines.lines().resize(3);
@@ -29,6 +31,9 @@ TEST(CueHeaderCdr, ReadsStampAndSeqOfEverySeedType) {
   GvImage image;
   image.image().resize(100);
   expect_header_read(image);
+  TagDetections tags;
+  tags.detections().resize(2);
+  expect_header_read(tags);
 }
 
 TEST(CueHeaderCdr, RejectsShortOrForeignPayloads) {
@@ -57,4 +62,4 @@ TEST(IdlTexts, HoldThePerceptionTypes) {
 }
 
 }  // namespace
-}  // namespace oscar::record
+}  // namespace oscar

@@ -1,8 +1,10 @@
-#include "cue_header_cdr.hpp"
+#include "oscar/cue_header_cdr.hpp"
 
-namespace oscar::record {
+#include <string>
 
-std::optional<CueHeaderFields> read_cue_header(std::span<const std::uint8_t> payload) {
+namespace oscar {
+
+std::optional<CueHeader> read_cue_header(std::span<const std::uint8_t> payload) {
   if (payload.size() < 4 || payload[0] != 0) return std::nullopt;
   const std::uint8_t kind = payload[1];
   // 0/1: XCDR1 big/little endian (8-byte values aligned to 8); 6..11: XCDR2 (aligned to 4).
@@ -22,17 +24,24 @@ std::optional<CueHeaderFields> read_cue_header(std::span<const std::uint8_t> pay
     at += size;
     return true;
   };
-  CueHeaderFields h;
-  std::uint64_t stamps = 0, stamp = 0, source_length = 0;
-  if (!read(4, 4, stamps)) return std::nullopt;
+  CueHeader h;
+  std::uint64_t stamps = 0, stamp = 0, source_length = 0, seq = 0;
+  if (!read(4, 4, stamps) || stamps > body.size()) return std::nullopt;
+  h.stamps().reserve(stamps);
   for (std::uint64_t i = 0; i < stamps; ++i) {
     if (!read(8, align8, stamp)) return std::nullopt;
-    if (i == 0) h.generation_stamp = stamp;
+    h.stamps().push_back(stamp);
   }
+  // The length counts the terminating NUL.
   if (!read(4, 4, source_length) || at + source_length > body.size()) return std::nullopt;
+  if (source_length > 0) {
+    const auto* chars = reinterpret_cast<const char*>(body.data() + at);
+    h.source(std::string(chars, source_length - (chars[source_length - 1] == '\0' ? 1 : 0)));
+  }
   at += source_length;
-  if (!read(8, align8, h.seq)) return std::nullopt;
+  if (!read(8, align8, seq)) return std::nullopt;
+  h.seq(seq);
   return h;
 }
 
-}  // namespace oscar::record
+}  // namespace oscar

@@ -1,25 +1,24 @@
 #pragma once
-// A Fast DDS type support that keeps each sample's serialized payload (encapsulation header
-// and CDR) as bytes, registered under any type name: the recorder subscribes to topics without
-// knowing their types, and the replayer publishes the recorded bytes unchanged.
+/// @file A Fast DDS type support that keeps each sample's serialized payload (encapsulation
+/// header and CDR) as bytes, registered under any type name: what subscribes to topics without
+/// knowing their types (oscar record, the frame for raw inputs) and what publishes recorded
+/// bytes unchanged (oscar replay). Its samples are RawCue.
 
 #include <cstdint>
 #include <string>
-#include <vector>
 
 #include <fastdds/dds/topic/TopicDataType.hpp>
 
-namespace oscar::record {
+#include "oscar/raw_cue.hpp"
 
-/// One sample: the payload exactly as it was on the wire.
-struct RawSample {
-  std::vector<std::uint8_t> bytes;
-};
+namespace oscar {
 
 class RawCdrType final : public eprosima::fastdds::dds::TopicDataType {
  public:
   explicit RawCdrType(const std::string& type_name);
+  /// Writes RawCue::cdr as it is.
   bool serialize(void* data, eprosima::fastrtps::rtps::SerializedPayload_t* payload) override;
+  /// Fills a RawCue: this type's name, the payload and the header read from it.
   bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data) override;
   std::function<std::uint32_t()> getSerializedSizeProvider(void* data) override;
   void* createData() override;
@@ -28,4 +27,4 @@ class RawCdrType final : public eprosima::fastdds::dds::TopicDataType {
               bool force_md5) override;
 };
 
-}  // namespace oscar::record
+}  // namespace oscar

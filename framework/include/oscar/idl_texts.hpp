@@ -5,8 +5,8 @@
 #include <map>
 #include <string>
 
-namespace oscar::record {
+namespace oscar {
 
 const std::map<std::string, std::string>& idl_texts();
 
-}  // namespace oscar::record
+}  // namespace oscar
