@@ -38,6 +38,8 @@ TEST(Topics, TheWriterAndReaderOfEveryCatalogueTopicMatch) {
   expect_both_sides_match(p, topics::registry_request());
   expect_both_sides_match(p, topics::registry_reply());
   expect_both_sides_match(p, topics::system_state());
+  expect_both_sides_match(p, topics::pull_request("k/out"));
+  expect_both_sides_match(p, topics::pull_reply("k/out"));
 }
 
 TEST(Topics, EveryCatalogueTopicHasANameOfItsOwn) {
@@ -52,8 +54,10 @@ TEST(Topics, EveryCatalogueTopicHasANameOfItsOwn) {
                                     topics::registry_request().name,
                                     topics::registry_reply().name,
                                     topics::system_state().name,
+                                    topics::pull_request("k/out").name,
+                                    topics::pull_reply("k/out").name,
                                     topics::cue("k/out")};
-  EXPECT_EQ(names.size(), 12u);
+  EXPECT_EQ(names.size(), 14u);
 }
 
 TEST(Topics, CueTopicsAreNamedAfterTheirOutput) {
