@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <stdexcept>
+#include <string>
 
 namespace oscar::applets {
 namespace {
@@ -117,16 +119,8 @@ class Assignment {
     if (u.by == Use::By::kResource) __builtin_prefetch(&resource_used_[u.holder]);
   }
 
-  // The uses per service, each in grant order; marks the resources used in `resource_granted`.
-  std::vector<std::vector<GrantedUse>> take_uses(std::vector<char>& resource_granted) {
-    std::vector<std::vector<GrantedUse>> out(service_.size());
-    for (ServiceId s = 0; s < service_.size(); ++s) out[s].reserve(service_[s].count);
-    for (const GrantedUse& g : granted_) {
-      out[g.use.service].push_back(g);
-      if (g.use.by == Use::By::kResource) resource_granted[g.use.holder] = 1;
-    }
-    return out;
-  }
+  // Every use granted so far, in grant order.
+  const std::vector<GrantedUse>& granted() const { return granted_; }
 
  private:
   // Abb. 4.21 steps 1–2: a service given exclusively admits nobody else; an exclusive use
@@ -216,6 +210,29 @@ void sort_working_set(std::vector<Entry>& entries, Workspace& w) {
 }
 
 }  // namespace
+
+UsesByService::UsesByService(std::size_t services, const std::vector<GrantedUse>& in_grant_order)
+    : begin_(services + 1, 0), uses_(in_grant_order.size()) {
+  // A counting sort by service: stable, so each service's uses stay in grant order.
+  for (const GrantedUse& g : in_grant_order) {
+    if (g.use.service >= services) {
+      throw std::invalid_argument("plan: a use of service " + std::to_string(g.use.service) +
+                                  " among " + std::to_string(services) + " services");
+    }
+    ++begin_[g.use.service + 1];
+  }
+  for (std::size_t s = 0; s < services; ++s) begin_[s + 1] += begin_[s];
+  std::vector<std::uint32_t> next(begin_.begin(), begin_.end() - 1);
+  for (const GrantedUse& g : in_grant_order) uses_[next[g.use.service]++] = g;
+}
+
+std::span<const GrantedUse> UsesByService::at(ServiceId service) const {
+  if (service >= size()) {
+    throw std::out_of_range("plan: unknown service " + std::to_string(service) + " (the plan has " +
+                            std::to_string(size()) + ")");
+  }
+  return (*this)[service];
+}
 
 bool waits_for_t_early(const BundleState& state, std::chrono::milliseconds now) {
   return state.requested && state.deadline && state.deadline->t_early > now;
@@ -337,7 +354,10 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
     if (entries[k].waits) continue;
     assignment.try_grant(model.bundle_uses(entries[k].bundle), entries[k].bundle);
   }
-  plan.uses = assignment.take_uses(plan.resource_granted);
+  plan.uses = UsesByService(model.services().size(), assignment.granted());
+  for (const GrantedUse& g : plan.uses.all()) {
+    if (g.use.by == Use::By::kResource) plan.resource_granted[g.use.holder] = 1;
+  }
   // A bundle is granted when all its resources are: also one granted only through inheritance
   // (a service applet's bundle).
   for (BundleId b = 0; b < n; ++b) {
@@ -370,9 +390,7 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
 
 bool can_grant(const Model& model, const Plan& plan, ServiceId service, Access access) {
   Assignment assignment(model, plan.unavailable, workspace());
-  for (const auto& list : plan.uses) {
-    for (const GrantedUse& g : list) assignment.add_existing(g);
-  }
+  for (const GrantedUse& g : plan.uses.all()) assignment.add_existing(g);
   // A hypothetical holder that nobody else is: the service itself as its own user.
   const Use probe{service, access, Use::By::kService, service};
   return assignment.probe(std::span<const Use>(&probe, 1));

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <random>
 #include <set>
+#include <span>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -101,11 +102,19 @@ struct Reference {
   }
 };
 
-Plan reference_plan(const Model& m, const std::vector<BundleState>& state,
-                    const std::vector<BundleId>& previous_order,
-                    const std::vector<char>& previously_granted, const PlanContext& context) {
+// The reference's plan: a Plan with the uses per service kept apart, as lists.
+struct ReferencePlan {
+  Plan plan;
+  std::vector<std::vector<GrantedUse>> uses;
+};
+
+ReferencePlan reference_plan(const Model& m, const std::vector<BundleState>& state,
+                             const std::vector<BundleId>& previous_order,
+                             const std::vector<char>& previously_granted,
+                             const PlanContext& context) {
   const std::size_t n = m.bundles().size();
-  Plan p;
+  ReferencePlan out;
+  Plan& p = out.plan;
   p.time = context.now;
   p.unavailable = context.unavailable;
   p.effective_priority.assign(n, 0);
@@ -148,7 +157,7 @@ Plan reference_plan(const Model& m, const std::vector<BundleState>& state,
     }
     if (ok) granted = std::move(trial);
   }
-  p.uses = granted.uses;
+  out.uses = granted.uses;
   p.resource_granted.assign(m.resources().size(), 0);
   for (ResourceId r : granted.used_resources) p.resource_granted[r] = 1;
   p.bundle_granted.assign(n, 0);
@@ -168,28 +177,29 @@ Plan reference_plan(const Model& m, const std::vector<BundleState>& state,
       }
     }
   }
-  return p;
+  return out;
 }
 
 using UseKey = std::tuple<ServiceId, Access, Use::By, std::uint32_t, BundleId>;
 
-std::vector<std::vector<UseKey>> keys_of(const std::vector<std::vector<GrantedUse>>& uses) {
-  std::vector<std::vector<UseKey>> out;
-  for (const auto& list : uses) {
-    auto& o = out.emplace_back();
-    for (const GrantedUse& g : list) {
-      o.emplace_back(g.use.service, g.use.access, g.use.by, g.use.holder, g.root);
-    }
+std::vector<UseKey> keys_of(std::span<const GrantedUse> uses) {
+  std::vector<UseKey> out;
+  for (const GrantedUse& g : uses) {
+    out.emplace_back(g.use.service, g.use.access, g.use.by, g.use.holder, g.root);
   }
   return out;
 }
 
-void expect_same(const Plan& got, const Plan& want, const std::string& where) {
+void expect_same(const Plan& got, const ReferencePlan& ref, const std::string& where) {
+  const Plan& want = ref.plan;
   EXPECT_EQ(got.time, want.time) << where;
   EXPECT_EQ(got.order, want.order) << where;
   EXPECT_EQ(got.bundle_granted, want.bundle_granted) << where;
   EXPECT_EQ(got.resource_granted, want.resource_granted) << where;
-  EXPECT_EQ(keys_of(got.uses), keys_of(want.uses)) << where;
+  ASSERT_EQ(got.uses.size(), ref.uses.size()) << where;
+  for (ServiceId s = 0; s < ref.uses.size(); ++s) {
+    EXPECT_EQ(keys_of(got.uses[s]), keys_of(ref.uses[s])) << where << " service " << s;
+  }
   EXPECT_EQ(got.deadline_overlaps, want.deadline_overlaps) << where;
   EXPECT_EQ(got.effective_priority, want.effective_priority) << where;
   EXPECT_EQ(got.unavailable, want.unavailable) << where;
@@ -287,7 +297,8 @@ void run_chain(unsigned seed, int services, int applets, int plans) {
     }
     const Plan got =
         calculate_assignments(m, state, previous_order, previous.bundle_granted, context);
-    const Plan want = reference_plan(m, state, previous_order, previous.bundle_granted, context);
+    const ReferencePlan want =
+        reference_plan(m, state, previous_order, previous.bundle_granted, context);
     expect_same(got, want, "seed " + std::to_string(seed) + " plan " + std::to_string(k));
     if (::testing::Test::HasFailure()) return;
     previous = got;
