@@ -8,6 +8,7 @@
 #include <random>
 #include <set>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -317,6 +318,39 @@ TEST(PlanReference, SmallRandomModelsGiveTheReferencePlan) {
 TEST(PlanReference, LargeRandomModelsGiveTheReferencePlan) {
   // Hundreds of bundles: long sorted runs with few entries set aside, and many at once.
   for (unsigned seed = 1; seed <= 4; ++seed) run_chain(1000 + seed, 150, 400, 30);
+}
+
+TEST(PlanUses, KeepEachServicesUsesInGrantOrder) {
+  const auto use = [](ServiceId s, std::uint32_t holder, BundleId root) {
+    return GrantedUse{Use{s, Access::kShared, Use::By::kResource, holder}, root};
+  };
+  const UsesByService uses(3, {use(2, 7, 1), use(0, 3, 2), use(2, 4, 3), use(0, 9, 4)});
+  ASSERT_EQ(uses.size(), 3u);
+  ASSERT_EQ(uses[0].size(), 2u);
+  EXPECT_EQ(uses[0][0].use.holder, 3u);
+  EXPECT_EQ(uses[0][1].use.holder, 9u);
+  EXPECT_TRUE(uses[1].empty());
+  ASSERT_EQ(uses.at(2).size(), 2u);
+  EXPECT_EQ(uses.at(2)[0].root, 1u);
+  EXPECT_EQ(uses.at(2)[1].root, 3u);
+  EXPECT_EQ(uses.all().size(), 4u);
+}
+
+TEST(PlanUses, RejectAnUnknownService) {
+  const GrantedUse beyond{Use{5, Access::kShared, Use::By::kService, 0}, 0};
+  try {
+    UsesByService(2, {beyond});
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "plan: a use of service 5 among 2 services");
+  }
+  const UsesByService uses(2, {});
+  try {
+    (void)uses.at(2);
+    FAIL() << "no exception";
+  } catch (const std::out_of_range& e) {
+    EXPECT_STREQ(e.what(), "plan: unknown service 2 (the plan has 2)");
+  }
 }
 
 }  // namespace
