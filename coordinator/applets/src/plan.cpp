@@ -48,6 +48,7 @@ struct Workspace {
   std::vector<char> resource_used;
   std::vector<ServiceId> expanded_journal;
   std::vector<Entry> entries, aside;
+  std::vector<char> waits;
   std::vector<std::uint32_t> place;
   std::vector<std::pair<int, BundleId>> timed;
 };
@@ -178,17 +179,21 @@ class Assignment {
 
 // Sorts the working set, which arrives in its previous order and so is sorted but for the
 // bundles whose keys changed since the last plan (seed §4.5.3: plans are recomputed on every
-// request, release, priority or deadline change). One pass keeps a sorted run and sets aside
-// each entry that breaks it (or the run's last entry, if that is the one out of place); only
-// those m entries are sorted, then merged back: O(n + m log m), O(n log n) at worst.
-void sort_working_set(std::vector<Entry>& entries, Workspace& w) {
+// request, release, priority or deadline change). One pass keeps a sorted run in place and sets
+// aside each entry that breaks it (or the run's last entry, if that is the one out of place);
+// only those m entries are sorted, then merged with the run: O(n + m log n), O(n log n) at
+// worst. The merge writes only what the walk needs, the bundles in order and whether each
+// waits, not the entries themselves.
+void sort_working_set(std::vector<Entry>& entries, Workspace& w, std::vector<BundleId>& order,
+                      std::vector<char>& waits) {
   std::vector<Entry>& aside = w.aside;
   aside.clear();
   std::size_t run = 0;  // the run is entries[0, run), built in place: run <= k at entry k
   for (std::size_t k = 0; k < entries.size(); ++k) {
     const Entry e = entries[k];
     if (run == 0 || !before(e, entries[run - 1])) {
-      entries[run++] = e;
+      if (run != k) entries[run] = e;
+      ++run;
     } else if (run >= 2 && !before(e, entries[run - 2])) {
       aside.push_back(entries[run - 1]);  // the run's last entry moved down: set it aside instead
       entries[run - 1] = e;
@@ -196,17 +201,25 @@ void sort_working_set(std::vector<Entry>& entries, Workspace& w) {
       aside.push_back(e);
     }
   }
-  if (aside.empty()) return;
   std::sort(aside.begin(), aside.end(), before);
-  // Merged from the back into the places the set-aside entries left free at the end.
-  std::size_t out = entries.size(), i = run, j = aside.size();
-  while (j > 0) {
-    if (i > 0 && before(aside[j - 1], entries[i - 1])) {
-      entries[--out] = entries[--i];
-    } else {
-      entries[--out] = aside[--j];
-    }
+  order.resize(entries.size());
+  waits.resize(entries.size());
+  // Each set-aside entry's place in the run by binary search, the run's entries before it
+  // copied without comparing: O(n + m log n).
+  std::size_t k = 0;
+  auto put = [&](const Entry& e) {
+    order[k] = e.bundle;
+    waits[k] = e.waits;
+    ++k;
+  };
+  const auto run_end = entries.begin() + static_cast<std::ptrdiff_t>(run);
+  auto i = entries.begin();
+  for (const Entry& e : aside) {
+    const auto place = std::lower_bound(i, run_end, e, before);
+    for (; i != place; ++i) put(*i);
+    put(e);
   }
+  for (; i != run_end; ++i) put(*i);
 }
 
 }  // namespace
@@ -332,8 +345,8 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
     entries[place[b]] = e;
   }
   // Abb. 4.19 step 2; equal bundles keep their place (no oscillation, §4.5.3).
-  sort_working_set(entries, w);
-  plan.order.resize(entries.size());
+  std::vector<char>& waits = w.waits;
+  sort_working_set(entries, w, plan.order, waits);
 
   // Abb. 4.19 step 3: greedy from the highest priority down; a bundle before its t_early waits
   // (§4.5.1), keeping its place for the plan at t_early. The walk jumps between bundles and
@@ -342,17 +355,17 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
   // waited for in turn.
   Assignment assignment(model, plan.unavailable, w);
   constexpr std::size_t kAhead = 8;
-  for (std::size_t k = 0; k < entries.size(); ++k) {
-    if (k + 2 * kAhead < entries.size()) {
-      __builtin_prefetch(model.bundle_uses(entries[k + 2 * kAhead].bundle).data());
+  const std::vector<BundleId>& order = plan.order;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    if (k + 2 * kAhead < order.size()) {
+      __builtin_prefetch(model.bundle_uses(order[k + 2 * kAhead]).data());
     }
-    if (k + kAhead < entries.size()) {
-      const auto ahead = model.bundle_uses(entries[k + kAhead].bundle);
+    if (k + kAhead < order.size()) {
+      const auto ahead = model.bundle_uses(order[k + kAhead]);
       if (!ahead.empty()) assignment.prefetch(ahead.front());
     }
-    plan.order[k] = entries[k].bundle;
-    if (entries[k].waits) continue;
-    assignment.try_grant(model.bundle_uses(entries[k].bundle), entries[k].bundle);
+    if (waits[k]) continue;
+    assignment.try_grant(model.bundle_uses(order[k]), order[k]);
   }
   plan.uses = UsesByService(model.services().size(), assignment.granted());
   for (const GrantedUse& g : plan.uses.all()) {
