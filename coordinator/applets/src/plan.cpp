@@ -34,9 +34,9 @@ bool before(const Entry& a, const Entry& b) {
 
 // What the plan knows of one service while it walks, in one place: a grant looks at all of it.
 struct ServiceUse {
-  std::uint32_t count = 0;  ///< uses granted
-  bool exclusive = false;   ///< one of them (then the only one) is exclusive
-  bool expanded = false;    ///< what it needs is used too
+  std::uint32_t count : 30 = 0;     ///< uses granted
+  std::uint32_t exclusive : 1 = 0;  ///< one of them (then the only one) is exclusive
+  std::uint32_t expanded : 1 = 0;   ///< what it needs is used too
 };
 
 // Scratch memory of the plan, kept per thread from one plan to the next: a plan over 100 000
@@ -119,6 +119,9 @@ class Assignment {
     __builtin_prefetch(&service_[u.service]);
     if (u.by == Use::By::kResource) __builtin_prefetch(&resource_used_[u.holder]);
   }
+
+  // Per resource: whether a granted use is by it.
+  const std::vector<char>& resources_used() const { return resource_used_; }
 
   // Every use granted so far, in grant order.
   const std::vector<GrantedUse>& granted() const { return granted_; }
@@ -271,7 +274,6 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
   plan.time = context.now;
   plan.unavailable = context.unavailable;
   plan.bundle_granted.assign(n, 0);
-  plan.resource_granted.assign(model.resources().size(), 0);
   plan.effective_priority.assign(n, 0);
 
   // A cycle is one element with its highest priority (triggered first among equals) and earliest
@@ -368,9 +370,7 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
     assignment.try_grant(model.bundle_uses(order[k]), order[k]);
   }
   plan.uses = UsesByService(model.services().size(), assignment.granted());
-  for (const GrantedUse& g : plan.uses.all()) {
-    if (g.use.by == Use::By::kResource) plan.resource_granted[g.use.holder] = 1;
-  }
+  plan.resource_granted = assignment.resources_used();
   // A bundle is granted when all its resources are: also one granted only through inheritance
   // (a service applet's bundle).
   for (BundleId b = 0; b < n; ++b) {
