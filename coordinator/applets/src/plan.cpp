@@ -47,10 +47,8 @@ struct Workspace {
   std::vector<ServiceUse> service;
   std::vector<char> resource_used;
   std::vector<ServiceId> expanded_journal;
-  std::vector<Entry> entries, aside, appended;
+  std::vector<Entry> entries, aside;
   std::vector<char> waits;
-  std::vector<Use> walk;
-  std::vector<std::uint32_t> walk_end;
   std::vector<std::uint32_t> place;
   std::vector<std::pair<int, BundleId>> timed;
 };
@@ -188,15 +186,14 @@ class Assignment {
 // aside each entry that breaks it (or the run's last entry, if that is the one out of place);
 // only those m entries are sorted, then merged with the run: O(n + m log n), O(n log n) at
 // worst. The merge writes only what the walk needs, the bundles in order and whether each
-// waits, not the entries themselves. Entries of bundle `hole` are left out.
-void sort_working_set(std::vector<Entry>& entries, BundleId hole, Workspace& w,
-                      std::vector<BundleId>& order, std::vector<char>& waits) {
+// waits, not the entries themselves.
+void sort_working_set(std::vector<Entry>& entries, Workspace& w, std::vector<BundleId>& order,
+                      std::vector<char>& waits) {
   std::vector<Entry>& aside = w.aside;
   aside.clear();
   std::size_t run = 0;  // the run is entries[0, run), built in place: run <= k at entry k
   for (std::size_t k = 0; k < entries.size(); ++k) {
     const Entry e = entries[k];
-    if (e.bundle == hole) continue;
     if (run == 0 || !before(e, entries[run - 1])) {
       if (run != k) entries[run] = e;
       ++run;
@@ -208,8 +205,8 @@ void sort_working_set(std::vector<Entry>& entries, BundleId hole, Workspace& w,
     }
   }
   std::sort(aside.begin(), aside.end(), before);
-  order.resize(run + aside.size());
-  waits.resize(run + aside.size());
+  order.resize(entries.size());
+  waits.resize(entries.size());
   // Each set-aside entry's place in the run by binary search, the run's entries before it
   // copied without comparing: O(n + m log n).
   std::size_t k = 0;
@@ -303,33 +300,35 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
     }
   }
 
-  // Abb. 4.19 line 6: W_t = W_{t-1} ∪ R, new requests appended (in bundle order). Each bundle of
-  // W_{t-1} gets its place first (a small array per bundle, read and written in W_{t-1}'s
-  // order); then one pass in bundle order writes each requested bundle's entry to its place, a
-  // hole where a bundle of W_{t-1} is no longer requested (the sort skips it), and appends the
-  // new requests. The same pass notes the bundles with a deadline, for the overlap check.
+  // Abb. 4.19 line 6: W_t = W_{t-1} ∪ R, new requests appended (in bundle order). Each requested
+  // bundle's place in W_t first (a small array per bundle, read and written in W_{t-1}'s order),
+  // then its entry is written straight to that place in one pass in bundle order. The first
+  // pass also notes the bundles with a deadline, for the overlap check at the end.
   Workspace& w = workspace();
-  constexpr std::uint32_t kNoPlace = ~std::uint32_t{0};
-  constexpr BundleId kHole = ~BundleId{0};
+  constexpr std::uint32_t kNotRequested = ~std::uint32_t{0};
+  constexpr std::uint32_t kNoPlace = kNotRequested - 1;
   std::vector<std::uint32_t>& place = w.place;
-  place.assign(n, kNoPlace);
+  place.resize(n);
+  std::vector<std::pair<int, BundleId>>& timed = w.timed;
+  timed.clear();
+  std::uint32_t requested = 0;
+  for (BundleId b = 0; b < n; ++b) {
+    place[b] = kNotRequested;
+    if (!state[b].requested) continue;
+    place[b] = kNoPlace;
+    ++requested;
+    if (state[b].deadline) timed.emplace_back(0, b);
+  }
   std::uint32_t size = 0;
   for (BundleId b : previous_order) {
     if (b < n && place[b] == kNoPlace) place[b] = size++;
   }
   std::vector<Entry>& entries = w.entries;
-  entries.resize(size);
-  std::vector<Entry>& appended = w.appended;
-  appended.clear();
-  std::vector<std::pair<int, BundleId>>& timed = w.timed;
-  timed.clear();
+  entries.resize(requested);
   for (BundleId b = 0; b < n; ++b) {
+    if (place[b] == kNotRequested) continue;
+    if (place[b] == kNoPlace) place[b] = size++;
     const BundleState& st = state[b];
-    if (!st.requested) {
-      if (place[b] != kNoPlace) entries[place[b]].bundle = kHole;
-      continue;
-    }
-    if (st.deadline) timed.emplace_back(0, b);
     Entry e;
     e.bundle = b;
     e.priority = st.priority;
@@ -343,50 +342,32 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
     }
     e.held = b < previously_granted.size() && previously_granted[b];
     e.waits = waits_for_t_early(st, context.now);
+    e.position = place[b];
     plan.effective_priority[b] = e.priority;
-    if (place[b] == kNoPlace) {
-      e.position = size++;
-      appended.push_back(e);
-    } else {
-      e.position = place[b];
-      entries[place[b]] = e;
-    }
+    entries[place[b]] = e;
   }
-  entries.insert(entries.end(), appended.begin(), appended.end());
   // Abb. 4.19 step 2; equal bundles keep their place (no oscillation, §4.5.3).
   std::vector<char>& waits = w.waits;
-  sort_working_set(entries, kHole, w, plan.order, waits);
-
-  // What the walk needs, gathered in walk order first: the loads of this loop are independent
-  // of each other, so the processor has many of them under way at once, where the walk itself,
-  // busy with each grant, would wait for each bundle's uses in turn.
-  const std::vector<BundleId>& order = plan.order;
-  std::vector<Use>& walk = w.walk;
-  std::vector<std::uint32_t>& walk_end = w.walk_end;
-  walk.clear();
-  walk_end.resize(order.size());
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    if (!waits[k]) {
-      const auto uses = model.bundle_uses(order[k]);
-      walk.insert(walk.end(), uses.begin(), uses.end());
-    }
-    walk_end[k] = static_cast<std::uint32_t>(walk.size());
-  }
+  sort_working_set(entries, w, plan.order, waits);
 
   // Abb. 4.19 step 3: greedy from the highest priority down; a bundle before its t_early waits
-  // (§4.5.1), keeping its place for the plan at t_early. The state of the first service of the
-  // bundle some places ahead is fetched into the cache while this one is tried.
+  // (§4.5.1), keeping its place for the plan at t_early. The walk jumps between bundles and
+  // services: the uses of a bundle 2d places ahead, and the state of the first service of the
+  // bundle d places ahead, are fetched into the cache while this one is tried, instead of being
+  // waited for in turn.
   Assignment assignment(model, plan.unavailable, w);
   constexpr std::size_t kAhead = 8;
-  std::uint32_t begin = 0;
+  const std::vector<BundleId>& order = plan.order;
   for (std::size_t k = 0; k < order.size(); ++k) {
-    if (k + kAhead < order.size()) {
-      const std::uint32_t first = walk_end[k + kAhead - 1];  // of the bundle kAhead places on
-      if (first < walk_end[k + kAhead]) assignment.prefetch(walk[first]);
+    if (k + 2 * kAhead < order.size()) {
+      __builtin_prefetch(model.bundle_uses(order[k + 2 * kAhead]).data());
     }
-    const std::span<const Use> uses(walk.data() + begin, walk_end[k] - begin);
-    begin = walk_end[k];
-    if (!waits[k]) assignment.try_grant(uses, order[k]);
+    if (k + kAhead < order.size()) {
+      const auto ahead = model.bundle_uses(order[k + kAhead]);
+      if (!ahead.empty()) assignment.prefetch(ahead.front());
+    }
+    if (waits[k]) continue;
+    assignment.try_grant(model.bundle_uses(order[k]), order[k]);
   }
   plan.uses = UsesByService(model.services().size(), assignment.granted());
   plan.resource_granted = assignment.resources_used();
@@ -401,7 +382,7 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
   // Overlapping deadlines within one priority (eq. 4.11), reported, not resolved (best effort).
   // The requested bundles with a deadline, grouped by priority; the check is symmetric and the
   // pairs are sorted at the end, so the order within a group does not matter.
-  for (auto& [priority, b] : timed) priority = plan.effective_priority[b];  // cycles' too
+  for (auto& [priority, b] : timed) priority = plan.effective_priority[b];
   std::sort(timed.begin(), timed.end());
   for (std::size_t group = 0; group < timed.size();) {
     std::size_t group_end = group;
