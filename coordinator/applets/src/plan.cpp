@@ -49,6 +49,7 @@ struct Workspace {
   std::vector<ServiceId> expanded_journal;
   std::vector<Entry> entries, aside;
   std::vector<char> waits;
+  std::vector<std::span<const Use>> walk;
   std::vector<std::uint32_t> place;
   std::vector<std::pair<int, BundleId>> timed;
 };
@@ -185,10 +186,12 @@ class Assignment {
 // request, release, priority or deadline change). One pass keeps a sorted run in place and sets
 // aside each entry that breaks it (or the run's last entry, if that is the one out of place);
 // only those m entries are sorted, then merged with the run: O(n + m log n), O(n log n) at
-// worst. The merge writes only what the walk needs, the bundles in order and whether each
-// waits, not the entries themselves.
-void sort_working_set(std::vector<Entry>& entries, Workspace& w, std::vector<BundleId>& order,
-                      std::vector<char>& waits) {
+// worst. The merge writes only what the walk needs, not the entries themselves: the bundles in
+// order, whether each waits, and where each one's uses are (looked up here, in a loop of
+// independent loads, rather than in the walk, where each lookup would stall the grants).
+void sort_working_set(const Model& model, std::vector<Entry>& entries, Workspace& w,
+                      std::vector<BundleId>& order, std::vector<char>& waits,
+                      std::vector<std::span<const Use>>& walk) {
   std::vector<Entry>& aside = w.aside;
   aside.clear();
   std::size_t run = 0;  // the run is entries[0, run), built in place: run <= k at entry k
@@ -207,12 +210,14 @@ void sort_working_set(std::vector<Entry>& entries, Workspace& w, std::vector<Bun
   std::sort(aside.begin(), aside.end(), before);
   order.resize(entries.size());
   waits.resize(entries.size());
+  walk.resize(entries.size());
   // Each set-aside entry's place in the run by binary search, the run's entries before it
   // copied without comparing: O(n + m log n).
   std::size_t k = 0;
   auto put = [&](const Entry& e) {
     order[k] = e.bundle;
     waits[k] = e.waits;
+    walk[k] = model.bundle_uses(e.bundle);
     ++k;
   };
   const auto run_end = entries.begin() + static_cast<std::ptrdiff_t>(run);
@@ -348,7 +353,8 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
   }
   // Abb. 4.19 step 2; equal bundles keep their place (no oscillation, §4.5.3).
   std::vector<char>& waits = w.waits;
-  sort_working_set(entries, w, plan.order, waits);
+  std::vector<std::span<const Use>>& walk = w.walk;
+  sort_working_set(model, entries, w, plan.order, waits, walk);
 
   // Abb. 4.19 step 3: greedy from the highest priority down; a bundle before its t_early waits
   // (§4.5.1), keeping its place for the plan at t_early. The walk jumps between bundles and
@@ -359,15 +365,12 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
   constexpr std::size_t kAhead = 8;
   const std::vector<BundleId>& order = plan.order;
   for (std::size_t k = 0; k < order.size(); ++k) {
-    if (k + 2 * kAhead < order.size()) {
-      __builtin_prefetch(model.bundle_uses(order[k + 2 * kAhead]).data());
-    }
-    if (k + kAhead < order.size()) {
-      const auto ahead = model.bundle_uses(order[k + kAhead]);
-      if (!ahead.empty()) assignment.prefetch(ahead.front());
+    if (k + 2 * kAhead < order.size()) __builtin_prefetch(walk[k + 2 * kAhead].data());
+    if (k + kAhead < order.size() && !walk[k + kAhead].empty()) {
+      assignment.prefetch(walk[k + kAhead].front());
     }
     if (waits[k]) continue;
-    assignment.try_grant(model.bundle_uses(order[k]), order[k]);
+    assignment.try_grant(walk[k], order[k]);
   }
   plan.uses = UsesByService(model.services().size(), assignment.granted());
   plan.resource_granted = assignment.resources_used();
