@@ -330,7 +330,13 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
   }
   std::vector<Entry>& entries = w.entries;
   entries.resize(requested);
+  constexpr BundleId kWriteAhead = 16;
   for (BundleId b = 0; b < n; ++b) {
+    // The places are at random in the entries: the line of one some bundles on is fetched
+    // for writing while this one is made, instead of the writes queueing up for their lines.
+    if (b + kWriteAhead < n && place[b + kWriteAhead] < kNoPlace) {
+      __builtin_prefetch(&entries[place[b + kWriteAhead]], 1);
+    }
     if (place[b] == kNotRequested) continue;
     if (place[b] == kNoPlace) place[b] = size++;
     const BundleState& st = state[b];
