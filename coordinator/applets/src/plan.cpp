@@ -34,7 +34,7 @@ bool before(const Entry& a, const Entry& b) {
 
 // What the plan knows of one service while it walks, in one place: a grant looks at all of it.
 struct ServiceUse {
-  std::uint32_t count : 30 = 0;     ///< uses granted
+  std::uint32_t count : 30 = 0;     ///< uses granted (each by another resource or service)
   std::uint32_t exclusive : 1 = 0;  ///< one of them (then the only one) is exclusive
   std::uint32_t expanded : 1 = 0;   ///< what it needs is used too
 };
@@ -282,8 +282,9 @@ Plan calculate_assignments(const Model& model, const std::vector<BundleState>& s
   plan.effective_priority.assign(n, 0);
 
   // A cycle is one element with its highest priority (triggered first among equals) and earliest
-  // relative deadline (seed §4.5.1), over its requested members: one pass over all bundles, then
-  // one lookup per member (not a walk over the cycle per member, quadratic in its size).
+  // relative deadline (seed §4.5.1), over its requested members: one pass over each cycle's
+  // members, then one lookup per member (not a walk over the cycle per member, quadratic in its
+  // size).
   constexpr auto kNoDeadline = std::chrono::milliseconds::max();
   struct CycleKey {
     int priority = std::numeric_limits<int>::min();
