@@ -407,6 +407,7 @@ std::optional<int> SystemUnderTest::shut_down(std::chrono::milliseconds timeout)
   eventually([&] { return leftover_processes().empty(); }, 10s, 10ms);
   config_.reset();
   registry_.reset();
+  watches_->close_all();  // the test's watches read through the participant
   participant_.reset();
   // Fast DDS leaves the semaphores of its ports (and a killed process everything): remove the
   // files of the system's processes, now that none of them lives.

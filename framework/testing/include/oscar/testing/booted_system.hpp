@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <deque>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -60,20 +61,60 @@ struct BootOptions {
   std::string log_dir;  ///< where the processes write their output; default: a temporary folder
 };
 
+/// The watches a system handed out: their readers are closed when the system shuts down, before
+/// the participant they read through goes (a watch may outlive the shutdown; it then gets no
+/// more cues).
+class WatchRegistry {
+ public:
+  void add(const void* watch, std::function<void()> close) {
+    std::lock_guard lock(mutex_);
+    if (closed_) {
+      close();
+    } else {
+      watches_[watch] = std::move(close);
+    }
+  }
+  void remove(const void* watch) {
+    std::lock_guard lock(mutex_);
+    watches_.erase(watch);
+  }
+  void close_all() {
+    std::lock_guard lock(mutex_);
+    closed_ = true;
+    for (auto& [watch, close] : watches_) close();
+    watches_.clear();
+  }
+
+ private:
+  std::mutex mutex_;
+  bool closed_ = false;
+  std::map<const void*, std::function<void()>> watches_;
+};
+
 /// Cues of one channel ("<kernel>/<channel>"), as they arrive. Reads best effort, so it matches
-/// every producer; keeps the newest `capacity` cues until take() hands them out.
+/// every producer; keeps the newest `capacity` cues until take() hands them out. With a
+/// `registry`, its reader is closed when the registry's system shuts down.
 template <CueType T>
 class CueWatch {
  public:
-  CueWatch(DdsParticipant& participant, const std::string& channel, std::size_t capacity = 1000)
-      : capacity_(capacity),
-        reader_(participant, topics::cue(channel), reader_qos(capacity),
-                [this](const T& cue, const auto&) {
-                  std::lock_guard lock(mutex_);
-                  cues_.push_back(cue);
-                  if (cues_.size() > capacity_) cues_.pop_front();
-                  arrived_.notify_all();
-                }) {}
+  CueWatch(DdsParticipant& participant, const std::string& channel, std::size_t capacity = 1000,
+           std::shared_ptr<WatchRegistry> registry = nullptr)
+      : capacity_(capacity), registry_(std::move(registry)) {
+    reader_.emplace(participant, topics::cue(channel), reader_qos(capacity),
+                    [this](const T& cue, const auto&) {
+                      std::lock_guard lock(mutex_);
+                      cues_.push_back(cue);
+                      if (cues_.size() > capacity_) cues_.pop_front();
+                      arrived_.notify_all();
+                    });
+    if (registry_) registry_->add(this, [this] { reader_.reset(); });
+  }
+  ~CueWatch() {
+    if (registry_) registry_->remove(this);
+    reader_.reset();
+  }
+  CueWatch(const CueWatch&) = delete;
+  CueWatch& operator=(const CueWatch&) = delete;
 
   /// Waits until at least `count` cues are there (false if they are not within `timeout`).
   bool wait_for(std::size_t count, std::chrono::milliseconds timeout) {
@@ -102,7 +143,8 @@ class CueWatch {
   std::mutex mutex_;
   std::condition_variable arrived_;
   std::deque<T> cues_;
-  TopicReader<T, typename CueTraits<T>::PubSubType> reader_;  // last: its callback uses the rest
+  std::shared_ptr<WatchRegistry> registry_;
+  std::optional<TopicReader<T, typename CueTraits<T>::PubSubType>> reader_;  // uses the rest
 };
 
 /// A system booted by `oscar boot` for a test, on a domain of its own. The destructor shuts it
@@ -144,10 +186,11 @@ class SystemUnderTest {
   ::testing::AssertionResult wait_for_cues(
       const std::vector<std::string>& channels, std::size_t count = 1,
       std::chrono::milliseconds timeout = std::chrono::seconds(30));
-  /// Starts watching a channel's cues (read them with take() or wait_for()).
+  /// Starts watching a channel's cues (read them with take() or wait_for()); after shut_down()
+  /// the watch gets no more cues, and may still be read and destroyed.
   template <CueType T>
   std::unique_ptr<CueWatch<T>> watch(const std::string& channel, std::size_t capacity = 1000) {
-    return std::make_unique<CueWatch<T>>(*participant_, channel, capacity);
+    return std::make_unique<CueWatch<T>>(*participant_, channel, capacity, watches_);
   }
   /// The next `count` cues of a channel; fewer if they do not come within `timeout`.
   template <CueType T>
@@ -189,6 +232,7 @@ class SystemUnderTest {
   std::vector<pid_t> pids_;                      ///< every process of the system seen
   std::vector<std::string> shm_files_;           ///< /dev/shm files they had open
   std::unique_ptr<DdsParticipant> participant_;
+  std::shared_ptr<WatchRegistry> watches_ = std::make_shared<WatchRegistry>();
   std::unique_ptr<RegistryClient> registry_;
   std::unique_ptr<ConfigClient> config_;
 };
