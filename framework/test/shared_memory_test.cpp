@@ -16,8 +16,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include "oscar/dds_participant.hpp"
 #include "dds/participant_identity.hpp"  // framework/src
+#include "oscar/dds_participant.hpp"
 
 namespace oscar {
 namespace {

@@ -14,8 +14,8 @@
 #include <oscar/registry/system_options.hpp>
 #include <oscar/time.hpp>
 
-#include "oscar/idl_texts.hpp"
 #include "idl_types.hpp"  // tools/inspect
+#include "oscar/idl_texts.hpp"
 
 namespace {
 
