@@ -9,7 +9,9 @@
 
 #include <chrono>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -85,5 +87,21 @@ class Process {
 
 /// A DDS domain of this test process's own (tests on one machine do not hear each other).
 inline int test_domain() { return 1 + static_cast<int>(getpid() % 200); }
+
+/// "<temporary folder>/<name>_<pid>": a path of this test process's own.
+inline std::string temp_path(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / (name + "_" + std::to_string(getpid())))
+      .string();
+}
+
+/// An oscar-run process named `module` on test_domain(), with further arguments (e.g. `-k
+/// bench_source:fast -m continuous:10ms`); its output goes to temp_path(module + ".log").
+inline std::unique_ptr<Process> run_module(const std::string& module,
+                                           std::vector<std::string> args) {
+  std::vector<std::string> argv{bin("oscar-run"), "--name", module, "--domain",
+                                std::to_string(test_domain())};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return std::make_unique<Process>(argv, temp_path(module + ".log"));
+}
 
 }  // namespace oscar::test

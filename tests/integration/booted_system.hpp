@@ -15,11 +15,6 @@
 
 namespace oscar::test {
 
-inline std::string temp_path(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / (name + "_" + std::to_string(getpid())))
-      .string();
-}
-
 class BootedSystem : public testing::SystemUnderTest {
  public:
   /// Writes `yaml` to a file and boots it on `domain` (default: test_domain(); the file's own

@@ -18,18 +18,6 @@ using namespace std::chrono_literals;
 using test::Process;
 using testing::HasSubstr;
 
-std::string temp(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / (name + "_" + std::to_string(getpid())))
-      .string();
-}
-
-std::unique_ptr<Process> run(const std::string& module, std::vector<std::string> args) {
-  std::vector<std::string> argv{test::bin("oscar-run"), "--name", module, "--domain",
-                                std::to_string(test::test_domain())};
-  argv.insert(argv.end(), args.begin(), args.end());
-  return std::make_unique<Process>(argv, temp(module + ".log"));
-}
-
 struct Run {
   int exit_code;
   std::string output;
@@ -37,7 +25,7 @@ struct Run {
 
 // `oscar config MODULE command ...` as the coordinator.
 Run config(const std::string& module, std::vector<std::string> args) {
-  const auto log = temp("oscar_config_command.log");
+  const auto log = test::temp_path("oscar_config_command.log");
   std::vector<std::string> argv{test::bin("oscar-config"), module, "command"};
   argv.insert(argv.end(), args.begin(), args.end());
   for (const auto& a : {"--as", "coordinator", "--domain"}) argv.emplace_back(a);
@@ -54,8 +42,9 @@ Bool flag(bool value) {
 }
 
 TEST(CommandPortsAcrossProcesses, AModuleProcessAnswersOnItsProcessingThreadBetweenCycles) {
-  auto arm = run("arm", {"--plugin", OSCAR_TEST_PLUGIN_DIR "/liboscar_kernel_test_commanded.so",
-                         "-k", "test_commanded:arm", "-m", "continuous:2ms"});
+  auto arm = test::run_module(
+      "arm", {"--plugin", OSCAR_TEST_PLUGIN_DIR "/liboscar_kernel_test_commanded.so", "-k",
+              "test_commanded:arm", "-m", "continuous:2ms"});
   DdsParticipant participant(test::test_domain(), "test:coordinator");
   ConfigClient client(participant, "coordinator");
   ASSERT_TRUE(eventually([&] { return client.module_state("arm", 5s).kernels()[0].cycles() > 3; }))
@@ -80,7 +69,7 @@ TEST(CommandPortsAcrossProcesses, AModuleProcessAnswersOnItsProcessingThreadBetw
 }
 
 TEST(CommandPortsAcrossProcesses, OscarConfigSendsTheFramegrabbersFrameModeFromYaml) {
-  auto cams = run("cams", {"-k", "framegrabber:cam", "-m", "continuous:50ms"});
+  auto cams = test::run_module("cams", {"-k", "framegrabber:cam", "-m", "continuous:50ms"});
   auto r = config("cams", {"cam", "frame_mode", "{mode: half}"});
   ASSERT_EQ(r.exit_code, 0) << r.output << cams->output();
   EXPECT_THAT(r.output, HasSubstr("cams: cam accepted frame_mode: frame mode full -> half"));

@@ -26,19 +26,6 @@ using namespace std::chrono_literals;
 using test::Process;
 using testing::HasSubstr;
 
-std::string temp(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / (name + "_" + std::to_string(getpid())))
-      .string();
-}
-
-// An oscar-run process hosting one kernel of a standard module type.
-std::unique_ptr<Process> run(const std::string& module, std::vector<std::string> args) {
-  std::vector<std::string> argv{test::bin("oscar-run"), "--name", module, "--domain",
-                                std::to_string(test::test_domain())};
-  argv.insert(argv.end(), args.begin(), args.end());
-  return std::make_unique<Process>(argv, temp(module + ".log"));
-}
-
 // A module in this test process, joined to the same domain.
 std::unique_ptr<Module> local_module(const std::string& yaml) {
   auto m = std::make_unique<Module>(ModuleSpec::from_yaml(YAML::Load(yaml), "test"),
@@ -52,14 +39,14 @@ test::Collect& collect(Module& m, const std::string& name) {
 }
 
 TEST(CueFlow, PushAcrossProcessesDeliversEveryCueInOrder) {
-  const auto report = temp("push_report.json");
+  const auto report = test::temp_path("push_report.json");
   std::filesystem::remove(report);
-  auto sink = run("sink", {"-k", "bench_sink:sink", "-p", "sink.type=LineSeg3DSeq", "-p",
-                           "sink.report=" + report, "-p", "sink.expect=200", "-i",
-                           "sink.in=src/out", "-m", "single_step"});
+  auto sink = test::run_module("sink", {"-k", "bench_sink:sink", "-p", "sink.type=LineSeg3DSeq",
+                                        "-p", "sink.report=" + report, "-p", "sink.expect=200",
+                                        "-i", "sink.in=src/out", "-m", "single_step"});
   std::this_thread::sleep_for(300ms);
-  auto src =
-      run("src", {"-k", "bench_source:src", "-p", "src.type=LineSeg3DSeq", "-m", "continuous:2ms"});
+  auto src = test::run_module(
+      "src", {"-k", "bench_source:src", "-p", "src.type=LineSeg3DSeq", "-m", "continuous:2ms"});
   ASSERT_TRUE(eventually([&] { return std::filesystem::exists(report); }))
       << sink->output() << src->output();
   const auto r = nlohmann::json::parse(std::ifstream(report));
@@ -71,13 +58,14 @@ TEST(CueFlow, PushAcrossProcessesDeliversEveryCueInOrder) {
 
 // A bench_sink in another process that reports once it has `expect` Bool cues from em/out.
 std::unique_ptr<Process> sink_of_em(const std::string& report, int expect) {
-  return run("sink", {"-k", "bench_sink:sink", "-p", "sink.type=Bool", "-p",
-                      "sink.report=" + report, "-p", "sink.expect=" + std::to_string(expect), "-i",
-                      "sink.in=em/out", "-m", "single_step"});
+  return test::run_module(
+      "sink",
+      {"-k", "bench_sink:sink", "-p", "sink.type=Bool", "-p", "sink.report=" + report, "-p",
+       "sink.expect=" + std::to_string(expect), "-i", "sink.in=em/out", "-m", "single_step"});
 }
 
 TEST(CueFlow, ABestEffortOutputDeliversToAConsumerThatWasWaitingForIt) {
-  const auto report = temp("best_effort_report.json");
+  const auto report = test::temp_path("best_effort_report.json");
   std::filesystem::remove(report);
   auto sink = sink_of_em(report, 50);
   // The consumer made its reader before the producer existed, not knowing its class.
@@ -102,7 +90,7 @@ kernels:
 )");
   auto& out = *em->kernel("em").ports().outputs.front();
   ASSERT_TRUE(eventually([&] { return out.published() == 10; }));
-  const auto report = temp("history_report.json");
+  const auto report = test::temp_path("history_report.json");
   std::filesystem::remove(report);
   auto sink = sink_of_em(report, 4);
   ASSERT_TRUE(eventually([&] { return std::filesystem::exists(report); })) << sink->output();
@@ -123,8 +111,9 @@ mode: { continuous: 10ms }
 kernels: [ { type: test_raw_collect, name: sink, inputs: { img: cam/frame } } ]
 )");
   auto& collect = dynamic_cast<test::RawCollect&>(sink->kernel("sink").kernel());
-  auto cam = run("cam", {"-k", "framegrabber:cam", "-p", "cam.source=synthetic:static", "-p",
-                         "cam.width=64", "-p", "cam.height=48", "-m", "continuous:20ms"});
+  auto cam =
+      test::run_module("cam", {"-k", "framegrabber:cam", "-p", "cam.source=synthetic:static", "-p",
+                               "cam.width=64", "-p", "cam.height=48", "-m", "continuous:20ms"});
   ASSERT_TRUE(eventually([&] { return collect.seen().size() >= 5; })) << cam->output();
   const auto seen = collect.seen();
   for (std::size_t i = 0; i < seen.size(); ++i) {
@@ -151,7 +140,8 @@ kernels:
 )";
 
 TEST(CueFlow, PullAcrossProcessesForAGivenTime) {
-  auto src = run("src", {"-k", "bench_source:src", "-p", "src.type=Bool", "-m", "continuous:5ms"});
+  auto src = test::run_module(
+      "src", {"-k", "bench_source:src", "-p", "src.type=Bool", "-m", "continuous:5ms"});
   auto consumer = local_module(kPullConsumer);
   auto& in = collect(*consumer, "sink").in_;
   std::this_thread::sleep_for(100ms);
@@ -177,8 +167,8 @@ Stamp stamp(const Input<Bool>::Ptr& cue) { return static_cast<Stamp>(cue->header
 
 TEST(CueFlow, BlockPullsAcrossProcessesReturnTheProducersNewestCuesAndATimeRange) {
   // 30 cues, then quiet: the producer's ring (depth 16) holds cues 15 to 30.
-  auto src = run("src", {"-k", "bench_source:src", "-p", "src.type=Bool", "-p", "src.count=30",
-                         "-m", "continuous:5ms"});
+  auto src = test::run_module("src", {"-k", "bench_source:src", "-p", "src.type=Bool", "-p",
+                                      "src.count=30", "-m", "continuous:5ms"});
   auto consumer = local_module(kPullConsumer);
   auto& in = collect(*consumer, "sink").in_;
   ASSERT_TRUE(eventually([&] {
@@ -203,8 +193,8 @@ TEST(CueFlow, BlockPullsAcrossProcessesReturnTheProducersNewestCuesAndATimeRange
 
 TEST(CueFlow, ABlockOfImagesCrossesProcessesInOneReply) {
   // 16 images of 442 KB: one reply of 7 MB, larger than a shared-memory segment or a datagram.
-  auto src = run("src", {"-k", "bench_source:src", "-p", "src.type=GvImage", "-p", "src.count=16",
-                         "-m", "continuous:20ms"});
+  auto src = test::run_module("src", {"-k", "bench_source:src", "-p", "src.type=GvImage", "-p",
+                                      "src.count=16", "-m", "continuous:20ms"});
   auto consumer = local_module(R"(
 name: consumer
 mode: deactivated
@@ -225,7 +215,8 @@ kernels:
 }
 
 TEST(CueFlow, TwoPullersOfOneProducerAcrossProcessesReceiveOnlyTheirOwnReplies) {
-  auto src = run("src", {"-k", "bench_source:src", "-p", "src.type=Bool", "-m", "continuous:5ms"});
+  auto src = test::run_module(
+      "src", {"-k", "bench_source:src", "-p", "src.type=Bool", "-m", "continuous:5ms"});
   // Two consumers, as two modules would have them: a participant and an input each.
   struct Puller {
     DdsParticipant participant;
@@ -251,8 +242,8 @@ TEST(CueFlow, TwoPullersOfOneProducerAcrossProcessesReceiveOnlyTheirOwnReplies) 
 }
 
 TEST(CueFlow, PrefetchReturnsAtOnceAndDeliversLater) {
-  auto src =
-      run("src", {"-k", "bench_source:src", "-p", "src.type=GvImage", "-m", "continuous:20ms"});
+  auto src = test::run_module(
+      "src", {"-k", "bench_source:src", "-p", "src.type=GvImage", "-m", "continuous:20ms"});
   auto consumer = local_module(R"(
 name: consumer
 mode: deactivated
@@ -277,8 +268,8 @@ kernels:
 }
 
 TEST(CueFlow, RewireMidStreamLosesNothingAfterTheSwitch) {
-  auto a = run("a", {"-k", "bench_source:a", "-m", "continuous:3ms"});
-  auto b = run("b", {"-k", "bench_source:b", "-m", "continuous:3ms"});
+  auto a = test::run_module("a", {"-k", "bench_source:a", "-m", "continuous:3ms"});
+  auto b = test::run_module("b", {"-k", "bench_source:b", "-m", "continuous:3ms"});
   auto consumer = local_module(R"(
 name: consumer
 kernels: [ { type: test_collect, name: sink, inputs: { in: { source: a/out, depth: 512 } } } ]
@@ -322,8 +313,8 @@ kernels: [ { type: test_collect, name: ask, inputs: { in: { source: b/out, trans
 // Issue 15.2: the wait for a slow new source is the command's (here 3 s); after the switch no cue
 // of the new source is missing and none of the old one arrives.
 TEST(CueFlow, RewireFromA100HzToA1HzSourceLosesAndRepeatsNothingAfterTheSwitch) {
-  auto fast = run("fast", {"-k", "bench_source:fast", "-m", "continuous:10ms"});
-  auto slow = run("slow", {"-k", "bench_source:slow", "-m", "continuous:1s"});
+  auto fast = test::run_module("fast", {"-k", "bench_source:fast", "-m", "continuous:10ms"});
+  auto slow = test::run_module("slow", {"-k", "bench_source:slow", "-m", "continuous:1s"});
   auto consumer = local_module(R"(
 name: consumer
 kernels: [ { type: test_collect, name: sink, inputs: { in: { source: fast/out, depth: 512 } } } ]
@@ -354,8 +345,8 @@ kernels: [ { type: test_collect, name: sink, inputs: { in: { source: fast/out, d
 }
 
 TEST(CueFlow, ARewireWhoseNewSourceSendsNothingInTheWaitSaysSoInTheReply) {
-  auto a = run("a", {"-k", "bench_source:a", "-m", "continuous:10ms"});
-  auto idle = run("idle", {"-k", "bench_source:idle", "-m", "single_step:command"});
+  auto a = test::run_module("a", {"-k", "bench_source:a", "-m", "continuous:10ms"});
+  auto idle = test::run_module("idle", {"-k", "bench_source:idle", "-m", "single_step:command"});
   auto consumer = local_module(R"(
 name: consumer
 kernels: [ { type: test_collect, name: sink, inputs: { in: a/out } } ]
@@ -372,8 +363,8 @@ kernels: [ { type: test_collect, name: sink, inputs: { in: a/out } } ]
 }
 
 TEST(CueFlow, APullInputRewiredAcrossProcessesPullsFromTheNewProducerOnly) {
-  auto a = run("a", {"-k", "bench_source:a", "-m", "continuous:5ms"});
-  auto b = run("b", {"-k", "bench_source:b", "-m", "continuous:5ms"});
+  auto a = test::run_module("a", {"-k", "bench_source:a", "-m", "continuous:5ms"});
+  auto b = test::run_module("b", {"-k", "bench_source:b", "-m", "continuous:5ms"});
   auto consumer = local_module(R"(
 name: consumer
 mode: deactivated
@@ -395,7 +386,7 @@ kernels: [ { type: test_collect, name: sink, inputs: { in: { source: a/out, tran
 }
 
 TEST(CueFlow, APullInputRewiredToAProducerInItsOwnModuleStaysAPullInput) {
-  auto a = run("a", {"-k", "bench_source:a", "-m", "continuous:5ms"});
+  auto a = test::run_module("a", {"-k", "bench_source:a", "-m", "continuous:5ms"});
   auto consumer = local_module(R"(
 name: consumer
 mode: { continuous: 5ms }
@@ -424,7 +415,7 @@ kernels:
 }
 
 TEST(CueFlow, CommandsConfigureAModuleInAnotherProcess) {
-  auto src = run("src", {"-k", "bench_source:src", "-m", "single_step:command"});
+  auto src = test::run_module("src", {"-k", "bench_source:src", "-m", "single_step:command"});
   auto consumer = local_module(R"(
 name: consumer
 kernels: [ { type: test_collect, name: sink, inputs: { in: src/out } } ]
@@ -520,19 +511,19 @@ TEST(CueFlow, ACommandToAnUnknownModuleIsAClearError) {
 }
 
 TEST(OscarRun, BadInputExitsWithAClearMessage) {
-  const auto yaml = temp("bad.yaml");
+  const auto yaml = test::temp_path("bad.yaml");
   std::ofstream(yaml) << "name: m\nkernels:\n  - { type: relay\n";
-  Process malformed({test::bin("oscar-run"), yaml}, temp("bad1.log"));
+  Process malformed({test::bin("oscar-run"), yaml}, test::temp_path("bad1.log"));
   EXPECT_EQ(malformed.wait(10s), 2);
   EXPECT_THAT(malformed.output(), HasSubstr(yaml + ":4:"));
 
-  Process unknown({test::bin("oscar-run"), "-k", "no_such_kernel"}, temp("bad2.log"));
+  Process unknown({test::bin("oscar-run"), "-k", "no_such_kernel"}, test::temp_path("bad2.log"));
   EXPECT_EQ(unknown.wait(10s), 2);
   EXPECT_THAT(unknown.output(), HasSubstr("unknown kernel type 'no_such_kernel'"));
 
   Process mismatch({test::bin("oscar-run"), "-k", "bench_source:src", "-p", "src.type=GvImage",
                     "-k", "bench_sink:sink", "-i", "sink.in=src/out", "--check"},
-                   temp("bad3.log"));
+                   test::temp_path("bad3.log"));
   EXPECT_EQ(mismatch.wait(10s), 2);
   EXPECT_THAT(mismatch.output(),
               HasSubstr("cannot wire src/out (oscar::GvImage) to input sink/in (oscar::Bool)"));

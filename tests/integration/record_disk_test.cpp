@@ -22,15 +22,10 @@ namespace {
 using namespace std::chrono_literals;
 using test::Process;
 
-std::string temp(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / (name + "_" + std::to_string(getpid())))
-      .string();
-}
-
 // A tmpfs of `size` mounted for the test, unmounted afterwards.
 class SmallDisk {
  public:
-  explicit SmallDisk(const std::string& size) : dir_(temp("small_disk")) {
+  explicit SmallDisk(const std::string& size) : dir_(test::temp_path("small_disk")) {
     std::filesystem::create_directories(dir_);
     const auto options = "size=" + size;
     mounted_ = mount("tmpfs", dir_.c_str(), "tmpfs", 0, options.c_str()) == 0;
@@ -56,10 +51,10 @@ TEST(RecordDisk, AFullDiskIsAClearErrorAndTheWrittenChunksStayReadable) {
   // 768x576 images (442 KB each) at 20 Hz: the 2 MiB are full after about five.
   Process source({test::bin("oscar-run"), "--name", "cam", "--domain", domain, "-k",
                   "bench_source:cam", "-p", "cam.type=GvImage", "-m", "deactivated"},
-                 temp("disk_cam.log"));
+                 test::temp_path("disk_cam.log"));
   Process rec({test::bin("oscar-record"), "-o", file, "--domain", domain, "--compression", "none",
                "cam/out"},
-              temp("disk_record.log"));
+              test::temp_path("disk_record.log"));
   const auto until = std::chrono::steady_clock::now() + 15s;
   while (rec.output().find("recording oscar/cue/cam/out") == std::string::npos) {
     ASSERT_LT(std::chrono::steady_clock::now(), until) << rec.output();
@@ -87,7 +82,7 @@ TEST(RecordDisk, AFullDiskIsAClearErrorAndTheWrittenChunksStayReadable) {
   EXPECT_TRUE(scan.truncation.has_value()) << "the file has no end: the disk was full";
   ASSERT_GE(seqs.size(), 1u) << "a complete chunk was written before the disk filled";
   for (std::size_t i = 0; i < seqs.size(); ++i) EXPECT_EQ(seqs[i], i + 1);
-  Process info({test::bin("oscar-info"), file}, temp("disk_info.log"));
+  Process info({test::bin("oscar-info"), file}, test::temp_path("disk_info.log"));
   ASSERT_TRUE(info.wait(20s).has_value());
   EXPECT_THAT(info.output(), testing::HasSubstr("oscar/cue/cam/out")) << info.output();
 }

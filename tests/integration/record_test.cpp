@@ -26,11 +26,6 @@ using test::Process;
 using testing::ContainsRegex;
 using testing::HasSubstr;
 
-std::string temp(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / (name + "_" + std::to_string(getpid())))
-      .string();
-}
-
 std::unique_ptr<Process> source(const std::string& name, const std::string& type, int count,
                                 const std::string& mode) {
   return std::make_unique<Process>(
@@ -38,14 +33,14 @@ std::unique_ptr<Process> source(const std::string& name, const std::string& type
                                std::to_string(test::test_domain()), "-k", "bench_source:" + name,
                                "-p", name + ".type=" + type, "-p",
                                name + ".count=" + std::to_string(count), "-m", mode},
-      temp(name + ".log"));
+      test::temp_path(name + ".log"));
 }
 
 std::unique_ptr<Process> recorder(const std::string& file, std::vector<std::string> args) {
   std::vector<std::string> argv{test::bin("oscar-record"), "-o", file, "--domain",
                                 std::to_string(test::test_domain())};
   argv.insert(argv.end(), args.begin(), args.end());
-  return std::make_unique<Process>(argv, temp("record.log"));
+  return std::make_unique<Process>(argv, test::temp_path("record.log"));
 }
 
 // The cue bench_source publishes (its prototype), given the header the recording carries.
@@ -128,7 +123,7 @@ std::vector<std::uint64_t> one_to(std::uint64_t n) {
 }
 
 TEST(Record, HoldsEveryPublishedCueOfTheThreeSeedTypesInOrderWithItsBytes) {
-  const auto file = temp("record_all.mcap");
+  const auto file = test::temp_path("record_all.mcap");
   constexpr int kCount = 60;
   auto b = source("rb", "Bool", kCount, "deactivated");
   auto l = source("rl", "LineSeg3DSeq", kCount, "deactivated");
@@ -150,7 +145,7 @@ TEST(Record, HoldsEveryPublishedCueOfTheThreeSeedTypesInOrderWithItsBytes) {
 }
 
 TEST(Record, AKilledRecorderLeavesAFileReadableUpToItsLastChunk) {
-  const auto file = temp("record_killed.mcap");
+  const auto file = test::temp_path("record_killed.mcap");
   auto g = source("kg", "GvImage", 0, "continuous:20ms");
   auto rec = recorder(file, {"kg/out"});
   ASSERT_TRUE(eventually([&] { return rec->output().find("kg/out") != std::string::npos; }));
@@ -166,7 +161,7 @@ TEST(Record, AKilledRecorderLeavesAFileReadableUpToItsLastChunk) {
     ++seen;
   });
   EXPECT_GT(seen, 50u) << "~3 s at 50 Hz, less the open chunk";
-  Process info({test::bin("oscar-info"), file}, temp("info.log"));
+  Process info({test::bin("oscar-info"), file}, test::temp_path("info.log"));
   ASSERT_EQ(info.wait(10s), 0) << info.output();
   EXPECT_THAT(info.output(), HasSubstr("summary:     none (no footer"));
   EXPECT_THAT(info.output(), HasSubstr("messages:    " + std::to_string(seen) + " in " +
@@ -175,7 +170,7 @@ TEST(Record, AKilledRecorderLeavesAFileReadableUpToItsLastChunk) {
 }
 
 TEST(Record, SplitsBySizeIntoCompleteFilesThatTogetherHoldEveryCue) {
-  const auto file = temp("record_split.mcap");
+  const auto file = test::temp_path("record_split.mcap");
   constexpr int kCount = 40;  // 40 images of 432 KiB: ~17 MiB uncompressed
   auto g = source("sg", "GvImage", kCount, "deactivated");
   auto rec = recorder(file, {"sg/out", "--compression", "none", "--split-size", "4M"});
@@ -222,8 +217,8 @@ Recorded messages_of(const std::string& file, std::map<std::string, std::uint64_
 }
 
 TEST(Replay, DeliversTheRecordedBytesAndHeadersInOrderWithTheOriginalTiming) {
-  const auto original = temp("replay_original.mcap");
-  const auto replayed = temp("replay_replayed.mcap");
+  const auto original = test::temp_path("replay_original.mcap");
+  const auto replayed = test::temp_path("replay_replayed.mcap");
   constexpr int kCount = 30;
   {
     auto b = source("pb", "Bool", kCount, "deactivated");
@@ -239,7 +234,7 @@ TEST(Replay, DeliversTheRecordedBytesAndHeadersInOrderWithTheOriginalTiming) {
   std::this_thread::sleep_for(300ms);
   Process replay(
       {test::bin("oscar-replay"), original, "--domain", std::to_string(test::test_domain())},
-      temp("replay.log"));
+      test::temp_path("replay.log"));
   ASSERT_EQ(replay.wait(30s), 0) << replay.output();
   EXPECT_THAT(replay.output(), HasSubstr("published 90 messages on 3 topics"));
   EXPECT_THAT(replay.output(),
@@ -264,7 +259,7 @@ TEST(Replay, DeliversTheRecordedBytesAndHeadersInOrderWithTheOriginalTiming) {
 
 TEST(Replay, LoopsTheRecordingInOrderUntilStopped) {
   // Five Bools 20 ms apart, written directly: one pass takes 80 ms.
-  const auto file = temp("replay_loop.mcap");
+  const auto file = test::temp_path("replay_loop.mcap");
   {
     mcap::Writer w(file, {});
     const auto channel = w.add_channel(0, "oscar/cue/lp/out", "cdr", {{"type", "oscar::Bool"}});
@@ -283,12 +278,12 @@ TEST(Replay, LoopsTheRecordingInOrderUntilStopped) {
     }
     w.close();
   }
-  const auto replayed = temp("replay_loop_replayed.mcap");
+  const auto replayed = test::temp_path("replay_loop_replayed.mcap");
   auto consumer = recorder(replayed, {"--all"});
   std::this_thread::sleep_for(300ms);
   Process replay(
       {test::bin("oscar-replay"), file, "--loop", "--domain", std::to_string(test::test_domain())},
-      temp("replay_loop.log"));
+      test::temp_path("replay_loop.log"));
   // Its writers exist once it says what it replays; then it waits up to 2 s for its reader
   // (longer than a pass takes under a sanitizer, with a participant per topic).
   const auto until = std::chrono::steady_clock::now() + 30s;
@@ -311,7 +306,7 @@ TEST(Replay, LoopsTheRecordingInOrderUntilStopped) {
 }
 
 TEST(Replay, OntoATopicOfAnotherTypeIsAClearError) {
-  const auto file = temp("replay_mismatch.mcap");
+  const auto file = test::temp_path("replay_mismatch.mcap");
   {
     auto g = source("xg", "GvImage", 5, "deactivated");
     auto rec = recorder(file, {"xg/out"});
@@ -324,7 +319,7 @@ TEST(Replay, OntoATopicOfAnotherTypeIsAClearError) {
   std::this_thread::sleep_for(500ms);
   Process replay({test::bin("oscar-replay"), file, "--remap", "xg/out:=xb/out", "--domain",
                   std::to_string(test::test_domain())},
-                 temp("replay_mismatch.log"));
+                 test::temp_path("replay_mismatch.log"));
   EXPECT_EQ(replay.wait(20s), 1);
   EXPECT_THAT(replay.output(), HasSubstr("oscar replay: topic 'oscar/cue/xb/out' carries "
                                          "oscar::Bool in the running system, not oscar::GvImage"));

@@ -15,11 +15,6 @@ namespace oscar {
 namespace {
 using namespace std::chrono_literals;
 
-std::string temp(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / (name + "_" + std::to_string(getpid())))
-      .string();
-}
-
 TEST(LandmarksOnTwoHosts, BootsAndFusesBothCamerasAsOnOneHost) {
   if (const auto why = test::TestHosts::unavailable(); !why.empty()) GTEST_SKIP() << why;
   test::TestHosts hosts(2);
@@ -29,19 +24,19 @@ TEST(LandmarksOnTwoHosts, BootsAndFusesBothCamerasAsOnOneHost) {
   root["hosts"]["pc1"]["address"] = hosts.address(1);
   root["hosts"]["pc2"]["netns"] = hosts.netns(2);
   root["hosts"]["pc2"]["address"] = hosts.address(2);
-  const auto file = temp("landmarks2") + ".yaml";
+  const auto file = test::temp_path("landmarks2") + ".yaml";
   {
     YAML::Emitter out;
     out << root;
     std::ofstream(file) << out.c_str();
   }
-  const auto log_dir = temp("landmarks2_logs");
+  const auto log_dir = test::temp_path("landmarks2_logs");
   std::filesystem::remove_all(log_dir);
   auto argv = hosts.on(1);  // boot and the registry run on pc1
   argv.insert(argv.end(),
               {test::bin("oscar-boot"), file, "--domain", std::to_string(test::test_domain()),
                "--log-dir", log_dir, "--timeout", "40", "--duration", "8"});
-  test::Process boot(argv, temp("landmarks2_boot.log"));
+  test::Process boot(argv, test::temp_path("landmarks2_boot.log"));
   ASSERT_EQ(boot.wait(90s), 0) << boot.output();
 
   const auto summaries = test::landmark_summaries(log_dir + "/pc1/landmarks.log");

@@ -18,17 +18,12 @@ namespace {
 using namespace std::chrono_literals;
 using nlohmann::json;
 
-std::string temp(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / (name + "_" + std::to_string(getpid())))
-      .string();
-}
-
 class ThreeHosts : public testing::Test {
  protected:
   void SetUp() override {
     if (const auto why = test::TestHosts::unavailable(); !why.empty()) GTEST_SKIP() << why;
     hosts_ = std::make_unique<test::TestHosts>(3);
-    file_ = temp("netns_system") + ".yaml";
+    file_ = test::temp_path("netns_system") + ".yaml";
     std::ofstream(file_) << fmt::format(R"(
 system: three
 lease: 1s
@@ -53,12 +48,12 @@ modules:
 )",
                                         hosts_->address(1), hosts_->netns(2), hosts_->address(2),
                                         hosts_->netns(3), hosts_->address(3));
-    log_dir_ = temp("netns_logs");
+    log_dir_ = test::temp_path("netns_logs");
     std::filesystem::remove_all(log_dir_);
     auto argv = hosts_->on(1);  // boot and the registry run on h1
     argv.insert(argv.end(), {test::bin("oscar-boot"), file_, "--domain", domain(), "--log-dir",
                              log_dir_, "--timeout", "40"});
-    boot_ = std::make_unique<test::Process>(argv, temp("netns_boot.log"));
+    boot_ = std::make_unique<test::Process>(argv, test::temp_path("netns_boot.log"));
   }
   void TearDown() override {
     if (boot_) {
@@ -76,7 +71,7 @@ modules:
     auto argv = hosts_->on(1);
     argv.insert(argv.end(),
                 {test::bin("oscar-ps"), "--system", file_, "--domain", domain(), "--json"});
-    test::Process p(argv, temp("netns_ps.log"));
+    test::Process p(argv, test::temp_path("netns_ps.log"));
     if (p.wait(20s) != 0) return json();
     const auto out = p.output();
     return json::parse(out.substr(out.find('{')), nullptr, false);
@@ -141,7 +136,7 @@ TEST_F(ThreeHosts, CuesCrossHostsALostHostFailsItsModulesAndComesBack) {
   auto argv = hosts_->on(2);
   argv.insert(argv.end(), {test::bin("oscar-monitor"), "--system", file_, "--host", "h2",
                            "--domain", domain(), "--log-dir", log_dir_ + "/h2"});
-  test::Process monitor(argv, temp("netns_monitor2.log"));
+  test::Process monitor(argv, test::temp_path("netns_monitor2.log"));
   s = until([&](const json& st) {
     return st["state"] == "running" && st["hosts_lost"].empty() &&
            module(st, "relay")["incarnation"] == 2 && module(st, "relay")["status"] == "running";

@@ -34,9 +34,6 @@ namespace fs = std::filesystem;
 std::string own_bin(const std::string& program) {
   return (fs::read_symlink("/proc/self/exe").parent_path() / program).string();
 }
-std::string temp(const std::string& name) {
-  return (fs::temp_directory_path() / fmt::format("{}_{}", name, getpid())).string();
-}
 using oscar::test::percentile;
 
 // --watch: subscribes to the fused pose (on the network of `host` in `system`) and writes one
@@ -101,7 +98,8 @@ Result run(const std::string& config, int width, int height, double seconds, boo
     prefix = hosts->on(1);
     host = "pc1";
   }
-  const auto file = temp(two_hosts ? "bench_landmarks2" : "bench_landmarks1") + ".yaml";
+  const auto file =
+      oscar::test::temp_path(two_hosts ? "bench_landmarks2" : "bench_landmarks1") + ".yaml";
   {
     YAML::Emitter e;
     e << root;
@@ -111,17 +109,18 @@ Result run(const std::string& config, int width, int height, double seconds, boo
   auto boot_argv = prefix;
   boot_argv.insert(boot_argv.end(),
                    {own_bin("oscar-boot"), file, "--domain", std::to_string(domain), "--log-dir",
-                    temp("bench_landmarks_logs"), "--timeout", "40", "--duration",
+                    oscar::test::temp_path("bench_landmarks_logs"), "--timeout", "40", "--duration",
                     fmt::format("{:.0f}", seconds + 6)});
-  oscar::test::Process boot(boot_argv, temp("bench_landmarks_boot.log"));
+  oscar::test::Process boot(boot_argv, oscar::test::temp_path("bench_landmarks_boot.log"));
   std::this_thread::sleep_for(1s);
-  const auto out = temp("bench_landmarks_ms") + ".txt";
+  const auto out = oscar::test::temp_path("bench_landmarks_ms") + ".txt";
   auto watch_argv = prefix;
   watch_argv.insert(watch_argv.end(), {own_bin("oscar-bench-landmarks"), "--watch", "--system",
                                        file, "--host", host, "--domain", std::to_string(domain),
                                        "--seconds", fmt::format("{}", seconds), "--out", out});
   oscar::test::Process watcher(
-      watch_argv, temp(two_hosts ? "bench_landmarks_watch2" : "bench_landmarks_watch1"));
+      watch_argv,
+      oscar::test::temp_path(two_hosts ? "bench_landmarks_watch2" : "bench_landmarks_watch1"));
   if (watcher.wait(std::chrono::seconds(static_cast<int>(seconds) + 60)) != 0) {
     throw std::runtime_error("the watcher failed: " + watcher.output());
   }

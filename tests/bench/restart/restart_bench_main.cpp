@@ -24,10 +24,6 @@
 namespace {
 using namespace std::chrono_literals;
 
-std::string temp(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / fmt::format("{}_{}", name, getpid())).string();
-}
-
 using oscar::test::percentile;
 
 const oscar::ModuleEntry* find(const oscar::SystemState& s, const std::string& name) {
@@ -95,14 +91,14 @@ double boot_time_ms(int modules, bool netns, int domain) {
         source ? "" : fmt::format(", inputs: {{ in: k{}/out }}", i - 1),
         source ? "{ continuous: 50ms }" : "single_step");
   }
-  const auto file = temp("bench_boot20") + ".yaml";
+  const auto file = oscar::test::temp_path("bench_boot20") + ".yaml";
   std::ofstream(file) << yaml;
   std::vector<std::string> argv;
   if (netns) argv = hosts->on(1);
   argv.insert(argv.end(),
               {oscar::sibling_program("oscar-boot"), file, "--domain", std::to_string(domain),
-               "--log-dir", temp("bench_boot20_logs"), "--duration", "1"});
-  oscar::test::Process boot(argv, temp("bench_boot20") + ".log");
+               "--log-dir", oscar::test::temp_path("bench_boot20_logs"), "--duration", "1"});
+  oscar::test::Process boot(argv, oscar::test::temp_path("bench_boot20") + ".log");
   if (boot.wait(120s) != 0)
     throw std::runtime_error("boot of 20 modules failed:\n" + boot.output());
   std::smatch m;
@@ -126,7 +122,7 @@ int main(int argc, char** argv) {
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     const int domain = 1 + getpid() % 200;
-    const auto file = temp("bench_restart") + ".yaml";
+    const auto file = oscar::test::temp_path("bench_restart") + ".yaml";
     std::ofstream(file) << R"(system: bench_restart
 lease: 300ms
 modules:
@@ -134,9 +130,10 @@ modules:
   - { name: b, kernels: [ { type: relay, name: b, params: { type: Bool }, inputs: { in: a/out } } ], mode: single_step, restart: { max: 100000 } }
   - { name: c, kernels: [ { type: bench_sink, name: c, params: { type: Bool }, inputs: { in: b/out } } ], mode: single_step, restart: { max: 100000 } }
 )";
-    oscar::test::Process boot({oscar::sibling_program("oscar-boot"), file, "--domain",
-                               std::to_string(domain), "--log-dir", temp("bench_restart_logs")},
-                              temp("bench_restart") + ".log");
+    oscar::test::Process boot(
+        {oscar::sibling_program("oscar-boot"), file, "--domain", std::to_string(domain),
+         "--log-dir", oscar::test::temp_path("bench_restart_logs")},
+        oscar::test::temp_path("bench_restart") + ".log");
     oscar::DdsParticipant participant(domain, "bench-restart");
     oscar::RegistryClient registry(participant, "bench");
     const auto crashes = fail_modules(registry, {"a", "b", "c"}, kills, SIGKILL);
