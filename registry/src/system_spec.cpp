@@ -172,7 +172,7 @@ void add_coordinator_module(SystemSpec& s, const YAML::Node& node,
   kernel["type"] = "coordinator";
   kernel["name"] = SystemSpec::kCoordinatorModule;
   module["kernels"].push_back(kernel);
-  module["mode"] = "deactivated";
+  module["mode"] = "single_step";  // never triggered; a deactivated kernel takes no commands
   SystemModule m;
   m.spec = ModuleSpec::from_yaml(module, s.file);
   m.spec.where = c.where;
