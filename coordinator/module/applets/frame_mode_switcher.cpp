@@ -5,6 +5,7 @@
 #include <oscar/command_types.hpp>
 #include <oscar/coordinator/applet.hpp>
 
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -31,21 +32,24 @@ class FrameModeSwitcher final : public oscar::coordinator::Applet {
   void step(oscar::applets::AppletContext& ctx) override {
     // While it does not hold the camera it waits; one that insists commands anyway (and is
     // refused: the coordinator names the holder).
-    if (!ctx.granted(bundle_) && !insist_) {
-      last_.reset();
-      return;
-    }
+    const bool granted = ctx.granted(bundle_);
+    if (granted != granted_) current_.reset();  // a new holder sets the mode afresh
+    granted_ = granted;
+    if (!granted && !insist_) return;
     const auto now = std::chrono::steady_clock::now();
     if (last_ && now - *last_ < every_) return;
+    const auto& mode = modes_[next_ % modes_.size()];
+    if (current_ == mode) return;  // one mode only: set once per grant
     last_ = now;
     oscar::SetFrameMode request;
-    request.mode(modes_[next_ % modes_.size()]);
+    request.mode(mode);
     const auto reply = command(service_, module_, kernel_, "frame_mode", request);
     if (reply.ok()) {
+      current_ = mode;
       ++next_;
-      spdlog::info("applet {}: frame mode -> {}", name(), request.mode());
+      spdlog::info("applet {}: frame mode -> {}", name(), mode);
     } else {
-      spdlog::warn("applet {}: frame mode {} refused: {}", name(), request.mode(), reply.error());
+      spdlog::warn("applet {}: frame mode {} refused: {}", name(), mode, reply.error());
     }
   }
 
@@ -57,6 +61,8 @@ class FrameModeSwitcher final : public oscar::coordinator::Applet {
   std::chrono::milliseconds every_;
   std::vector<std::string> modes_;
   std::size_t next_ = 0;
+  bool granted_ = false;
+  std::optional<std::string> current_;  // the mode it set last while holding the camera
   std::optional<std::chrono::steady_clock::time_point> last_;
 };
 

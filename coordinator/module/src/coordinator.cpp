@@ -176,7 +176,7 @@ Coordinator::Snapshot Coordinator::snapshot() {
     e.state(runtime_->crashed(e.name()) ? "crashed"
             : holding[id]               ? "holding"
             : waiting[id]               ? "waiting"
-                                        : "running");
+                                        : "idle");
     plan.applets().push_back(std::move(e));
   }
   return snap;

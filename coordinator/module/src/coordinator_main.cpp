@@ -102,8 +102,8 @@ int main(int argc, char** argv) {
     module.wait();
     coordinator.stop();
     oscar::coordinator::the_coordinator = nullptr;
+    spdlog::set_default_logger(previous_logger);  // before the module's log sink goes
     module.stop();
-    spdlog::set_default_logger(previous_logger);
     pthread_kill(signal_waiter.native_handle(), SIGTERM);
     signal_waiter.join();
     return 0;
