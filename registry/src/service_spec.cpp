@@ -21,8 +21,10 @@ std::string text(const std::string& file, const YAML::Node& node, const std::str
 }
 
 // A scalar or a map where a list belongs would read as an empty list or one item: say so.
-const YAML::Node& list(const std::string& file, const YAML::Node& node, const std::string& what,
-                       const char* example) {
+// Returns the node by value (a handle): a range-for over a reference to the temporary argument
+// would outlive it.
+YAML::Node list(const std::string& file, const YAML::Node& node, const std::string& what,
+                const char* example) {
   if (!node.IsSequence())
     fail(file, node, fmt::format("{} must be a list, such as {}", what, example));
   return node;
