@@ -115,7 +115,10 @@ void Coordinator::loop() {
       spdlog::error("coordinator: {}", e.what());
     }
     lock.lock();
-    wake_.wait_for(lock, kTick, [&] { return stopping_; });
+    // Applets' own requests and releases are seen at the next tick; events and the registry's
+    // reports wake the loop at once.
+    wake_.wait_for(lock, kTick, [&] { return stopping_ || woken_; });
+    woken_ = false;
   }
 }
 
@@ -125,6 +128,7 @@ void Coordinator::on_system_state(const SystemState& state) {
     for (const auto& m : state.modules()) {
       modules_[m.name()] = {m.status(), m.incarnation()};
     }
+    woken_ = true;
   }
   wake_.notify_all();
 }
@@ -241,7 +245,11 @@ std::optional<std::string> Coordinator::apply_event(const std::string& applet,
       error = e.what();
     }
   });
-  if (!error) wake_.notify_all();
+  if (!error) {
+    std::lock_guard lock(mutex_);
+    woken_ = true;
+    wake_.notify_all();
+  }
   return error;
 }
 

@@ -83,6 +83,7 @@ class Coordinator final : public AppletGateway {
   std::condition_variable wake_;
   bool stopping_ = false;
   bool started_ = false;
+  bool woken_ = false;  // something to reconcile before the next tick
   std::map<std::string, std::pair<std::string, unsigned long>> modules_;  // status, incarnation
   AppletPlan published_;
   bool published_any_ = false;
