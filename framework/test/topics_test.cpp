@@ -38,6 +38,7 @@ TEST(Topics, TheWriterAndReaderOfEveryCatalogueTopicMatch) {
   expect_both_sides_match(p, topics::registry_request());
   expect_both_sides_match(p, topics::registry_reply());
   expect_both_sides_match(p, topics::system_state());
+  expect_both_sides_match(p, topics::applet_plan());
 }
 
 TEST(Topics, EveryCatalogueTopicHasANameOfItsOwn) {
@@ -52,8 +53,9 @@ TEST(Topics, EveryCatalogueTopicHasANameOfItsOwn) {
                                     topics::registry_request().name,
                                     topics::registry_reply().name,
                                     topics::system_state().name,
+                                    topics::applet_plan().name,
                                     topics::cue("k/out")};
-  EXPECT_EQ(names.size(), 12u);
+  EXPECT_EQ(names.size(), 13u);
 }
 
 TEST(Topics, CueTopicsAreNamedAfterTheirOutput) {
