@@ -206,6 +206,28 @@ TEST(Coordinator, AFailedProviderTakesTheServiceAwayAndTheRestartGivesItBackConf
       "Camera held by high again");
 }
 
+// The registry supervises the coordinator like any module. A restarted coordinator starts
+// with nothing granted: no module stays configured for a holder that lost its service.
+TEST(Coordinator, AKilledCoordinatorIsRestartedAndIdlesWhatItsHoldersLost) {
+  CoordinatedSystem c("coord_killed");
+  c.sys.running();
+  ASSERT_TRUE(c.accepted("low", "request"));
+  c.wait_cam_mode("continuous");
+  const auto s =
+      c.sys.wait_for([](const SystemState& st) { return entry(st, "coordinator") != nullptr; });
+  ASSERT_EQ(kill(static_cast<pid_t>(entry(s, "coordinator")->pid()), SIGKILL), 0);
+  c.sys.wait_for([](const SystemState& st) {
+    const auto* m = entry(st, "coordinator");
+    return m && m->incarnation() == 2 && m->status() == "running";
+  });
+  c.wait_cam_mode("deactivated");
+  c.wait_plan([](const AppletPlan& p) { return CoordinatedSystem::holders(p, "Camera").empty(); },
+              "Camera idle after the restart");
+  // And it grants again.
+  ASSERT_TRUE(c.accepted("high", "request"));
+  c.wait_cam_mode("continuous");
+}
+
 TEST(Coordinator, AnEventForAnUnknownBundleIsRefusedWithTheReason) {
   CoordinatedSystem c("coord_bad_event");
   c.sys.running();
