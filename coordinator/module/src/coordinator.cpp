@@ -126,7 +126,10 @@ void Coordinator::on_system_state(const SystemState& state) {
   {
     std::lock_guard lock(mutex_);
     for (const auto& m : state.modules()) {
-      modules_[m.name()] = {m.status(), m.incarnation()};
+      auto& known = modules_[m.name()];
+      known.running = m.status() == "running";
+      known.incarnation = m.incarnation();
+      known.ran = known.ran || known.running;
     }
     woken_ = true;
   }
@@ -188,17 +191,21 @@ Coordinator::Snapshot Coordinator::snapshot() {
 
 void Coordinator::reconcile() {
   std::map<std::string, Providers::ModuleStatus> modules;
+  std::set<std::string> down;  // ran, and does not run now (failed, restarting)
   {
     std::lock_guard lock(mutex_);
-    for (const auto& [name, m] : modules_) modules[name] = {m.first == "running", m.second};
+    for (const auto& [name, m] : modules_) {
+      modules[name] = {m.running, m.incarnation};
+      if (m.ran && !m.running) down.insert(name);
+    }
   }
-  // A service whose provider module does not run (failed, restarting) is unavailable: its
-  // holders lose it and keep their request; it is granted again once the module runs.
+  // A service whose provider module is down is unavailable: its holders lose it and keep their
+  // request; it is granted again once the module runs. (A module still starting at boot is not
+  // down: its service can be granted, and the providers are configured once it runs.)
   std::set<std::string> unavailable;
   for (const auto& svc : system_.services) {
     for (const auto& p : svc.providers) {
-      const auto it = modules.find(p.module);
-      if (it != modules.end() && !it->second.running) unavailable.insert(svc.name);
+      if (down.contains(p.module)) unavailable.insert(svc.name);
     }
   }
   runtime_->with_scheduler([&](applets::Scheduler& s) {

@@ -84,7 +84,12 @@ class Coordinator final : public AppletGateway {
   bool stopping_ = false;
   bool started_ = false;
   bool woken_ = false;  // something to reconcile before the next tick
-  std::map<std::string, std::pair<std::string, unsigned long>> modules_;  // status, incarnation
+  struct KnownModule {  // what the registry reports of a module
+    bool running = false;
+    unsigned long incarnation = 0;
+    bool ran = false;  // seen running at least once
+  };
+  std::map<std::string, KnownModule> modules_;
   AppletPlan published_;
   bool published_any_ = false;
   std::thread thread_;
