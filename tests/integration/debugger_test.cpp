@@ -28,7 +28,7 @@ namespace {
 using namespace std::chrono_literals;
 using test::BootedSystem;
 using test::entry;
-using testing::HasSubstr;
+using ::testing::HasSubstr;
 
 /// The program's path if it is on $PATH.
 std::optional<std::string> on_path(const std::string& program) {
@@ -122,7 +122,7 @@ TEST(Debugger, AModuleHeldAtABreakpointKeepsItsIncarnationAndPsShowsDebug) {
   ASSERT_TRUE(eventually([&] { return beating.load(); }, 30s)) << "no heartbeat from 'held'";
 
   // The reply may wait until gdb lets the module go: all its threads stop at the breakpoint.
-  EXPECT_TRUE(sys.config().send("held", CMD_ACTIVATE, {"held", "continuous:20ms"}, 20s).ok());
+  EXPECT_TRUE(sys.configure("held", CMD_ACTIVATE, {"held", "continuous:20ms"}, 20s).ok());
   const auto gdb_said = [&](const std::string& text) {
     return eventually([&] { return gdb.output().find(text) != std::string::npos; }, 60s, 20ms);
   };
@@ -155,7 +155,7 @@ TEST(Debugger, AModuleHeldAtABreakpointKeepsItsIncarnationAndPsShowsDebug) {
   ASSERT_EQ(ps_json.wait(30s), 0) << ps_json.output();
   const auto j = nlohmann::json::parse(ps_json.output());
   EXPECT_EQ(j["modules"][0]["debug"], "gdbserver 127.0.0.1:" + std::to_string(port));
-  EXPECT_EQ(sys.shut_down(), 0) << sys.boot().output();
+  EXPECT_EQ(sys.shut_down(), 0) << sys.boot_output();
 }
 
 constexpr const char* kCrashing = R"(
@@ -191,7 +191,7 @@ TEST(Debugger, ACrashOfAModuleUnderTheDebuggerIsStillDetected) {
   EXPECT_THAT(crashing->last_failure(), HasSubstr("SIGSEGV"));
   EXPECT_EQ(s.state(), "suspended");
   EXPECT_TRUE(eventually([&] { return !test::alive(pid); }, 10s)) << "the module process is left";
-  EXPECT_EQ(sys.shut_down(), 0) << sys.boot().output();
+  EXPECT_EQ(sys.shut_down(), 0) << sys.boot_output();
 }
 
 }  // namespace

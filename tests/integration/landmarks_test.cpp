@@ -151,7 +151,7 @@ mode: { continuous: 50ms }
   test::BootedSystem sys("landmarks_log", yaml.c_str());
   sys.running();
   std::this_thread::sleep_for(4s);
-  ASSERT_EQ(sys.shut_down(), 0) << sys.boot().output();
+  ASSERT_EQ(sys.shut_down(), 0) << sys.boot_output();
 
   mcap::Reader reader(file);
   std::map<std::string, std::vector<std::uint64_t>> seqs;  // by topic

@@ -13,6 +13,7 @@
 
 #include <oscar/configPubSubTypes.h>
 #include <oscar/coordinatorPubSubTypes.h>
+#include <oscar/pullPubSubTypes.h>
 #include <oscar/registryPubSubTypes.h>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
@@ -38,6 +39,12 @@ inline constexpr std::string_view kCuePrefix = "oscar/cue/";
 std::string cue(std::string_view address);
 /// True for a cue topic's name.
 bool is_cue(std::string_view topic);
+
+/// Pull requests to output `address` ("kernel/channel") and the producer's replies: reliable,
+/// volatile, 16 deep, without data sharing (each puller reads only its own replies through a
+/// content filter, which the producer's writer evaluates).
+TopicSpec<PullRequest, PullRequestPubSubType> pull_request(std::string_view address);
+TopicSpec<PullReply, PullReplyPubSubType> pull_reply(std::string_view address);
 
 /// Configuration commands to `module` (reliable, keep all: no command is dropped).
 TopicSpec<ConfigCommand, ConfigCommandPubSubType> config(const std::string& module);

@@ -83,10 +83,10 @@ ConfigReply ConfigClient::send_command(const std::string& module, const std::str
 
 ModuleState ConfigClient::module_state(const std::string& module,
                                        std::chrono::milliseconds timeout) {
-  const auto spec = topics::module_state();
+  const auto states = topics::module_state();
   auto* reader = participant_.subscriber().create_datareader(
-      &participant_.topic(spec.name, new ModuleStatePubSubType()), spec.reader_qos);
-  if (!reader) throw std::runtime_error("cannot read oscar/registry/module_state");
+      &participant_.topic(states.name, new ModuleStatePubSubType()), states.reader_qos);
+  if (!reader) throw std::runtime_error("cannot read " + states.name);
   const auto until = std::chrono::steady_clock::now() + timeout;
   std::optional<ModuleState> found;
   while (!found && std::chrono::steady_clock::now() < until) {

@@ -61,15 +61,17 @@ const CueTypeInfo* wire_type(DdsParticipant& p, const InputPort& input, const st
 class Module::Dds::CueReader final : public dds::DataReaderListener {
  public:
   /// `producer`: the source output's declared options, as far as they are known; `type`: the
-  /// producer's type name.
+  /// producer's type name; `replaces`: the input's reader so far, which delivers nothing more
+  /// once this one has delivered its first cue (a rewire switches at one point of the stream).
   CueReader(Dds& owner, InputPort& input, const std::string& source, const OutputOptions& producer,
-            const std::string& type)
+            const std::string& type, CueReader* replaces)
       : owner_(owner),
         input_(input),
         source_(source),
         type_(type),
         producer_(producer),
-        wire_(wire_type(owner.participant_, input, type)) {
+        wire_(wire_type(owner.participant_, input, type)),
+        replaces_(replaces) {
     auto& p = owner.participant_;
     auto& topic =
         p.topic(topics::cue(source), wire_ ? wire_->new_topic_type() : new RawCdrType(type));
@@ -87,11 +89,23 @@ class Module::Dds::CueReader final : public dds::DataReaderListener {
     for (;;) {
       auto cue = arriving.make();
       if (reader->take_next_sample(cue.get(), &info) != ReturnCode_t::RETCODE_OK) break;
-      if (info.valid_data) {
-        input_.deliver_from(arriving, std::move(cue));
-        received_ = true;
-      }
+      if (!info.valid_data) continue;
+      if (!received_) take_over();
+      std::lock_guard lock(deliver_mutex_);
+      if (retired_) continue;
+      input_.deliver_from(arriving, std::move(cue));
+      received_ = true;
     }
+  }
+  /// Delivers nothing from now on; returns once a delivery under way is done.
+  void retire() {
+    std::lock_guard lock(deliver_mutex_);
+    retired_ = true;
+  }
+  /// The reader this one replaced is deleted: nothing to retire any more.
+  void forget_replaced() {
+    std::lock_guard lock(replaces_mutex_);
+    replaces_ = nullptr;
   }
   void on_subscription_matched(dds::DataReader*,
                                const dds::SubscriptionMatchedStatus& status) override {
@@ -136,6 +150,16 @@ class Module::Dds::CueReader final : public dds::DataReaderListener {
   OutputOptions producer_;
   const CueTypeInfo* wire_;  // what the reader takes; nullptr: RawCue from RawCdrType
   std::atomic<int> matched_{0};
+  std::mutex deliver_mutex_;  // a delivery, against retire()
+  bool retired_ = false;
+  std::mutex replaces_mutex_;
+  CueReader* replaces_;
+
+  void take_over() {
+    std::lock_guard lock(replaces_mutex_);
+    if (replaces_) replaces_->retire();
+    replaces_ = nullptr;
+  }
 };
 
 Module::Dds::Dds(Module& module, int domain)
@@ -209,7 +233,7 @@ std::string Module::Dds::connect_input(InputPort& input, const std::string& sour
     auto note = fmt::format(
         "input {}/{}: no publisher of {} seen yet, so its type is unknown; it is subscribed once "
         "discovery finds one",
-        input.kernel(), input.name(), cue_topic(source));
+        input.kernel(), input.name(), topics::cue(source));
     module_.log_->warn("{}", note);
     return note;
   }
@@ -226,7 +250,13 @@ std::string Module::Dds::subscribe(InputPort& input, const std::string& source,
     std::lock_guard lock(queue_mutex_);
     awaiting_type_.erase(&input);  // subscribed now
   }
-  auto reader = std::make_unique<CueReader>(*this, input, source, producer, type);
+  CueReader* current = nullptr;  // subscribe() runs on the configuration thread only
+  {
+    std::lock_guard lock(readers_mutex_);
+    if (const auto it = readers_.find(&input); it != readers_.end()) current = it->second.get();
+  }
+  auto reader = std::make_unique<CueReader>(*this, input, source, producer, type, current);
+  auto& fresh = *reader;
   std::string note;
   if (!reader->wait_matched(until)) {
     note = fmt::format("input {}/{}: no publisher of {} matched yet; cues arrive once it appears",
@@ -248,7 +278,11 @@ std::string Module::Dds::subscribe(InputPort& input, const std::string& source,
     old = std::move(slot);
     slot = std::move(reader);
   }
-  if (old) participant_.subscriber().delete_datareader(old->reader_);
+  if (old) {
+    old->retire();
+    fresh.forget_replaced();
+    participant_.subscriber().delete_datareader(old->reader_);
+  }
   return note;
 }
 
@@ -284,7 +318,7 @@ void Module::Dds::subscribe_discovered() {
     awaiting = awaiting_type_;
   }
   for (const auto& [input, source] : awaiting) {
-    const auto seen = participant_.discovered_writer(cue_topic(source));
+    const auto seen = participant_.discovered_writer(topics::cue(source));
     if (!seen) continue;
     OutputOptions producer;
     producer.reliable = seen->reliable;
@@ -293,7 +327,7 @@ void Module::Dds::subscribe_discovered() {
       subscribe(*input, source, producer, seen->type, std::nullopt,
                 std::chrono::steady_clock::now() + std::chrono::milliseconds(2000));
       module_.log_->info("input {}/{}: subscribed to {} ({})", input->kernel(), input->name(),
-                         cue_topic(source), seen->type);
+                         topics::cue(source), seen->type);
     } catch (const std::exception& e) {
       std::lock_guard lock(queue_mutex_);
       awaiting_type_.erase(input);  // reported once, not every round

@@ -1,5 +1,7 @@
 #include "dds/pull.hpp"
 
+#include "oscar/topics.hpp"
+
 #include <thread>
 
 #include <fastcdr/Cdr.h>
@@ -15,23 +17,6 @@ namespace dds = eprosima::fastdds::dds;
 namespace {
 // Data sharing would make the writer leave content filtering to the readers (so would
 // intra-process delivery and multicast, which OSCAR's participants do not use across processes).
-dds::DataWriterQos reliable_writer() {
-  dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
-  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-  q.history().depth = 16;
-  q.data_sharing().off();
-  return q;
-}
-dds::DataReaderQos reliable_reader() {
-  dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
-  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-  q.history().depth = 16;
-  q.data_sharing().off();
-  return q;
-}
-
 // The reply filter: a reply passes if its first member, `requester`, is the filter expression.
 // Fast DDS's SQL filter would deserialize every reply (cues included) into a dynamic type; this
 // one reads one string. Both sides register it: the consumer's participant to create the
@@ -112,22 +97,16 @@ std::vector<RingEntry> answer(const RingBuffer& ring, const PullRequest& request
 }
 }  // namespace
 
-std::string pull_request_topic(const std::string& address) {
-  return "oscar/pull/" + address + "/request";
-}
-std::string pull_reply_topic(const std::string& address) {
-  return "oscar/pull/" + address + "/reply";
-}
-
 DdsPullServer::DdsPullServer(DdsParticipant& participant, OutputPort& output)
     : participant_(participant), output_(output) {
   register_requester_filter(participant);  // before the writer meets a filtered reader
+  const auto replies = topics::pull_reply(output.address());
+  const auto requests = topics::pull_request(output.address());
   replies_ = participant.publisher().create_datawriter(
-      &participant.topic(pull_reply_topic(output.address()), new PullReplyPubSubType()),
-      reliable_writer());
+      &participant.topic(replies.name, new PullReplyPubSubType()), replies.writer_qos);
   requests_ = participant.subscriber().create_datareader(
-      &participant.topic(pull_request_topic(output.address()), new PullRequestPubSubType()),
-      reliable_reader(), this, dds::StatusMask::data_available());
+      &participant.topic(requests.name, new PullRequestPubSubType()), requests.reader_qos, this,
+      dds::StatusMask::data_available());
   if (!replies_ || !requests_) {
     throw std::runtime_error("cannot create the pull endpoints of " + output.address());
   }
@@ -161,15 +140,15 @@ DdsPullSource::DdsPullSource(DdsParticipant& participant, InputPort& input,
   static std::atomic<std::uint64_t> sources{0};
   requester_ = fmt::format("{}#{}", requester, ++sources);
   register_requester_filter(participant);
+  const auto requests = topics::pull_request(source);
+  const auto replies = topics::pull_reply(source);
   requests_ = participant.publisher().create_datawriter(
-      &participant.topic(pull_request_topic(source), new PullRequestPubSubType()),
-      reliable_writer());
+      &participant.topic(requests.name, new PullRequestPubSubType()), requests.writer_qos);
   my_replies_ = participant.get().create_contentfilteredtopic(
-      pull_reply_topic(source) + "/" + requester_,
-      &participant.topic(pull_reply_topic(source), new PullReplyPubSubType()), requester_, {},
-      kRequesterFilter);
+      replies.name + "/" + requester_, &participant.topic(replies.name, new PullReplyPubSubType()),
+      requester_, {}, kRequesterFilter);
   if (my_replies_) {
-    replies_ = participant.subscriber().create_datareader(my_replies_, reliable_reader(), this,
+    replies_ = participant.subscriber().create_datareader(my_replies_, replies.reader_qos, this,
                                                           dds::StatusMask::data_available());
   }
   if (!replies_ || !requests_) {

@@ -26,9 +26,6 @@ class PullRequest;
 
 namespace oscar::internal {
 
-std::string pull_request_topic(const std::string& address);
-std::string pull_reply_topic(const std::string& address);
-
 /// Answers pull requests for one output from its ring buffer.
 class DdsPullServer final : public eprosima::fastdds::dds::DataReaderListener {
  public:

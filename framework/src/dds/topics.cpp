@@ -8,6 +8,27 @@ std::string cue(std::string_view address) { return std::string(kCuePrefix).appen
 
 bool is_cue(std::string_view topic) { return topic.starts_with(kCuePrefix); }
 
+namespace {
+template <class Qos>
+Qos without_data_sharing(Qos q) {
+  q.data_sharing().off();
+  return q;
+}
+std::string pull_topic(std::string_view address, std::string_view end) {
+  return std::string("oscar/pull/").append(address).append("/").append(end);
+}
+}  // namespace
+
+TopicSpec<PullRequest, PullRequestPubSubType> pull_request(std::string_view address) {
+  return {pull_topic(address, "request"), without_data_sharing(qos::stream_writer(16)),
+          without_data_sharing(qos::stream_reader(16))};
+}
+
+TopicSpec<PullReply, PullReplyPubSubType> pull_reply(std::string_view address) {
+  return {pull_topic(address, "reply"), without_data_sharing(qos::stream_writer(16)),
+          without_data_sharing(qos::stream_reader(16))};
+}
+
 TopicSpec<ConfigCommand, ConfigCommandPubSubType> config(const std::string& module) {
   return {"oscar/config/" + module, qos::command_writer(), qos::command_reader()};
 }

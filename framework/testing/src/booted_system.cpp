@@ -354,7 +354,7 @@ std::optional<SystemState> SystemUnderTest::wait_for(
   };
   std::vector<std::unique_ptr<CueCounter>> counters;
   for (const auto& channel : channels) {
-    const auto topic = "oscar/cue/" + channel;
+    const auto topic = topics::cue(channel);
     std::optional<DdsParticipant::DiscoveredWriter> writer;
     eventually([&] { return (writer = participant_->discovered_writer(topic)).has_value(); },
                left(), 10ms);

@@ -20,7 +20,7 @@ using ResourceId = std::uint32_t;
 using BundleId = std::uint32_t;
 
 /// How a resource wants to use its service (seed §4.2.2).
-enum class Access { kShared, kExclusive };
+enum class Access : std::uint8_t { kShared, kExclusive };
 
 /// Predefined priority levels; any int in between is allowed (seed §4.5.2).
 inline constexpr int kPriorityLow = 100;
@@ -139,6 +139,11 @@ class Model {
   std::size_t cycle_count() const {
     ensure_analysed();
     return cycles_.size();
+  }
+  /// The bundles on cycle `index` (< cycle_count()), in bundle order.
+  const std::vector<BundleId>& cycle_members(std::size_t index) const {
+    ensure_analysed();
+    return cycles_.at(index);
   }
   std::optional<std::uint32_t> cycle_index(BundleId bundle) const {
     ensure_analysed();

@@ -2,7 +2,9 @@
 // The resource plan: calculateAssignments of seed 000 Abb. 4.19–4.21, as a pure function.
 
 #include <chrono>
+#include <cstdint>
 #include <optional>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -34,6 +36,30 @@ struct GrantedUse {
   BundleId root = 0;
 };
 
+/// Who uses which service: per service its granted uses in grant order, all in one flat list
+/// (a list per service cost an allocation per service and plan).
+class UsesByService {
+ public:
+  UsesByService() = default;
+  /// From uses in grant order, each with a service below `services`.
+  UsesByService(std::size_t services, const std::vector<GrantedUse>& in_grant_order);
+
+  /// The uses of `service`, in grant order.
+  std::span<const GrantedUse> operator[](ServiceId service) const {
+    return {uses_.data() + begin_[service], begin_[service + 1] - begin_[service]};
+  }
+  /// As operator[]. @throws std::out_of_range for a service the plan does not know.
+  std::span<const GrantedUse> at(ServiceId service) const;
+  /// The number of services.
+  std::size_t size() const { return begin_.empty() ? 0 : begin_.size() - 1; }
+  /// All uses, by service, each service's in grant order.
+  const std::vector<GrantedUse>& all() const { return uses_; }
+
+ private:
+  std::vector<std::uint32_t> begin_;  // per service and one past the last: its first use
+  std::vector<GrantedUse> uses_;
+};
+
 /// What a plan needs besides the bundles' state.
 struct PlanContext {
   /// The time the plan is made for: a bundle whose deadline's t_early lies after it is not
@@ -51,9 +77,9 @@ struct Plan {
   std::chrono::milliseconds time{0};
   /// The sorted working set W_t (requested bundles); the next plan starts from it.
   std::vector<BundleId> order;
-  std::vector<char> bundle_granted;           ///< Per bundle: all its resources are granted.
-  std::vector<char> resource_granted;         ///< Per resource.
-  std::vector<std::vector<GrantedUse>> uses;  ///< Per service: who uses it.
+  std::vector<char> bundle_granted;    ///< Per bundle: all its resources are granted.
+  std::vector<char> resource_granted;  ///< Per resource.
+  UsesByService uses;                  ///< Per service: who uses it.
   /// Requested bundles of one priority whose deadlines overlap (eq. 4.11), each pair once.
   std::vector<std::pair<BundleId, BundleId>> deadline_overlaps;
   /// Per bundle: the priority it was sorted with (cycles take their highest, seed §4.5.1).

@@ -25,6 +25,7 @@
 #include "oscar/dds_participant.hpp"
 #include "oscar/output.hpp"
 #include "oscar/topic_io.hpp"
+#include "oscar/topics.hpp"
 
 namespace oscar {
 class ConfigClient;
@@ -66,7 +67,7 @@ class CueWatch {
  public:
   CueWatch(DdsParticipant& participant, const std::string& channel, std::size_t capacity = 1000)
       : capacity_(capacity),
-        reader_(participant, "oscar/cue/" + channel, reader_qos(capacity),
+        reader_(participant, topics::cue(channel), reader_qos(capacity),
                 [this](const T& cue, const auto&) {
                   std::lock_guard lock(mutex_);
                   cues_.push_back(cue);
