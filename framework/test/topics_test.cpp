@@ -38,6 +38,7 @@ TEST(Topics, TheWriterAndReaderOfEveryCatalogueTopicMatch) {
   expect_both_sides_match(p, topics::registry_request());
   expect_both_sides_match(p, topics::registry_reply());
   expect_both_sides_match(p, topics::system_state());
+  expect_both_sides_match(p, topics::applet_plan());
   expect_both_sides_match(p, topics::pull_request("k/out"));
   expect_both_sides_match(p, topics::pull_reply("k/out"));
 }
@@ -54,10 +55,11 @@ TEST(Topics, EveryCatalogueTopicHasANameOfItsOwn) {
                                     topics::registry_request().name,
                                     topics::registry_reply().name,
                                     topics::system_state().name,
+                                    topics::applet_plan().name,
                                     topics::pull_request("k/out").name,
                                     topics::pull_reply("k/out").name,
                                     topics::cue("k/out")};
-  EXPECT_EQ(names.size(), 14u);
+  EXPECT_EQ(names.size(), 15u);
 }
 
 TEST(Topics, CueTopicsAreNamedAfterTheirOutput) {

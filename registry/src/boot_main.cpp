@@ -19,6 +19,7 @@
 #include <CLI/CLI.hpp>
 #include <oscar/command_line.hpp>
 
+#include "oscar/coordinator/applet_system.hpp"
 #include "oscar/cue_types.hpp"
 #include "oscar/kernel_registry.hpp"
 #include "oscar/process_util.hpp"
@@ -147,6 +148,7 @@ int main(int argc, char** argv) {
     if (domain >= 0) system.override_domain(domain);
     oscar::register_standard_cue_types();
     system.check_modules(oscar::plugin_search_path());
+    oscar::coordinator::check_applets(system, oscar::plugin_search_path());
     const auto& local = system.local_host();
     check_hosts(system);
     if (check) {

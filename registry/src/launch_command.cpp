@@ -46,7 +46,9 @@ std::vector<std::string> module_command(const SystemSpec& system, const SystemMo
                                     incarnation)};
     argv.insert(argv.end(), module.debug.valgrind_args.begin(), module.debug.valgrind_args.end());
   }
-  argv.insert(argv.end(), {oscar_run, system.file, "--module", module.spec.name, "--incarnation",
+  // The monitor maps the program's bare name to its own copy next to it.
+  const auto& program = module.program == "oscar-run" ? oscar_run : module.program;
+  argv.insert(argv.end(), {program, system.file, "--module", module.spec.name, "--incarnation",
                            std::to_string(incarnation), "--domain",
                            std::to_string(module.spec.domain.value_or(system.domain))});
   return argv;

@@ -111,7 +111,8 @@ int main(int argc, char** argv) {
           case oscar::LAUNCH_START: {
             auto args = q.argv();
             for (auto& a : args) {
-              if (a == "oscar-run") a = oscar::sibling_program("oscar-run");
+              // Only OSCAR's own programs, found next to the monitor.
+              if (a == "oscar-run" || a == "oscar-coordinator") a = oscar::sibling_program(a);
             }
             try {
               const auto pid = supervisor.start(q.module_name(), q.incarnation(), args, q.env());

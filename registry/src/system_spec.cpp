@@ -11,6 +11,7 @@
 
 #include "oscar/module.hpp"
 #include "oscar/time.hpp"
+#include "service_spec.hpp"
 
 namespace oscar {
 namespace {
@@ -154,6 +155,36 @@ void check_replace_chains(const SystemSpec& s) {
   }
 }
 
+// The coordinator runs as a module of its own (oscar-coordinator), so the registry supervises
+// and restarts it like any other.
+void add_coordinator_module(SystemSpec& s, const YAML::Node& node,
+                            const std::vector<std::string>& plugins) {
+  const auto& c = *s.coordinator;
+  if (s.find_module(SystemSpec::kCoordinatorModule)) {
+    fail(c.where, fmt::format("a module is named '{}': the name belongs to the process of the "
+                              "coordinator: section",
+                              SystemSpec::kCoordinatorModule));
+  }
+  YAML::Node module;
+  module["name"] = SystemSpec::kCoordinatorModule;
+  module["host"] = c.host;
+  YAML::Node kernel;
+  kernel["type"] = "coordinator";
+  kernel["name"] = SystemSpec::kCoordinatorModule;
+  module["kernels"].push_back(kernel);
+  module["mode"] = "single_step";  // never triggered; a deactivated kernel takes no commands
+  SystemModule m;
+  m.spec = ModuleSpec::from_yaml(module, s.file);
+  m.spec.where = c.where;
+  m.spec.domain = s.domain;
+  m.spec.network = NetworkConfig::for_host(s.root, c.host);
+  m.spec.lease = s.lease;
+  m.spec.plugins = plugins;
+  m.restart = parse_restart(node["restart"], s.file, "coordinator.restart");
+  m.program = "oscar-coordinator";
+  s.modules.push_back(std::move(m));
+}
+
 }  // namespace
 
 std::string DebugSpec::describe() const {
@@ -169,7 +200,8 @@ SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
   s.root = root;
   if (!root.IsMap()) fail(file, "a system file is a map with system, hosts and modules");
   check_yaml_keys(root, file, "system file",
-                  {"system", "domain", "hosts", "modules", "network", "lease", "plugins"});
+                  {"system", "domain", "hosts", "modules", "network", "lease", "plugins",
+                   "services", "coordinator"});
   const auto plugins = ModuleSpec::plugins_of(root, file);
   s.name = root["system"] ? root["system"].as<std::string>() : "system";
   if (root["domain"]) {
@@ -238,6 +270,9 @@ SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
     }
   }
   check_replace_chains(s);
+  internal::parse_services(s, root["services"]);
+  internal::parse_coordinator(s, root["coordinator"]);
+  if (s.coordinator) add_coordinator_module(s, root["coordinator"], plugins);
   return s;
 }
 
@@ -245,6 +280,10 @@ void SystemSpec::check_modules(const std::vector<std::string>& plugin_path) cons
   std::vector<std::unique_ptr<Module>> built;
   std::map<std::string, const OutputPort*> outputs;  // by "<kernel>/<channel>"
   for (const auto& m : modules) {
+    if (m.program != "oscar-run") {
+      built.push_back(nullptr);  // the coordinator's kernel is linked into its program
+      continue;
+    }
     built.push_back(std::make_unique<Module>(m.spec, plugin_path));
     for (const auto& k : m.spec.kernels) {
       for (const auto& out : built.back()->kernel(k.name).ports().outputs) {
@@ -253,6 +292,7 @@ void SystemSpec::check_modules(const std::vector<std::string>& plugin_path) cons
     }
   }
   for (std::size_t i = 0; i < modules.size(); ++i) {
+    if (!built[i]) continue;
     for (const auto& k : modules[i].spec.kernels) {
       for (const auto& [input, wiring] : k.inputs) {
         if (wiring.source.empty()) continue;
@@ -302,6 +342,13 @@ const HostSpec& SystemSpec::host(const std::string& host_name) const {
     if (h.name == host_name) return h;
   }
   throw std::invalid_argument(fmt::format("{}: no host '{}'", file, host_name));
+}
+
+const ServiceSpec* SystemSpec::find_service(const std::string& service_name) const {
+  for (const auto& x : services) {
+    if (x.name == service_name) return &x;
+  }
+  return nullptr;
 }
 
 const SystemModule* SystemSpec::find_module(const std::string& module_name) const {

@@ -43,6 +43,17 @@ TEST(LaunchCommand, ModuleCommandNamesFileModuleIncarnationAndDomain) {
       (Argv{"oscar-run", "sys.yaml", "--module", "cam", "--incarnation", "3", "--domain", "9"}));
 }
 
+TEST(LaunchCommand, TheCoordinatorSectionStartsOscarCoordinatorAsAModule) {
+  const auto s = SystemSpec::parse(
+      YAML::Load("system: s\ndomain: 9\nmodules: [ { name: cam, kernels: [ { type: relay } ] } ]\n"
+                 "coordinator: { applets: [] }"),
+      "sys.yaml");
+  ASSERT_EQ(s.modules.size(), 2u);
+  EXPECT_EQ(module_command(s, s.modules[1], 1, "oscar-run", "/logs"),
+            (Argv{"oscar-coordinator", "sys.yaml", "--module", "coordinator", "--incarnation", "1",
+                  "--domain", "9"}));
+}
+
 TEST(LaunchCommand, GdbserverListensOnLoopbackOnly) {
   const auto s = one_module(", debug: { gdbserver: 2345 }");
   const auto argv = module_command(s, s.modules[0], 1, "oscar-run", "/logs");

@@ -12,11 +12,11 @@ namespace {
 using namespace std::chrono_literals;
 using testing::HasSubstr;
 
-const char* const kTools[] = {"oscar-applets",  "oscar-boot",       "oscar-config",  "oscar-echo",
-                              "oscar-graph",    "oscar-hz",         "oscar-info",    "oscar-log",
-                              "oscar-monitor",  "oscar-new-module", "oscar-ps",      "oscar-record",
-                              "oscar-registry", "oscar-replay",     "oscar-restart", "oscar-run",
-                              "oscar-swarm",    "oscar-shutdown",   "oscar-topics"};
+const char* const kTools[] = {
+    "oscar-applets",    "oscar-boot", "oscar-config", "oscar-coordinator", "oscar-echo",
+    "oscar-graph",      "oscar-hz",   "oscar-info",   "oscar-log",         "oscar-monitor",
+    "oscar-new-module", "oscar-ps",   "oscar-record", "oscar-registry",    "oscar-replay",
+    "oscar-restart",    "oscar-run",  "oscar-swarm",  "oscar-shutdown",    "oscar-topics"};
 
 struct Run {
   int exit_code;
@@ -69,6 +69,20 @@ TEST(CommandLine, AppletsRunDrawsWithSvgAsWithDot) {
   EXPECT_TRUE(std::filesystem::exists(svg + ".dot")) << r.output;
   std::filesystem::remove(svg);
   std::filesystem::remove(svg + ".dot");
+}
+
+TEST(CommandLine, AppletsPsSaysSoWhenNoCoordinatorPublishesAPlan) {
+  const auto r =
+      run("oscar-applets", {"ps", "-d", std::to_string(test::test_domain()), "--timeout", "0.5"});
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("no coordinator published its plan on domain"));
+}
+
+TEST(CommandLine, TheCoordinatorRefusesASystemFileWithoutACoordinatorSection) {
+  const auto r =
+      run("oscar-coordinator", {std::string(OSCAR_SOURCE_DIR) + "/config/demo-local.yaml"});
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("demo-local.yaml: no coordinator: section"));
 }
 
 }  // namespace

@@ -323,7 +323,16 @@ INSTANTIATE_TEST_SUITE_P(
         BadSystem{"missing_netns",
                   "hosts: { a: { local: true }, b: { netns: oscar_no_such_ns } }\nmodules: [ { "
                   "name: m, host: b, kernels: [ { type: relay } ] } ]",
-                  "network namespace 'oscar_no_such_ns' does not exist"}),
+                  "network namespace 'oscar_no_such_ns' does not exist"},
+        BadSystem{"service_of_no_module",
+                  "modules: [ { name: m, kernels: [ { type: relay } ] } ]\n"
+                  "services: { Camera: { provided_by: [cam] } }\ncoordinator: {}\n",
+                  ":2: service 'Camera'.provided_by: no module 'cam' in the system"},
+        BadSystem{"unknown_applet_type",
+                  "modules: [ { name: m, kernels: [ { type: relay } ] } ]\n"
+                  "services: { S: { provided_by: [m] } }\ncoordinator:\n  applets:\n"
+                  "    - { type: warp_applet, name: a }\n",
+                  ":5: applet 'a': unknown applet type 'warp_applet'"}),
     [](const ::testing::TestParamInfo<BadSystem>& param) { return param.param.name; });
 
 }  // namespace

@@ -1,5 +1,6 @@
 // oscar-applets run SCENARIO.yaml [--json] [--svg FILE] — runs an applet scenario on the
 // deterministic scheduler and prints the holder of every service after each step.
+// oscar-applets ps [--json] — the plan of the running system's coordinator.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
@@ -9,6 +10,9 @@
 
 #include "oscar/applets/dot.hpp"
 #include "oscar/applets/scenario.hpp"
+#ifdef OSCAR_APPLETS_LIVE
+#include "ps.hpp"
+#endif
 
 int main(int argc, char** argv) {
   CLI::App app{"Applet scheduler scenarios (seed 000): oscar applets run SCENARIO.yaml"};
@@ -22,7 +26,21 @@ int main(int argc, char** argv) {
   run->add_option("--svg,--dot", dot_file,
                   "Write a picture of the final state: FILE.svg (drawn with Graphviz; FILE.svg.dot "
                   "is kept beside it) or FILE.dot");
+#ifdef OSCAR_APPLETS_LIVE
+  oscar::tools::PsOptions ps;
+  oscar::tools::add_ps(app, ps);
+#endif
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
+#ifdef OSCAR_APPLETS_LIVE
+  if (ps.command->parsed()) {
+    try {
+      return oscar::tools::run_ps(ps);
+    } catch (const std::exception& e) {
+      std::cerr << "oscar applets ps: " << e.what() << "\n";
+      return 2;
+    }
+  }
+#endif
   try {
     const auto scenario = oscar::applets::Scenario::load_file(file);
     oscar::applets::Scheduler final_state(scenario.system().model, scenario.system().options);

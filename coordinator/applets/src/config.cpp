@@ -172,13 +172,12 @@ SystemConfig load_system(const YAML::Node& root, const std::string& file) {
     if (!deps.IsSequence())
       fail_at(deps, file, "service '" + name + "': depends_on must be a list");
     for (const auto& d : deps) {
-      YAML::Node svc = d;
-      Access access = Access::kExclusive;
-      if (d.IsMap()) {
-        allow_keys(d, file, "dependency", {"service", "access"});
-        svc = d["service"];
-        if (d["access"]) access = access_of(d["access"], file);
-      }
+      // Not `YAML::Node svc = d; svc = d["service"];`: assigning to a node that refers to `d`
+      // rewrites `d` itself (yaml-cpp nodes are references), and d["access"] then fails.
+      if (d.IsMap()) allow_keys(d, file, "dependency", {"service", "access"});
+      const YAML::Node svc = d.IsMap() ? d["service"] : d;
+      const Access access =
+          d.IsMap() && d["access"] ? access_of(d["access"], file) : Access::kExclusive;
       const std::string dep = text(svc, file, "dependency");
       const auto id = c.model.find_service(dep);
       if (!id) {

@@ -140,10 +140,28 @@ void Scheduler::crash(AppletId applet) {
     active_[b] = 0;
     stop_giving(b);
   }
-  // Its services are gone (seed §4.6.1, cascading effects): whoever uses them, directly or down
-  // the hierarchy, loses them now — there is nothing left to hand back — and is told so.
-  std::vector<char>& gone = plan_context_.unavailable;
-  for (ServiceId s : model_.applet(applet).provides) gone[s] = 1;
+  // Its services are gone (seed §4.6.1, cascading effects).
+  for (ServiceId s : model_.applet(applet).provides) plan_context_.unavailable[s] = 1;
+  revoke_unavailable();
+}
+
+void Scheduler::set_available(ServiceId service, bool available) {
+  auto& gone = plan_context_.unavailable.at(service);
+  const auto provider = model_.service(service).provider;
+  if (available && provider && crashed_.at(*provider)) return;  // gone for good
+  if ((gone == 0) == available) return;
+  gone = available ? 0 : 1;
+  if (available) {
+    replan();
+  } else {
+    revoke_unavailable();
+  }
+}
+
+void Scheduler::revoke_unavailable() {
+  // Whoever uses an unavailable service, directly or down the hierarchy, loses it now — there
+  // is nothing left to hand back — and is told so.
+  const std::vector<char>& gone = plan_context_.unavailable;
   for (BundleId b = 0; b < state_.size(); ++b) {
     if (!active_[b]) continue;
     const auto& services = services_of(b);

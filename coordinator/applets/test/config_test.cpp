@@ -44,6 +44,26 @@ timeline: []
   EXPECT_EQ(c.requested_at_start, std::vector<BundleId>{0});
 }
 
+// The long form of a dependency used to throw yaml-cpp's "operator[] call on a scalar": reading
+// its service rewrote the entry it came from.
+TEST(Config, ADependencysLongFormGivesItsServiceAndAccess) {
+  const auto s = Scenario::parse(R"(
+services:
+  - {name: Pilot}
+  - {name: Map}
+  - {name: Dock, depends_on: [{service: Pilot, access: shared}, Map]}
+timeline: []
+)",
+                                 "sys.yaml");
+  const auto& model = s.system().model;
+  const auto& deps = model.service(model.service_id("Dock")).dependencies;
+  ASSERT_EQ(deps.size(), 2u);
+  EXPECT_EQ(deps[0].service, model.service_id("Pilot"));
+  EXPECT_EQ(deps[0].access, Access::kShared);
+  EXPECT_EQ(deps[1].service, model.service_id("Map"));
+  EXPECT_EQ(deps[1].access, Access::kExclusive);
+}
+
 TEST(Config, MalformedYamlGivesFileLineAndColumn) {
   EXPECT_THAT(error_of("services:\n  - {name: Pilot\n"), HasSubstr("sys.yaml:3:"));
   EXPECT_THAT(error_of("services:\n  - {name: Pilot\n"), HasSubstr("malformed YAML"));

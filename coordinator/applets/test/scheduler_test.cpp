@@ -294,6 +294,48 @@ TEST(Scheduler, CrashReleasesOnlyTheCrashedAppletsBundles) {
   EXPECT_FALSE(s.requested(ba));
 }
 
+// A service whose modules failed goes away for a while (the coordinator, docs/coordinator.md):
+// its users, also down the hierarchy, lose it at once and are told; they keep their request and
+// get it back when it returns.
+TEST(Scheduler, AServiceAwayForAWhileIsTakenFromItsUsersAndGrantedAgainWhenBack) {
+  Model m;
+  const ServiceId camera = m.add_service("Camera", true);
+  const ServiceId tracker = m.add_service("Tracker");
+  m.add_dependency(tracker, camera);
+  const BundleId track = m.add_bundle(m.add_applet("Follow"), "t", {{tracker, kX}});
+  Scheduler s(m);
+  s.request(track);
+  ASSERT_TRUE(s.active(track));
+  s.take_notifications();
+  s.set_available(camera, false);
+  EXPECT_FALSE(s.available(camera));
+  EXPECT_FALSE(s.active(track));
+  EXPECT_TRUE(s.requested(track));
+  EXPECT_EQ(s.holder(camera), "unavailable");
+  bool told = false;
+  for (const Notification& n : s.take_notifications()) {
+    told = told || (n.kind == Notification::Kind::kRevokedByForce && n.bundle == track &&
+                    n.service == camera);
+  }
+  EXPECT_TRUE(told);
+  s.set_available(camera, true);
+  EXPECT_TRUE(s.available(camera));
+  EXPECT_TRUE(s.active(track));
+  EXPECT_EQ(s.holder(tracker), "Follow");
+}
+
+TEST(Scheduler, ACrashedServiceAppletsServiceDoesNotComeBack) {
+  Model m;
+  const ServiceId ui = m.add_service("UI", true);
+  const AppletId provider = m.add_applet("UIService");
+  m.provide(provider, ui);
+  m.add_bundle(provider, "io", {{m.add_service("Monitor"), kX}});
+  Scheduler s(m);
+  s.crash(provider);
+  s.set_available(ui, true);
+  EXPECT_FALSE(s.available(ui));
+}
+
 // Seed §4.6.1 (cascading effects): when a service applet crashes, its services are gone. Its
 // resources used to be granted again through inheritance, and the users of its service kept
 // their grant; now the users lose it at once (told, naming the service), keep their request,

@@ -12,6 +12,7 @@
 #include <string_view>
 
 #include <oscar/configPubSubTypes.h>
+#include <oscar/coordinatorPubSubTypes.h>
 #include <oscar/pullPubSubTypes.h>
 #include <oscar/registryPubSubTypes.h>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
@@ -67,6 +68,8 @@ TopicSpec<RegistryRequest, RegistryRequestPubSubType> registry_request();
 TopicSpec<RegistryReply, RegistryReplyPubSubType> registry_reply();
 /// The whole system's state, as the registry publishes it (keep last 1).
 TopicSpec<SystemState, SystemStatePubSubType> system_state();
+/// The coordinator's plan: services, holders, applets (keep last 1; `oscar applets ps`).
+TopicSpec<AppletPlan, AppletPlanPubSubType> applet_plan();
 
 }  // namespace topics
 }  // namespace oscar

@@ -75,4 +75,8 @@ TopicSpec<SystemState, SystemStatePubSubType> system_state() {
   return {"oscar/system/state", qos::state_writer(1), qos::state_reader(1)};
 }
 
+TopicSpec<AppletPlan, AppletPlanPubSubType> applet_plan() {
+  return {"oscar/coordinator/plan", qos::state_writer(1), qos::state_reader(1)};
+}
+
 }  // namespace oscar::topics

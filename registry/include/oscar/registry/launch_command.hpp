@@ -14,7 +14,8 @@ std::vector<std::string> on_host(const HostSpec& host, const std::vector<std::st
 
 /// The module process: `oscar-run FILE --module M --incarnation N --domain D`, under
 /// gdbserver (127.0.0.1:PORT) or valgrind (its log beside the module's) if the YAML says so.
-/// `oscar_run` is the program to start; `log_dir` the monitor's directory for the module.
+/// `oscar_run` is the program to start (the coordinator's module: its `program`,
+/// oscar-coordinator); `log_dir` the monitor's directory for the module.
 std::vector<std::string> module_command(const SystemSpec& system, const SystemModule& module,
                                         unsigned incarnation, const std::string& oscar_run,
                                         const std::string& log_dir);

@@ -3,6 +3,7 @@
 /// debug wrappers — parsed and checked whole before anything is started.
 
 #include <chrono>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,48 @@ struct SystemModule {
   RestartPolicy restart;
   DebugSpec debug;
   bool standby = false;  ///< started only as another module's replacement
+  /// The program the monitor starts: "oscar-run", or "oscar-coordinator" for the module the
+  /// `coordinator:` section makes.
+  std::string program = "oscar-run";
+};
+
+/// A service of the applet scheduler and the modules that provide it (docs/coordinator.md).
+struct ServiceSpec {
+  struct Provider {
+    std::string module;
+    std::string kernel;  ///< empty: every kernel of the module
+    std::string text() const { return kernel.empty() ? module : module + "/" + kernel; }
+  };
+  struct Need {
+    std::string service;
+    bool exclusive = true;
+  };
+  std::string name;
+  std::vector<Provider> providers;
+  bool exclusive_only = false;  ///< `access: exclusive`
+  std::vector<Need> needs;
+  /// `granted: {activate: MODE}`: activate the providers when the service is granted, in MODE
+  /// (mode text such as "continuous:33ms"; empty: the kernel's configured mode).
+  std::optional<std::string> activate;
+  bool idle_deactivates = false;  ///< `idle: deactivate` (else `idle: keep`)
+  std::string where;              ///< "file:line"
+};
+
+/// One applet the coordinator runs: its type (a registered applet class) and its configuration
+/// in the applet scheduler's vocabulary (name, params, bundles, fail_stop).
+struct AppletSpec {
+  std::string type;
+  std::string name;
+  YAML::Node node;
+  std::string where;
+};
+
+/// The `coordinator:` section: where the coordinator runs and what it runs.
+struct CoordinatorSpec {
+  std::string host;
+  YAML::Node scheduler;  ///< scheduler options, as the applet scheduler reads them
+  std::vector<AppletSpec> applets;
+  std::string where;
 };
 
 struct SystemSpec {
@@ -58,9 +101,14 @@ struct SystemSpec {
   std::string name;
   int domain = 0;
   std::chrono::milliseconds lease{300};
-  std::vector<HostSpec> hosts;  ///< without a `hosts:` key, one local host "localhost"
-  std::vector<SystemModule> modules;
+  std::vector<HostSpec> hosts;        ///< without a `hosts:` key, one local host "localhost"
+  std::vector<SystemModule> modules;  ///< with the coordinator's module, if there is one
+  std::vector<ServiceSpec> services;
+  std::optional<CoordinatorSpec> coordinator;
   YAML::Node root;
+
+  /// The module name the `coordinator:` section's process announces itself under.
+  static constexpr const char* kCoordinatorModule = "coordinator";
 
   /// Reads and checks a system file: unknown keys, unknown hosts, duplicate module or kernel
   /// names, wiring to unknown kernels, replace chains (unknown, not standby, cyclic).
@@ -80,6 +128,7 @@ struct SystemSpec {
   const HostSpec& local_host() const;
   const HostSpec& host(const std::string& name) const;
   const SystemModule* find_module(const std::string& name) const;
+  const ServiceSpec* find_service(const std::string& name) const;
 };
 
 }  // namespace oscar

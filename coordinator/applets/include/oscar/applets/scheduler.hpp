@@ -110,6 +110,11 @@ class Scheduler {
   /// hierarchy) lose them at once (kRevokedByForce naming the service) and keep their request,
   /// which cannot be granted while the service is gone. Nothing else is touched.
   void crash(AppletId applet);
+  /// A service goes away for a while (false: the modules providing it failed) or comes back
+  /// (true). While it is away the bundles using it, directly or down the hierarchy, lose it at
+  /// once (kRevokedByForce naming the service) and keep their request; they are granted again
+  /// when it is back. A service whose service applet crashed stays unavailable.
+  void set_available(ServiceId service, bool available);
   /// Whether the applet crashed.
   bool crashed(AppletId applet) const { return crashed_.at(applet) != 0; }
   /// Whether the service can be used: false once its service applet crashed.
@@ -168,6 +173,8 @@ class Scheduler {
   Notification notice(Notification::Kind kind, BundleId bundle,
                       std::optional<ServiceId> service = std::nullopt) const;
   void replan();
+  // Takes unavailable services from the bundles using them now, then plans again.
+  void revoke_unavailable();
   // Expiries, t_early reached and forced revocations due at now_.
   void handle_due();
   void update_handover();

@@ -1,0 +1,98 @@
+#pragma once
+/// @file The coordinator (docs/coordinator.md): binds the applet scheduler to running modules.
+/// Services are modules: granting a service configures its provider modules as the system file
+/// says (activate in a mode), idling it deactivates them. Applets run in threads of their own
+/// (the scheduler's Runtime) and command the modules of the services they hold through it; it is
+/// the only configuration authority for modules. It publishes its plan on oscar/coordinator/plan.
+
+#include <condition_variable>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <oscar/coordinator.h>
+
+#include "oscar/applets/config.hpp"
+#include "oscar/applets/runtime.hpp"
+#include "oscar/config_client.hpp"
+#include "oscar/coordinator/applet.hpp"
+#include "oscar/dds_participant.hpp"
+#include "oscar/registry/system_spec.hpp"
+#include "oscar/topic_io.hpp"
+#include "oscar/topics.hpp"
+
+namespace oscar::coordinator {
+
+class Providers;
+
+class Coordinator final : public AppletGateway {
+ public:
+  /// Builds the model from the system file's services and applets and makes every applet (from
+  /// a registered type or its plugin on `plugin_path`). Nothing runs yet.
+  /// @throws std::invalid_argument "file:line: ..." for an applet that cannot be made.
+  Coordinator(const SystemSpec& system, DdsParticipant& participant,
+              const std::vector<std::string>& plugin_path);
+  ~Coordinator() override;
+  Coordinator(const Coordinator&) = delete;
+  Coordinator& operator=(const Coordinator&) = delete;
+
+  /// Starts the applets' threads and the thread that configures the providers and publishes
+  /// the plan.
+  void start();
+  /// Stops the applets and the coordinator's thread (also called by the destructor).
+  void stop();
+
+  ConfigReply command(const std::string& applet, const std::string& service,
+                      const std::string& module, const std::string& kernel,
+                      const std::string& command, const std::string& type,
+                      std::vector<std::uint8_t> cdr) override;
+  std::string bundle_name(applets::BundleId bundle) const override;
+
+  /// The plan as it is now (what the coordinator publishes).
+  AppletPlan plan();
+
+  /// An operator's event for an applet's bundle: "request", "release" or "trigger" (what the
+  /// coordinator kernel's command port `applet` takes). Returns why it was refused, if it was.
+  std::optional<std::string> apply_event(const std::string& applet, const std::string& bundle,
+                                         const std::string& event);
+
+ private:
+  struct Snapshot;
+  Snapshot snapshot();  // under the runtime's lock
+  void loop();
+  void on_system_state(const SystemState& state);
+  // Applies what the snapshot's services need to their providers, then publishes if changed.
+  void reconcile();
+
+  const SystemSpec& system_;
+  applets::SystemConfig config_;
+  std::unique_ptr<applets::Runtime> runtime_;
+  std::vector<std::unique_ptr<Applet>> applets_;  // by AppletId
+  std::unique_ptr<ConfigClient> client_;
+  std::unique_ptr<Providers> providers_;
+  TopicWriter<AppletPlan, AppletPlanPubSubType> plan_writer_;
+  std::unique_ptr<TopicReader<SystemState, SystemStatePubSubType>> system_reader_;
+
+  std::mutex reconcile_mutex_;  // one reconciliation at a time (the loop or a command)
+  std::mutex mutex_;            // what follows
+  std::condition_variable wake_;
+  bool stopping_ = false;
+  bool started_ = false;
+  bool woken_ = false;  // something to reconcile before the next tick
+  struct KnownModule {  // what the registry reports of a module
+    bool running = false;
+    unsigned long incarnation = 0;
+    bool ran = false;  // seen running at least once
+  };
+  std::map<std::string, KnownModule> modules_;
+  AppletPlan published_;
+  bool published_any_ = false;
+  std::thread thread_;
+};
+
+}  // namespace oscar::coordinator

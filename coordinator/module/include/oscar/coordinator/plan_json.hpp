@@ -1,0 +1,23 @@
+#pragma once
+/// @file The coordinator's plan as JSON and as a table (`oscar applets ps`), and the request type
+/// of its command port `applet` (AppletEvent).
+
+#include <string>
+
+#include <oscar/coordinator.h>
+#include <oscar/coordinatorPubSubTypes.h>
+
+#include "oscar/idl_type_info.hpp"
+
+OSCAR_DECLARE_IDL_TYPE(oscar, AppletEvent)
+
+namespace oscar::coordinator {
+
+/// `{"services":{"<service>":{"holders":[..],"access":"shared|exclusive","waiting":[..]}},
+/// "applets":[{"name":..,"process":..,"state":..}]}` (one line).
+std::string plan_json(const AppletPlan& plan);
+
+/// The plan for people: one line per service (holders, access, waiting), then one per applet.
+std::string plan_table(const AppletPlan& plan);
+
+}  // namespace oscar::coordinator

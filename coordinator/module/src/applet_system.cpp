@@ -1,0 +1,69 @@
+#include "oscar/coordinator/applet_system.hpp"
+
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "oscar/coordinator/applet.hpp"
+
+namespace oscar::coordinator {
+
+applets::SystemConfig applet_system(const SystemSpec& system) {
+  // The applet scheduler's own YAML vocabulary, assembled from the system file's nodes (which
+  // keep their lines, so its messages point into the system file).
+  YAML::Node doc;
+  doc["services"] = YAML::Node(YAML::NodeType::Sequence);
+  for (const auto& svc : system.services) {
+    YAML::Node s;
+    s["name"] = svc.name;
+    s["exclusive_only"] = svc.exclusive_only;
+    for (const auto& n : svc.needs) {
+      YAML::Node d;
+      d["service"] = n.service;
+      d["access"] = n.exclusive ? "exclusive" : "shared";
+      s["depends_on"].push_back(d);
+    }
+    doc["services"].push_back(s);
+  }
+  if (!system.coordinator) return applets::load_system(doc, system.file);
+  const auto& c = *system.coordinator;
+  if (c.scheduler.IsDefined() && !c.scheduler.IsNull()) doc["scheduler"] = c.scheduler;
+  doc["applets"] = YAML::Node(YAML::NodeType::Sequence);
+  for (const auto& a : c.applets) {
+    YAML::Node applet;
+    for (const auto& kv : a.node) {
+      if (kv.first.as<std::string>() != "type") applet[kv.first] = kv.second;
+    }
+    doc["applets"].push_back(applet);
+  }
+  return applets::load_system(doc, system.file);
+}
+
+namespace {
+// Applets made only to check them: nothing runs, so nothing calls the gateway.
+class NoGateway final : public AppletGateway {
+ public:
+  ConfigReply command(const std::string&, const std::string&, const std::string&,
+                      const std::string&, const std::string&, const std::string&,
+                      std::vector<std::uint8_t>) override {
+    throw std::logic_error("an applet commanded a module while being checked");
+  }
+  std::string bundle_name(applets::BundleId) const override { return {}; }
+};
+}  // namespace
+
+void check_applets(const SystemSpec& system, const std::vector<std::string>& plugin_path) {
+  auto config = applet_system(system);
+  if (!system.coordinator) return;
+  NoGateway gateway;
+  for (const auto& a : system.coordinator->applets) {
+    AppletSetup setup(a.name, config.applet_params[a.name], gateway);
+    try {
+      make_applet(a.type, setup, plugin_path);
+    } catch (const std::exception& e) {
+      throw std::invalid_argument(fmt::format("{}: applet '{}': {}", a.where, a.name, e.what()));
+    }
+  }
+}
+
+}  // namespace oscar::coordinator

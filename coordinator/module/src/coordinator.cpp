@@ -1,0 +1,322 @@
+#include "oscar/coordinator/coordinator.hpp"
+
+#include <algorithm>
+#include <functional>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
+
+#include "oscar/coordinator/applet_system.hpp"
+#include "oscar/time.hpp"
+#include "providers.hpp"
+
+namespace oscar::coordinator {
+namespace {
+
+using applets::BundleId;
+using applets::ServiceId;
+constexpr std::chrono::milliseconds kTick{20};
+constexpr std::chrono::milliseconds kReadyWait{3000};
+
+ConfigReply refused(const std::string& module, const std::string& why) {
+  ConfigReply r;
+  r.module_name(module);
+  r.ok(false);
+  r.error(why);
+  return r;
+}
+
+std::vector<std::string> sorted(const std::set<std::string>& s) { return {s.begin(), s.end()}; }
+
+}  // namespace
+
+struct Coordinator::Snapshot {
+  std::set<std::string> in_use;  // services granted, directly or as what a granted one needs
+  AppletPlan plan;
+};
+
+Coordinator::Coordinator(const SystemSpec& system, DdsParticipant& participant,
+                         const std::vector<std::string>& plugin_path)
+    : system_(system),
+      config_(applet_system(system)),
+      plan_writer_(participant, topics::applet_plan()) {
+  runtime_ = std::make_unique<applets::Runtime>(config_.model, config_.options);
+  applets_.resize(config_.model.applets().size());
+  if (system.coordinator) {
+    for (const auto& a : system.coordinator->applets) {
+      AppletSetup setup(a.name, config_.applet_params[a.name], *this);
+      try {
+        applets_.at(config_.model.applet_id(a.name)) = make_applet(a.type, setup, plugin_path);
+      } catch (const std::exception& e) {
+        throw std::invalid_argument(fmt::format("{}: applet '{}': {}", a.where, a.name, e.what()));
+      }
+    }
+  }
+  for (std::size_t id = 0; id < applets_.size(); ++id) {
+    Applet* a = applets_[id].get();
+    if (!a) continue;  // a service applet without code of its own (none from system files yet)
+    applets::AppletCode code;
+    code.init = [a](applets::AppletContext& ctx) { a->init(ctx); };
+    code.step = [a](applets::AppletContext& ctx) { a->step(ctx); };
+    code.on_interrupt = [a, this](applets::AppletContext& ctx, const applets::Notification& n) {
+      if (!a->on_interrupt(ctx, n) && n.kind == applets::Notification::Kind::kRevokeRequested) {
+        ctx.yield(bundle_name(n.bundle));
+      }
+    };
+    code.period = a->period();
+    runtime_->set_code(a->name(), std::move(code));
+  }
+  client_ = std::make_unique<ConfigClient>(participant, "coordinator");
+  providers_ = std::make_unique<Providers>(system, *client_);
+  system_reader_ = std::make_unique<TopicReader<SystemState, SystemStatePubSubType>>(
+      participant, topics::system_state(),
+      [this](const SystemState& s, const auto&) { on_system_state(s); });
+}
+
+Coordinator::~Coordinator() {
+  stop();
+  system_reader_.reset();  // no callback into a half-destroyed object
+}
+
+void Coordinator::start() {
+  {
+    std::lock_guard lock(mutex_);
+    if (started_) return;
+    started_ = true;
+  }
+  runtime_->start();
+  runtime_->with_scheduler([&](applets::Scheduler& s) {
+    for (const BundleId b : config_.requested_at_start) s.request(b);
+  });
+  thread_ = std::thread([this] { loop(); });
+}
+
+void Coordinator::stop() {
+  {
+    std::lock_guard lock(mutex_);
+    if (stopping_) return;
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+  runtime_->stop();
+}
+
+void Coordinator::loop() {
+  std::unique_lock lock(mutex_);
+  while (!stopping_) {
+    lock.unlock();
+    try {
+      std::lock_guard reconciling(reconcile_mutex_);
+      reconcile();
+    } catch (const std::exception& e) {
+      spdlog::error("coordinator: {}", e.what());
+    }
+    lock.lock();
+    // Applets' own requests and releases are seen at the next tick; events and the registry's
+    // reports wake the loop at once.
+    wake_.wait_for(lock, kTick, [&] { return stopping_ || woken_; });
+    woken_ = false;
+  }
+}
+
+void Coordinator::on_system_state(const SystemState& state) {
+  {
+    std::lock_guard lock(mutex_);
+    for (const auto& m : state.modules()) {
+      auto& known = modules_[m.name()];
+      known.running = m.status() == "running";
+      known.incarnation = m.incarnation();
+      known.ran = known.ran || known.running;
+    }
+    woken_ = true;
+  }
+  wake_.notify_all();
+}
+
+Coordinator::Snapshot Coordinator::snapshot() {
+  Snapshot snap;
+  auto& plan = snap.plan;
+  plan.system(system_.name);
+  std::vector<char> holding(config_.model.applets().size()), waiting(holding.size());
+  runtime_->with_scheduler([&](applets::Scheduler& s) {
+    const auto& m = s.model();
+    std::vector<char> used(m.services().size());
+    std::function<void(ServiceId)> mark = [&](ServiceId id) {
+      if (used[id]) return;
+      used[id] = 1;
+      for (const auto& u : m.needs(id)) mark(u.service);
+    };
+    std::vector<std::set<std::string>> holders(used.size()), waiters(used.size());
+    for (BundleId b = 0; b < m.bundles().size(); ++b) {
+      const bool active = s.active(b);
+      if (!active && !s.requested(b)) continue;
+      const auto applet = m.bundle(b).applet;
+      (active ? holding : waiting)[applet] = 1;
+      for (const auto& u : m.bundle_uses(b)) {
+        if (active) mark(u.service);
+        (active ? holders : waiters)[u.service].insert(m.applet(applet).name);
+      }
+    }
+    for (ServiceId id = 0; id < used.size(); ++id) {
+      const auto& svc = m.service(id);
+      if (used[id]) snap.in_use.insert(svc.name);
+      ServicePlan p;
+      p.name(svc.name);
+      p.access(svc.exclusive_only ? "exclusive" : "shared");
+      p.holders(sorted(holders[id]));
+      std::set<std::string> w;
+      std::set_difference(waiters[id].begin(), waiters[id].end(), holders[id].begin(),
+                          holders[id].end(), std::inserter(w, w.end()));
+      p.waiting(sorted(w));
+      p.available(s.available(id));
+      plan.services().push_back(std::move(p));
+    }
+    plan.plans(s.plans_computed());
+  });
+  for (std::size_t id = 0; id < holding.size(); ++id) {
+    AppletEntry e;
+    e.name(config_.model.applet(static_cast<applets::AppletId>(id)).name);
+    e.process(SystemSpec::kCoordinatorModule);
+    e.state(runtime_->crashed(e.name()) ? "crashed"
+            : holding[id]               ? "holding"
+            : waiting[id]               ? "waiting"
+                                        : "idle");
+    plan.applets().push_back(std::move(e));
+  }
+  return snap;
+}
+
+void Coordinator::reconcile() {
+  std::map<std::string, Providers::ModuleStatus> modules;
+  std::set<std::string> down;  // ran, and does not run now (failed, restarting)
+  {
+    std::lock_guard lock(mutex_);
+    for (const auto& [name, m] : modules_) {
+      modules[name] = {m.running, m.incarnation};
+      if (m.ran && !m.running) down.insert(name);
+    }
+  }
+  // A service whose provider module is down is unavailable: its holders lose it and keep their
+  // request; it is granted again once the module runs. (A module still starting at boot is not
+  // down: its service can be granted, and the providers are configured once it runs.)
+  std::set<std::string> unavailable;
+  for (const auto& svc : system_.services) {
+    for (const auto& p : svc.providers) {
+      if (down.contains(p.module)) unavailable.insert(svc.name);
+    }
+  }
+  runtime_->with_scheduler([&](applets::Scheduler& s) {
+    for (const auto& svc : system_.services) {
+      const auto id = s.model().service_id(svc.name);
+      const bool available = !unavailable.contains(svc.name);
+      if (s.available(id) == available) continue;
+      spdlog::warn("coordinator: service {} is {}", svc.name,
+                   available ? "available again" : "unavailable: a module providing it is down");
+      s.set_available(id, available);
+    }
+  });
+  auto snap = snapshot();
+  providers_->apply(snap.in_use, unavailable, modules);
+  AppletPlan unstamped = snap.plan;
+  if (!published_any_ || !(unstamped == published_)) {
+    published_ = unstamped;
+    published_any_ = true;
+    snap.plan.stamp_ns(static_cast<unsigned long long>(wall_now()));
+    plan_writer_.write(snap.plan);
+  }
+}
+
+AppletPlan Coordinator::plan() { return snapshot().plan; }
+
+std::optional<std::string> Coordinator::apply_event(const std::string& applet,
+                                                    const std::string& bundle,
+                                                    const std::string& event) {
+  std::optional<std::string> error;
+  runtime_->with_scheduler([&](applets::Scheduler& s) {
+    try {
+      const auto& m = s.model();
+      const auto b = m.bundle_id(m.applet_id(applet), bundle);
+      if (event == "request") {
+        s.request(b);
+      } else if (event == "release") {
+        s.release(b);
+      } else if (event == "trigger") {
+        s.trigger(b);
+      } else {
+        error = fmt::format("unknown event '{}' (events: request, release, trigger)", event);
+      }
+    } catch (const std::invalid_argument& e) {
+      error = e.what();
+    }
+  });
+  if (!error) {
+    std::lock_guard lock(mutex_);
+    woken_ = true;
+    wake_.notify_all();
+  }
+  return error;
+}
+
+std::string Coordinator::bundle_name(applets::BundleId bundle) const {
+  return config_.model.bundle(bundle).name;
+}
+
+ConfigReply Coordinator::command(const std::string& applet, const std::string& service,
+                                 const std::string& module, const std::string& kernel,
+                                 const std::string& command, const std::string& type,
+                                 std::vector<std::uint8_t> cdr) {
+  const auto* svc = system_.find_service(service);
+  if (!svc) return refused(module, fmt::format("no service '{}' in the system", service));
+  const bool provides = std::any_of(svc->providers.begin(), svc->providers.end(), [&](auto& p) {
+    return p.module == module && (p.kernel.empty() || p.kernel == kernel);
+  });
+  if (!provides) {
+    std::vector<std::string> names;
+    for (const auto& p : svc->providers) names.push_back(p.text());
+    return refused(module, fmt::format("{}/{} does not provide service '{}' (its providers: {})",
+                                       module, kernel, service, fmt::join(names, ", ")));
+  }
+  bool holds = false;
+  std::string holder;
+  runtime_->with_scheduler([&](applets::Scheduler& s) {
+    const auto& m = s.model();
+    const auto id = m.service_id(service);
+    for (const BundleId b : m.applet(m.applet_id(applet)).bundles) {
+      if (!s.active(b)) continue;
+      for (const auto& u : m.bundle_uses(b)) holds = holds || u.service == id;
+    }
+    holder = s.active_holder(id);
+  });
+  if (!holds) {
+    return refused(module,
+                   fmt::format("applet '{}' does not hold service '{}': {}", applet, service,
+                               holder == "none" ? std::string("nobody holds it now")
+                                                : fmt::format("it is held by '{}'", holder)));
+  }
+  std::lock_guard reconciling(reconcile_mutex_);
+  // The holder may be quicker than the loop: configure the providers first (a deactivated
+  // kernel refuses commands).
+  const auto until = std::chrono::steady_clock::now() + kReadyWait;
+  reconcile();
+  while (!providers_->ready(service)) {
+    if (std::chrono::steady_clock::now() > until) {
+      return refused(module, fmt::format("the providers of service '{}' could not be configured "
+                                         "for its holder (see the coordinator's log)",
+                                         service));
+    }
+    std::this_thread::sleep_for(kTick);
+    reconcile();
+  }
+  try {
+    auto reply = client_->send_command(module, kernel, command, type, cdr);
+    if (reply.ok()) providers_->record(service, module, kernel, command, type, std::move(cdr));
+    return reply;
+  } catch (const std::exception& e) {
+    return refused(module, e.what());
+  }
+}
+
+}  // namespace oscar::coordinator

@@ -1,0 +1,144 @@
+// The applet API: registration, making applets by type, the system file's applet system.
+#include "oscar/coordinator/applet.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <oscar/command_types.hpp>
+
+#include "oscar/coordinator/applet_system.hpp"
+
+namespace oscar::coordinator {
+namespace {
+
+using ::testing::HasSubstr;
+
+class RecordingGateway final : public AppletGateway {
+ public:
+  ConfigReply command(const std::string& applet, const std::string& service,
+                      const std::string& module, const std::string& kernel,
+                      const std::string& command, const std::string& type,
+                      std::vector<std::uint8_t> cdr) override {
+    sent = applet + " " + service + " " + module + "/" + kernel + " " + command + " " + type;
+    bytes = cdr.size();
+    ConfigReply r;
+    r.ok(true);
+    return r;
+  }
+  std::string bundle_name(applets::BundleId) const override { return "b"; }
+  std::string sent;
+  std::size_t bytes = 0;
+};
+
+class Echo final : public Applet {
+ public:
+  explicit Echo(AppletSetup& setup) : Applet(setup), mode_(setup.param("mode", "full")) {}
+  void step(applets::AppletContext&) override {}
+  ConfigReply send() {
+    SetFrameMode r;
+    r.mode(mode_);
+    return command("Camera", "cam", "grab", "frame_mode", r);
+  }
+
+ private:
+  std::string mode_;
+};
+
+}  // namespace
+}  // namespace oscar::coordinator
+
+OSCAR_REGISTER_APPLET(oscar::coordinator::Echo, "test_echo")
+
+namespace oscar::coordinator {
+namespace {
+
+TEST(Applet, ARegisteredTypeIsMadeWithItsNameAndParams) {
+  RecordingGateway gateway;
+  AppletSetup setup("e", {{"mode", "half"}}, gateway);
+  auto applet = make_applet("test_echo", setup, {});
+  EXPECT_EQ(applet->name(), "e");
+  EXPECT_TRUE(dynamic_cast<Echo&>(*applet).send().ok());
+  EXPECT_EQ(gateway.sent, "e Camera cam/grab frame_mode oscar::SetFrameMode");
+  EXPECT_GT(gateway.bytes, 0u);
+}
+
+TEST(Applet, AnUnknownTypeIsAnErrorNamingTheFoldersAndTheKnownTypes) {
+  RecordingGateway gateway;
+  AppletSetup setup("e", {}, gateway);
+  try {
+    make_applet("tset_echo", setup, {"/nowhere"});
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_THAT(e.what(), HasSubstr("unknown applet type 'tset_echo': no plugin "
+                                    "liboscar_applet_tset_echo.so in [/nowhere]"));
+    EXPECT_THAT(e.what(), HasSubstr("test_echo"));
+  }
+}
+
+constexpr const char* kSystem = R"(system: t
+modules:
+  - { name: cam, kernels: [ { type: relay, name: grab } ], mode: deactivated }
+  - { name: drive, kernels: [ { type: relay, name: pilot } ], mode: deactivated }
+services:
+  Camera:
+    provided_by: [cam/grab]
+    access: exclusive
+    granted: { activate: "continuous:50ms" }
+    idle: deactivate
+  Pilot: { provided_by: [drive], needs: [Camera], granted: activate }
+coordinator:
+  applets:
+    - type: frame_mode_switcher
+      name: switcher
+      params: { mode: half }
+      bundles: [ { name: cam, priority: high, resources: [ { service: Camera } ], requested: true } ]
+)";
+
+SystemSpec parse(const std::string& text) { return SystemSpec::parse(YAML::Load(text), "s.yaml"); }
+
+TEST(AppletSystem, HasTheServicesTheirNeedsAndTheApplets) {
+  const auto config = applet_system(parse(kSystem));
+  const auto& model = config.model;
+  const auto camera = model.service_id("Camera");
+  EXPECT_TRUE(model.service(camera).exclusive_only);
+  ASSERT_EQ(model.service(model.service_id("Pilot")).dependencies.size(), 1u);
+  EXPECT_EQ(model.service(model.service_id("Pilot")).dependencies[0].service, camera);
+  const auto applet = model.applet_id("switcher");
+  EXPECT_EQ(model.bundle(model.bundle_id(applet, "cam")).priority, applets::kPriorityHigh);
+  EXPECT_EQ(config.applet_params.at("switcher").at("mode"), "half");
+  EXPECT_EQ(config.requested_at_start.size(), 1u);
+}
+
+TEST(AppletSystem, AppletBundlesAreCheckedWithTheirLinesInTheSystemFile) {
+  std::string text = kSystem;
+  const std::string camera = "service: Camera }";
+  text.replace(text.find(camera), camera.size(), "service: Light }");
+  try {
+    applet_system(parse(text));
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("s.yaml:17: applet 'switcher' bundle 'cam': unknown service "
+                                    "'Light'"));
+  }
+}
+
+TEST(AppletSystem, CheckAppletsNamesAnAppletWhoseTypeCannotBeMade) {
+  std::string text = kSystem;
+  text.replace(text.find("frame_mode_switcher"), 19, "frame_mode_swticher");
+  try {
+    check_applets(parse(text), {"/nowhere"});
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("s.yaml:14: applet 'switcher': unknown applet type "
+                                    "'frame_mode_swticher'"));
+  }
+  EXPECT_NO_THROW(check_applets(parse(kSystem), {"/nowhere"}));  // linked into this test
+}
+
+TEST(AppletSystem, AnAppletsBadParamsAreAnErrorWhenChecked) {
+  std::string text = kSystem;
+  text.replace(text.find("{ mode: half }"), 14, "{ modes: '' }");
+  EXPECT_THROW(check_applets(parse(text), {}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace oscar::coordinator

@@ -1,0 +1,205 @@
+#include "service_spec.hpp"
+
+#include <algorithm>
+#include <functional>
+#include <map>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+namespace oscar::internal {
+namespace {
+
+[[noreturn]] void fail(const std::string& file, const YAML::Node& node, const std::string& m) {
+  throw std::invalid_argument(yaml_where(file, node) + ": " + m);
+}
+
+std::string text(const std::string& file, const YAML::Node& node, const std::string& what) {
+  if (!node || !node.IsScalar()) fail(file, node, what + " must be a text value");
+  return node.as<std::string>();
+}
+
+// A scalar or a map where a list belongs would read as an empty list or one item: say so.
+// Returns the node by value (a handle): a range-for over a reference to the temporary argument
+// would outlive it.
+YAML::Node list(const std::string& file, const YAML::Node& node, const std::string& what,
+                const char* example) {
+  if (!node.IsSequence())
+    fail(file, node, fmt::format("{} must be a list, such as {}", what, example));
+  return node;
+}
+
+ServiceSpec::Provider provider_of(const SystemSpec& s, const YAML::Node& node,
+                                  const std::string& what) {
+  const auto t = text(s.file, node, what + " entry");
+  const auto slash = t.find('/');
+  ServiceSpec::Provider p{t.substr(0, slash),
+                          slash == std::string::npos ? "" : t.substr(slash + 1)};
+  const auto* m = s.find_module(p.module);
+  if (!m) {
+    std::vector<std::string> names;
+    for (const auto& x : s.modules) names.push_back(x.spec.name);
+    fail(s.file, node,
+         fmt::format("{}: no module '{}' in the system (modules: {})", what, p.module,
+                     fmt::join(names, ", ")));
+  }
+  if (!p.kernel.empty() && !m->spec.find_kernel(p.kernel)) {
+    fail(s.file, node, fmt::format("{}: module '{}' has no kernel '{}'", what, p.module, p.kernel));
+  }
+  return p;
+}
+
+void parse_granted(ServiceSpec& svc, const std::string& file, const YAML::Node& node,
+                   const std::string& what) {
+  if (node.IsScalar() && node.Scalar() == "nothing") return;
+  if (node.IsScalar() && node.Scalar() == "activate") {
+    svc.activate = "";
+    return;
+  }
+  if (!node.IsMap()) {
+    fail(file, node, what + ": expected {activate: MODE}, activate or nothing");
+  }
+  check_yaml_keys(node, file, what, {"activate"});
+  if (!node["activate"]) fail(file, node, what + ": expected {activate: MODE}");
+  const auto mode = text(file, node["activate"], what + ".activate");
+  try {
+    if (ModeSpec::parse_text(mode).kind == ModeSpec::Kind::kDeactivated) {
+      throw std::invalid_argument("a granted service's modules cannot be activated deactivated");
+    }
+  } catch (const std::invalid_argument& e) {
+    fail(file, node["activate"], fmt::format("{}.activate: {}", what, e.what()));
+  }
+  svc.activate = mode;
+}
+
+// A cycle of services needing each other can never be granted: no applet can break it.
+void check_cycles(const SystemSpec& s) {
+  std::map<std::string, int> state;  // 0 new, 1 on the path, 2 done
+  std::vector<std::string> path;
+  std::function<void(const ServiceSpec&)> visit = [&](const ServiceSpec& svc) {
+    state[svc.name] = 1;
+    path.push_back(svc.name);
+    for (const auto& n : svc.needs) {
+      if (state[n.service] == 1) {
+        path.push_back(n.service);
+        const auto start = std::find(path.begin(), path.end(), n.service);
+        const auto& first = *s.find_service(n.service);
+        throw std::invalid_argument(fmt::format(
+            "{}: service '{}': a cycle of needs: {} (services that need each other can never be "
+            "granted)",
+            first.where, first.name,
+            fmt::join(std::vector<std::string>(start, path.end()), " -> ")));
+      }
+      if (state[n.service] == 0) visit(*s.find_service(n.service));
+    }
+    path.pop_back();
+    state[svc.name] = 2;
+  };
+  for (const auto& svc : s.services) {
+    if (state[svc.name] == 0) visit(svc);
+  }
+}
+
+}  // namespace
+
+void parse_services(SystemSpec& s, const YAML::Node& node) {
+  if (!node) return;
+  if (!node.IsMap()) fail(s.file, node, "services: a map of service names to services");
+  for (const auto& kv : node) {
+    ServiceSpec svc;
+    svc.name = kv.first.as<std::string>();
+    svc.where = yaml_where(s.file, kv.first);
+    const auto what = "service '" + svc.name + "'";
+    const auto& n = kv.second;
+    if (!n.IsMap()) fail(s.file, n, what + ": expected a map with provided_by");
+    check_yaml_keys(n, s.file, what, {"provided_by", "access", "needs", "granted", "idle"});
+    if (!n["provided_by"]) fail(s.file, n, what + ": provided_by is missing");
+    for (const auto& p :
+         list(s.file, n["provided_by"], what + ".provided_by", "[cam, marks/mark_a]")) {
+      svc.providers.push_back(provider_of(s, p, what + ".provided_by"));
+    }
+    if (n["access"]) {
+      const auto a = text(s.file, n["access"], what + ".access");
+      if (a != "shared" && a != "exclusive") {
+        fail(s.file, n["access"],
+             fmt::format("{}.access '{}': expected shared or exclusive", what, a));
+      }
+      svc.exclusive_only = a == "exclusive";
+    }
+    if (n["granted"]) parse_granted(svc, s.file, n["granted"], what + ".granted");
+    if (n["idle"]) {
+      const auto idle = text(s.file, n["idle"], what + ".idle");
+      if (idle != "deactivate" && idle != "keep") {
+        fail(s.file, n["idle"],
+             fmt::format("{}.idle '{}': expected deactivate or keep", what, idle));
+      }
+      svc.idle_deactivates = idle == "deactivate";
+    }
+    if (s.find_service(svc.name)) fail(s.file, kv.first, "duplicate service '" + svc.name + "'");
+    s.services.push_back(std::move(svc));
+  }
+  // Needs in a second pass: their order in the file does not matter.
+  for (auto& svc : s.services) {
+    const auto what = "service '" + svc.name + "'";
+    const auto needs = node[svc.name]["needs"];
+    if (!needs) continue;
+    for (const auto& d : list(s.file, needs, what + ".needs", "[Pilot]")) {
+      ServiceSpec::Need need;
+      YAML::Node name = d;
+      if (d.IsMap()) {
+        check_yaml_keys(d, s.file, what + ".needs", {"service", "access"});
+        name = d["service"];
+        if (d["access"]) need.exclusive = text(s.file, d["access"], "access") != "shared";
+      }
+      need.service = text(s.file, name, what + ".needs entry");
+      if (!s.find_service(need.service)) {
+        fail(s.file, name,
+             fmt::format("{} needs service '{}', which is not declared under "
+                         "services:",
+                         what, need.service));
+      }
+      if (need.service == svc.name) fail(s.file, name, what + " needs itself");
+      svc.needs.push_back(need);
+    }
+  }
+  check_cycles(s);
+}
+
+void parse_coordinator(SystemSpec& s, const YAML::Node& node) {
+  if (!node) {
+    if (!s.services.empty()) {
+      fail(s.file, s.root["services"], "services: need a coordinator: section (who grants them)");
+    }
+    return;
+  }
+  if (!node.IsMap()) fail(s.file, node, "coordinator: expected a map with host and applets");
+  check_yaml_keys(node, s.file, "coordinator", {"host", "applets", "scheduler", "restart"});
+  CoordinatorSpec c;
+  c.where = yaml_where(s.file, node);
+  if (node["host"]) {
+    c.host = text(s.file, node["host"], "coordinator.host");
+    const bool known = std::any_of(s.hosts.begin(), s.hosts.end(),
+                                   [&](const HostSpec& h) { return h.name == c.host; });
+    if (!known) fail(s.file, node["host"], fmt::format("coordinator: unknown host '{}'", c.host));
+  } else {
+    if (s.hosts.size() != 1)
+      fail(s.file, node, "coordinator: name its host (several are declared)");
+    c.host = s.hosts.front().name;
+  }
+  if (node["scheduler"]) c.scheduler = node["scheduler"];
+  if (node["applets"]) {
+    for (const auto& a :
+         list(s.file, node["applets"], "coordinator.applets", "[{type: T, name: N}]")) {
+      if (!a.IsMap())
+        fail(s.file, a, "coordinator.applets: each applet is a map with type and name");
+      check_yaml_keys(a, s.file, "applet", {"type", "name", "params", "bundles", "fail_stop"});
+      AppletSpec spec{text(s.file, a["type"], "applet type"),
+                      text(s.file, a["name"], "applet name"), a, yaml_where(s.file, a)};
+      c.applets.push_back(std::move(spec));
+    }
+  }
+  s.coordinator = std::move(c);
+}
+
+}  // namespace oscar::internal

@@ -1,0 +1,158 @@
+// The services: and coordinator: sections of a system file (docs/coordinator.md).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "oscar/registry/system_spec.hpp"
+
+namespace oscar {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr const char* kModules = R"(system: t
+modules:
+  - { name: cam, kernels: [ { type: relay, name: grab } ], mode: deactivated }
+  - { name: drive, kernels: [ { type: relay, name: pilot } ], mode: deactivated }
+)";
+
+SystemSpec parse(const std::string& rest) {
+  return SystemSpec::parse(YAML::Load(std::string(kModules) + rest), "s.yaml");
+}
+
+std::string error_of(const std::string& rest) {
+  try {
+    parse(rest);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+constexpr const char* kGood = R"(services:
+  Camera:
+    provided_by: [cam/grab]
+    access: exclusive
+    granted: { activate: "continuous:50ms" }
+    idle: deactivate
+  Pilot: { provided_by: [drive], needs: [Camera], granted: activate }
+coordinator:
+  applets:
+    - type: frame_mode_switcher
+      name: switcher
+      params: { mode: half }
+      bundles: [ { name: cam, priority: high, resources: [ { service: Camera } ], requested: true } ]
+)";
+
+TEST(ServiceSpec, ServicesNameTheirProvidersAccessNeedsAndWhatGrantingAndIdlingMean) {
+  const auto s = parse(kGood);
+  ASSERT_EQ(s.services.size(), 2u);
+  const auto& camera = *s.find_service("Camera");
+  ASSERT_EQ(camera.providers.size(), 1u);
+  EXPECT_EQ(camera.providers[0].module, "cam");
+  EXPECT_EQ(camera.providers[0].kernel, "grab");
+  EXPECT_TRUE(camera.exclusive_only);
+  EXPECT_EQ(camera.activate, "continuous:50ms");
+  EXPECT_TRUE(camera.idle_deactivates);
+  const auto& pilot = *s.find_service("Pilot");
+  EXPECT_EQ(pilot.providers[0].text(), "drive");
+  EXPECT_FALSE(pilot.exclusive_only);
+  EXPECT_EQ(pilot.activate, "");  // the kernel's configured mode
+  EXPECT_FALSE(pilot.idle_deactivates);
+  ASSERT_EQ(pilot.needs.size(), 1u);
+  EXPECT_EQ(pilot.needs[0].service, "Camera");
+}
+
+TEST(ServiceSpec, TheCoordinatorBecomesASupervisedModuleOnItsHostWithItsApplets) {
+  const auto s = parse(kGood);
+  ASSERT_TRUE(s.coordinator);
+  EXPECT_EQ(s.coordinator->host, "localhost");
+  ASSERT_EQ(s.coordinator->applets.size(), 1u);
+  EXPECT_EQ(s.coordinator->applets[0].type, "frame_mode_switcher");
+  EXPECT_EQ(s.coordinator->applets[0].name, "switcher");
+  const auto* m = s.find_module("coordinator");
+  ASSERT_NE(m, nullptr);
+  EXPECT_EQ(m->program, "oscar-coordinator");
+  EXPECT_EQ(m->spec.host, "localhost");
+  EXPECT_EQ(m->restart.kind, RestartPolicy::Kind::kAuto);
+}
+
+TEST(ServiceSpec, AServiceProvidedByAModuleThatDoesNotExistIsAnError) {
+  EXPECT_THAT(error_of("services: { Camera: { provided_by: [eye] } }\ncoordinator: {}\n"),
+              HasSubstr("s.yaml:5: service 'Camera'.provided_by: no module 'eye' in the system "
+                        "(modules: cam, drive)"));
+  EXPECT_THAT(
+      error_of("services: { Camera: { provided_by: [cam/eye] } }\ncoordinator: {}\n"),
+      HasSubstr("s.yaml:5: service 'Camera'.provided_by: module 'cam' has no kernel 'eye'"));
+}
+
+TEST(ServiceSpec, ADependencyOnAMissingServiceIsAnError) {
+  EXPECT_THAT(
+      error_of("services: { Pilot: { provided_by: [drive], needs: [Map] } }\ncoordinator: {}\n"),
+      HasSubstr("s.yaml:5: service 'Pilot' needs service 'Map', which is not declared under "
+                "services:"));
+}
+
+TEST(ServiceSpec, ACycleOfServicesIsAnErrorNamingTheCycle) {
+  EXPECT_THAT(error_of(R"(services:
+  A: { provided_by: [cam], needs: [B] }
+  B: { provided_by: [drive], needs: [C] }
+  C: { provided_by: [drive], needs: [A] }
+coordinator: {}
+)"),
+              HasSubstr("s.yaml:6: service 'A': a cycle of needs: A -> B -> C -> A"));
+}
+
+TEST(ServiceSpec, UnknownKeysAreErrorsWithTheirLine) {
+  EXPECT_THAT(error_of("services:\n  Camera: { provided_by: [cam], acess: shared }\n"
+                       "coordinator: {}\n"),
+              HasSubstr("s.yaml:6"));
+  EXPECT_THAT(error_of("services:\n  Camera: { provided_by: [cam], acess: shared }\n"
+                       "coordinator: {}\n"),
+              HasSubstr("acess"));
+  EXPECT_THAT(error_of("coordinator: { host: localhost, aplets: [] }\n"), HasSubstr("aplets"));
+  EXPECT_THAT(error_of("coordinator:\n  applets:\n    - { type: t, name: a, bundels: [] }\n"),
+              HasSubstr("s.yaml:7"));
+}
+
+TEST(ServiceSpec, AScalarWhereAListBelongsIsAnError) {
+  EXPECT_THAT(error_of("services: { Camera: { provided_by: cam } }\ncoordinator: {}\n"),
+              HasSubstr("s.yaml:5: service 'Camera'.provided_by must be a list, such as "
+                        "[cam, marks/mark_a]"));
+  EXPECT_THAT(error_of("services:\n  Camera: { provided_by: [cam] }\n"
+                       "  Pilot: { provided_by: [drive], needs: Camera }\ncoordinator: {}\n"),
+              HasSubstr("s.yaml:7: service 'Pilot'.needs must be a list, such as [Pilot]"));
+  EXPECT_THAT(error_of("coordinator: { applets: { type: t } }\n"),
+              HasSubstr("coordinator.applets must be a list"));
+}
+
+TEST(ServiceSpec, BadAccessGrantedAndIdleValuesAreErrors) {
+  EXPECT_THAT(error_of("services: { C: { provided_by: [cam], access: mine } }\ncoordinator: {}\n"),
+              HasSubstr("service 'C'.access 'mine': expected shared or exclusive"));
+  EXPECT_THAT(error_of("services: { C: { provided_by: [cam], granted: { activate: often } } }\n"
+                       "coordinator: {}\n"),
+              HasSubstr("service 'C'.granted.activate: mode 'often'"));
+  EXPECT_THAT(error_of("services: { C: { provided_by: [cam], idle: sleep } }\ncoordinator: {}\n"),
+              HasSubstr("service 'C'.idle 'sleep': expected deactivate or keep"));
+}
+
+TEST(ServiceSpec, ServicesNeedACoordinatorAndTheCoordinatorsNameIsReserved) {
+  EXPECT_THAT(error_of("services: { C: { provided_by: [cam] } }\n"),
+              HasSubstr("services: need a coordinator: section"));
+  try {
+    SystemSpec::parse(
+        YAML::Load("modules: [ { name: coordinator, kernels: [ { type: relay } ] } ]\n"
+                   "coordinator: {}\n"),
+        "s.yaml");
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("a module is named 'coordinator'"));
+  }
+}
+
+TEST(ServiceSpec, TheCoordinatorsHostMustBeDeclared) {
+  EXPECT_THAT(error_of("coordinator: { host: mars }\n"),
+              HasSubstr("s.yaml:5: coordinator: unknown host 'mars'"));
+}
+
+}  // namespace
+}  // namespace oscar

@@ -1,0 +1,240 @@
+// The coordinator in a booted system (docs/coordinator.md): granting a service activates its
+// provider module, releasing it deactivates it, a higher priority preempts and the old holder's
+// command is refused naming the new holder, `oscar applets ps --json` shows the plan, and a
+// restarted provider gets its holder's configuration back.
+#include <signal.h>
+
+#include <condition_variable>
+#include <fstream>
+#include <mutex>
+#include <optional>
+#include <sstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "booted_system.hpp"
+#include "oscar/config_client.hpp"
+#include "oscar/coordinator/plan_json.hpp"
+#include "oscar/topic_io.hpp"
+#include "oscar/topics.hpp"
+
+namespace oscar {
+namespace {
+
+using test::entry;
+using ::testing::HasSubstr;
+
+// The example of docs/coordinator.md.
+std::string camera_system() {
+  std::ifstream in(std::string(OSCAR_SOURCE_DIR) + "/config/coordinator-camera.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The booted camera system, the coordinator's plan as published, and a client that sends the
+// applets' events with boot's authority.
+class CoordinatedSystem {
+ public:
+  explicit CoordinatedSystem(const std::string& name)
+      : sys(name, camera_system()),
+        plans_(sys.participant(), topics::applet_plan(),
+               [this](const AppletPlan& p, const auto&) {
+                 std::lock_guard lock(mutex_);
+                 plan_ = p;
+                 changed_.notify_all();
+               }),
+        client_(sys.participant(), "boot") {}
+
+  // The first plan satisfying `pred`; fails the test after a generous wait.
+  AppletPlan wait_plan(const std::function<bool(const AppletPlan&)>& pred, const char* what) {
+    std::unique_lock lock(mutex_);
+    if (changed_.wait_for(lock, std::chrono::seconds(30), [&] { return plan_ && pred(*plan_); })) {
+      return *plan_;
+    }
+    ADD_FAILURE() << "the plan never showed " << what
+                  << "; last: " << (plan_ ? coordinator::plan_json(*plan_) : "none")
+                  << "\nboot output:\n"
+                  << sys.boot_output();
+    return plan_.value_or(AppletPlan{});
+  }
+
+  static std::vector<std::string> holders(const AppletPlan& p, const std::string& service) {
+    for (const auto& s : p.services()) {
+      if (s.name() == service) return s.holders();
+    }
+    return {"(no such service)"};
+  }
+
+  ConfigReply event(const std::string& applet, const std::string& what) {
+    AppletEvent e;
+    e.applet(applet);
+    e.bundle("camera");
+    e.event(what);
+    return client_.command("coordinator", "coordinator", "applet", e);
+  }
+
+  ::testing::AssertionResult accepted(const std::string& applet, const std::string& what) {
+    const auto reply = event(applet, what);
+    if (reply.ok()) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << applet << " " << what << ": " << reply.error();
+  }
+
+  // The camera kernel's mode as the registry reports it reaches `mode`.
+  void wait_cam_mode(const std::string& mode) {
+    sys.wait_for([&](const SystemState& st) {
+      const auto* m = entry(st, "cam");
+      const auto* k = m ? test::kernel_state(*m, "cam") : nullptr;
+      return k && k->mode() == mode && m->status() == "running";
+    });
+  }
+
+  // Boot's merged log shows `text` (the coordinator's and applets' lines reach it).
+  ::testing::AssertionResult logged(const std::string& text) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (std::chrono::steady_clock::now() < until) {
+      if (sys.boot_output().find(text) != std::string::npos) {
+        return ::testing::AssertionSuccess();
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return ::testing::AssertionFailure() << "boot's log never showed '" << text << "':\n"
+                                         << sys.boot_output();
+  }
+
+  test::BootedSystem sys;
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::optional<AppletPlan> plan_;
+  TopicReader<AppletPlan, AppletPlanPubSubType> plans_;
+  ConfigClient client_;
+};
+
+using Strings = std::vector<std::string>;
+
+TEST(Coordinator, AnAppletsRequestActivatesTheProviderAndReleasingDeactivatesIt) {
+  CoordinatedSystem c("coord_grant");
+  c.sys.running();
+  c.wait_plan([](const AppletPlan& p) { return CoordinatedSystem::holders(p, "Camera").empty(); },
+              "Camera idle");
+  c.wait_cam_mode("deactivated");
+
+  ASSERT_TRUE(c.accepted("low", "request"));
+  c.wait_plan(
+      [](const AppletPlan& p) { return CoordinatedSystem::holders(p, "Camera") == Strings{"low"}; },
+      "Camera held by low");
+  c.wait_cam_mode("continuous");
+  // The holder's command reached the framegrabber through the coordinator.
+  EXPECT_TRUE(c.logged("applet low: frame mode -> quarter"));
+
+  ASSERT_TRUE(c.accepted("low", "release"));
+  c.wait_plan([](const AppletPlan& p) { return CoordinatedSystem::holders(p, "Camera").empty(); },
+              "Camera released");
+  c.wait_cam_mode("deactivated");
+}
+
+TEST(Coordinator, AHigherPriorityPreemptsAndTheOldHoldersCommandIsRefusedNamingTheNewHolder) {
+  CoordinatedSystem c("coord_preempt");
+  c.sys.running();
+  ASSERT_TRUE(c.accepted("low", "request"));
+  c.wait_plan(
+      [](const AppletPlan& p) { return CoordinatedSystem::holders(p, "Camera") == Strings{"low"}; },
+      "Camera held by low");
+  ASSERT_TRUE(c.accepted("high", "request"));
+  c.wait_plan(
+      [](const AppletPlan& p) {
+        return CoordinatedSystem::holders(p, "Camera") == Strings{"high"};
+      },
+      "Camera held by high");
+  EXPECT_TRUE(c.logged("applet high: frame mode -> half"));
+  EXPECT_TRUE(
+      c.logged("applet low: frame mode quarter refused: applet 'low' does not hold "
+               "service 'Camera': it is held by 'high'"));
+
+  // oscar applets ps --json shows the holder, the access and who waits.
+  test::Process ps(
+      {test::bin("oscar-applets"), "ps", "--json", "-d", std::to_string(c.sys.domain())},
+      test::temp_path("coord_ps") + ".out");
+  ASSERT_EQ(ps.wait(std::chrono::seconds(30)), 0) << ps.output();
+  const auto j = nlohmann::json::parse(ps.output());
+  EXPECT_EQ(j["services"]["Camera"]["holders"], nlohmann::json::array({"high"}));
+  EXPECT_EQ(j["services"]["Camera"]["access"], "exclusive");
+  EXPECT_EQ(j["services"]["Camera"]["waiting"], nlohmann::json::array({"low"}));
+  ASSERT_EQ(j["applets"].size(), 2u);
+  EXPECT_EQ(j["applets"][0]["name"], "low");
+  EXPECT_EQ(j["applets"][0]["process"], "coordinator");
+  EXPECT_EQ(j["applets"][0]["state"], "waiting");
+  EXPECT_EQ(j["applets"][1]["state"], "holding");
+
+  // When the higher priority lets go, the old holder gets the camera back.
+  ASSERT_TRUE(c.accepted("high", "release"));
+  c.wait_plan(
+      [](const AppletPlan& p) { return CoordinatedSystem::holders(p, "Camera") == Strings{"low"}; },
+      "Camera back with low");
+  c.wait_cam_mode("continuous");
+}
+
+TEST(Coordinator, AFailedProviderTakesTheServiceAwayAndTheRestartGivesItBackConfigured) {
+  CoordinatedSystem c("coord_restart");
+  c.sys.running();
+  ASSERT_TRUE(c.accepted("high", "request"));
+  c.wait_plan(
+      [](const AppletPlan& p) {
+        return CoordinatedSystem::holders(p, "Camera") == Strings{"high"};
+      },
+      "Camera held by high");
+  ASSERT_TRUE(c.logged("applet high: frame mode -> half"));
+  const auto s = c.sys.wait_for([](const SystemState& st) { return entry(st, "cam") != nullptr; });
+  ASSERT_EQ(kill(static_cast<pid_t>(entry(s, "cam")->pid()), SIGKILL), 0);
+  EXPECT_TRUE(c.logged("coordinator: service Camera is unavailable"));
+  c.sys.wait_for([](const SystemState& st) {
+    const auto* m = entry(st, "cam");
+    return m && m->incarnation() == 2 && m->status() == "running";
+  });
+  EXPECT_TRUE(c.logged("coordinator: service Camera is available again"));
+  c.wait_cam_mode("continuous");
+  // What the holder commanded before the failure, sent again to the new process.
+  EXPECT_TRUE(c.logged("coordinator: Camera: cam/cam frame_mode re-applied after the restart: ok"));
+  c.wait_plan(
+      [](const AppletPlan& p) {
+        return CoordinatedSystem::holders(p, "Camera") == Strings{"high"};
+      },
+      "Camera held by high again");
+}
+
+// The registry supervises the coordinator like any module. A restarted coordinator starts
+// with nothing granted: no module stays configured for a holder that lost its service.
+TEST(Coordinator, AKilledCoordinatorIsRestartedAndIdlesWhatItsHoldersLost) {
+  CoordinatedSystem c("coord_killed");
+  c.sys.running();
+  ASSERT_TRUE(c.accepted("low", "request"));
+  c.wait_cam_mode("continuous");
+  const auto s =
+      c.sys.wait_for([](const SystemState& st) { return entry(st, "coordinator") != nullptr; });
+  ASSERT_EQ(kill(static_cast<pid_t>(entry(s, "coordinator")->pid()), SIGKILL), 0);
+  c.sys.wait_for([](const SystemState& st) {
+    const auto* m = entry(st, "coordinator");
+    return m && m->incarnation() == 2 && m->status() == "running";
+  });
+  c.wait_cam_mode("deactivated");
+  c.wait_plan([](const AppletPlan& p) { return CoordinatedSystem::holders(p, "Camera").empty(); },
+              "Camera idle after the restart");
+  // And it grants again.
+  ASSERT_TRUE(c.accepted("high", "request"));
+  c.wait_cam_mode("continuous");
+}
+
+TEST(Coordinator, AnEventForAnUnknownBundleIsRefusedWithTheReason) {
+  CoordinatedSystem c("coord_bad_event");
+  c.sys.running();
+  const auto reply = c.event("nobody", "request");
+  EXPECT_FALSE(reply.ok());
+  EXPECT_THAT(reply.error(), HasSubstr("unknown applet 'nobody'"));
+}
+
+}  // namespace
+}  // namespace oscar
