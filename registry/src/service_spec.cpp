@@ -1,6 +1,7 @@
 #include "service_spec.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <functional>
 #include <map>
 #include <stdexcept>
@@ -231,10 +232,15 @@ void parse_coordinator(SystemSpec& s, const YAML::Node& node) {
       }
       if (a["process"]) {
         spec.process = text(s.file, a["process"], what + ".process");
-        if (spec.process.empty() || spec.process.find_first_of("/ \t") != std::string::npos) {
+        const bool identifier = !spec.process.empty() &&
+                                !std::isdigit(static_cast<unsigned char>(spec.process[0])) &&
+                                std::all_of(spec.process.begin(), spec.process.end(), [](char ch) {
+                                  return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
+                                });
+        if (!identifier) {
           fail(s.file, a["process"],
-               fmt::format("{}.process '{}': a process name is a module name (no '/', no "
-                           "spaces)",
+               fmt::format("{}.process '{}': a process name is a module name, an identifier "
+                           "(letters, digits, _)",
                            what, spec.process));
         }
         if (spec.process == SystemSpec::kCoordinatorModule) {
@@ -250,7 +256,10 @@ void parse_coordinator(SystemSpec& s, const YAML::Node& node) {
                            what, spec.process));
         }
       } else if (!spec.host.empty()) {
-        spec.process = "applets-" + spec.host;
+        spec.process = "applets_" + spec.host;
+        for (char& ch : spec.process) {
+          if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+        }
       }
       if (spec.remote()) {
         if (spec.host.empty()) spec.host = c.host;

@@ -190,8 +190,8 @@ TEST(ServiceSpec, AnAppletWithAProcessRunsInAModuleOfItsOwnProgramOscarApplet) {
             1);
   // host: alone names a process of its own on that host.
   const auto h = parse("coordinator: { applets: [ { type: t, name: a, host: localhost } ] }\n");
-  EXPECT_EQ(h.coordinator->applets[0].process, "applets-localhost");
-  EXPECT_NE(h.find_module("applets-localhost"), nullptr);
+  EXPECT_EQ(h.coordinator->applets[0].process, "applets_localhost");
+  EXPECT_NE(h.find_module("applets_localhost"), nullptr);
   // Without either key the applet runs in the coordinator.
   EXPECT_EQ(parse(kGood).coordinator->applet_lease, std::chrono::milliseconds(1500));
 }
@@ -210,8 +210,9 @@ TEST(ServiceSpec, BadAppletProcessesAndLeasesAreErrorsWithTheirLine) {
   EXPECT_THAT(
       error_of("coordinator: { applets: [ { type: t, name: a, process: coordinator } ] }\n"),
       HasSubstr("applet 'a'.process: 'coordinator' is the coordinator's own process"));
-  EXPECT_THAT(error_of("coordinator: { applets: [ { type: t, name: a, process: 'x/y' } ] }\n"),
-              HasSubstr("applet 'a'.process 'x/y': a process name is a module name"));
+  EXPECT_THAT(
+      error_of("coordinator: { applets: [ { type: t, name: a, process: 'x/y' } ] }\n"),
+      HasSubstr("applet 'a'.process 'x/y': a process name is a module name, an identifier"));
   EXPECT_THAT(error_of("coordinator: { applet_lease: soon }\n"),
               HasSubstr("s.yaml:5: coordinator.applet_lease:"));
   EXPECT_THAT(error_of("coordinator: { applet_lease: 0ms }\n"),

@@ -88,7 +88,7 @@ struct AppletSpec {
   std::string where;
   /// The process it runs in: empty for the coordinator's own; else a process of its own that
   /// boot starts (program oscar-applet, a module of this name) and that talks to the
-  /// coordinator over DDS (`process: NAME`, or `host: H` alone: "applets-H").
+  /// coordinator over DDS (`process: NAME`, or `host: H` alone: "applets_H").
   std::string process;
   std::string host;  ///< the host of `process` (default: the coordinator's)
   bool remote() const { return !process.empty(); }
