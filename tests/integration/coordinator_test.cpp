@@ -359,7 +359,8 @@ TEST(RemoteApplet, AKilledRemoteHoldersServiceGoesToTheWaitingAppletWithinTheLea
       "Camera held by the remote high, low waiting");
   const auto s = c.sys.wait_for([](const SystemState& st) { return entry(st, "applets"); });
   ASSERT_EQ(kill(static_cast<pid_t>(entry(s, "applets")->pid()), SIGKILL), 0);
-  EXPECT_TRUE(c.logged("coordinator: applet 'high' in process 'applets' missed its lease"));
+  // The lease runs out, or the restarted process announces a new session first (the registry
+  // restarts it after 200 ms): either way what the dead process held is taken.
   c.wait_plan(
       [](const AppletPlan& p) { return CoordinatedSystem::holders(p, "Camera") == Strings{"low"}; },
       "Camera given to the waiting low");

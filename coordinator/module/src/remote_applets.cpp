@@ -219,7 +219,13 @@ void RemoteApplets::on_hello(const SchedHello& hello) {
     a.last_beat = Clock::now();
   }
   // A new start of the applet's process: what the old one held is gone with it.
-  if (replaced) take_bundles(id);
+  if (replaced) {
+    spdlog::warn(
+        "coordinator: applet '{}' announced itself from a new start of process '{}': "
+        "what the old one held is taken",
+        hello.applet(), hello.process());
+    take_bundles(id);
+  }
   SchedNotice welcome;
   welcome.applet(hello.applet());
   welcome.session(hello.session());
