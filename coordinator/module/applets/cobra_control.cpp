@@ -1,11 +1,15 @@
 // CobraControl, the coordination of seed 004 §4.2's landmark application: while it holds its
-// cameras it triggers them in order every cycle, and it sets their frame mode (MARVIN's
-// coordinator switches the framegrabber between quarter and half frames), see docs/landmarks.md.
+// cameras it triggers them every cycle (each module's in order, the modules side by side), and it
+// sets their frame mode (MARVIN's coordinator switches the framegrabber between quarter and half
+// frames), see docs/landmarks.md.
 #include <spdlog/spdlog.h>
 #include <oscar/command_types.hpp>
 #include <oscar/coordinator/applet.hpp>
 
+#include <algorithm>
+#include <atomic>
 #include <cstdint>
+#include <future>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -43,6 +47,15 @@ class CobraControl final : public oscar::coordinator::Applet {
     }
     if (cameras_.empty()) {
       throw bad("cameras is empty (give '<service>:<module>/<kernel>,...', in trigger order)");
+    }
+    for (const auto& c : cameras_) {
+      auto lane = std::find_if(lanes_.begin(), lanes_.end(),
+                               [&](const auto& l) { return l.front().module == c.module; });
+      if (lane == lanes_.end()) {
+        lanes_.push_back({c});
+      } else {
+        lane->push_back(c);
+      }
     }
     const auto cycle_text = setup.param("cycle_ms", "100");
     try {
@@ -104,17 +117,14 @@ class CobraControl final : public oscar::coordinator::Applet {
     last_ = now;
     const auto mode = mode_for(cycles_++);
     if (mode && mode != applied_mode_) set_frame_mode(*mode);
-    for (const auto& c : cameras_) {
-      const auto reply = trigger(c.service, c.module, c.kernel);
-      if (!reply.ok()) {
-        // The rest of this cycle's sequence would run out of order: it waits for the next.
-        if (++refused_ == 1 || refused_ % 100 == 0) {
-          spdlog::warn("applet {}: trigger {}/{} refused ({} so far): {}", name(), c.module,
-                       c.kernel, refused_, reply.error());
-        }
-        return;
-      }
+    // Each module's cameras in order; the modules side by side (seed 004 §4.2: on two PCs both
+    // images are grabbed and evaluated in parallel), the first module's from this thread.
+    std::vector<std::future<void>> others;
+    for (std::size_t i = 1; i < lanes_.size(); ++i) {
+      others.push_back(std::async(std::launch::async, [this, i] { run_lane(lanes_[i]); }));
     }
+    run_lane(lanes_.front());
+    for (auto& f : others) f.get();
   }
 
   std::chrono::milliseconds period() const override { return cycle_; }
@@ -123,6 +133,22 @@ class CobraControl final : public oscar::coordinator::Applet {
   struct Camera {
     std::string service, module, kernel;
   };
+
+  // Triggers one module's cameras in order; a refused trigger ends the lane for this cycle (the
+  // rest would run out of order).
+  void run_lane(const std::vector<Camera>& lane) {
+    for (const auto& c : lane) {
+      const auto reply = trigger(c.service, c.module, c.kernel);
+      if (!reply.ok()) {
+        const auto n = ++refused_;
+        if (n == 1 || n % 100 == 0) {
+          spdlog::warn("applet {}: trigger {}/{} refused ({} so far): {}", name(), c.module,
+                       c.kernel, n, reply.error());
+        }
+        return;
+      }
+    }
+  }
 
   std::optional<std::string> mode_for(std::uint64_t cycle) const {
     if (schedule_.empty()) return std::nullopt;
@@ -157,13 +183,15 @@ class CobraControl final : public oscar::coordinator::Applet {
   }
 
   std::string bundle_;
-  std::vector<Camera> cameras_;  // in trigger order
+  std::vector<Camera> cameras_;             // in trigger order
+  std::vector<std::vector<Camera>> lanes_;  // by module, in the order of cameras_
   std::chrono::milliseconds cycle_{100};
   std::vector<std::pair<std::string, std::uint64_t>> schedule_;  // frame mode, cycles
   std::uint64_t period_cycles_ = 0;                              // 0: one mode for good
   bool holding_ = false;
   std::uint64_t cycles_ = 0;  // since it holds the cameras
-  std::uint64_t skipped_ = 0, refused_ = 0;
+  std::uint64_t skipped_ = 0;
+  std::atomic<std::uint64_t> refused_ = 0;  // counted by the lanes
   std::optional<std::string> applied_mode_;
   std::optional<std::chrono::steady_clock::time_point> last_;
 };

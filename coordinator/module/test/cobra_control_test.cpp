@@ -168,6 +168,44 @@ TEST(CobraControl, ARefusedTriggerEndsTheCyclesSequence) {
       << "B is never triggered before A";
 }
 
+// config/landmarks-2hosts.yaml: one camera per module (one module per host); each cycle
+// triggers both, side by side.
+constexpr const char* kTwoModules = R"(
+system: s
+modules:
+  - name: landmarks
+    kernels: [ { type: framegrabber, name: cam_a } ]
+  - name: cameras_b
+    kernels: [ { type: framegrabber, name: cam_b } ]
+services:
+  CameraA: { provided_by: [landmarks/cam_a], access: exclusive }
+  CameraB: { provided_by: [cameras_b/cam_b], access: exclusive }
+coordinator:
+  applets:
+    - type: cobra_control
+      name: cobra
+      params: { cameras: 'CameraB:cameras_b/cam_b, CameraA:landmarks/cam_a', cycle_ms: 20 }
+      bundles: [ { name: cameras, resources: [ { service: CameraA }, { service: CameraB } ] } ]
+)";
+
+TEST(CobraControl, TriggersTheCamerasOfDifferentModulesEveryCycle) {
+  Running r(kTwoModules);
+  r.event(true);
+  const auto count = [](const std::vector<std::string>& s, const char* what) {
+    return std::count(s.begin(), s.end(), what);
+  };
+  ASSERT_TRUE(eventually([&] { return count(r.recorder.sent(), "trigger cameras_b/cam_b") >= 5; }));
+  r.event(false);
+  ASSERT_TRUE(eventually([&] {
+    const auto s = r.recorder.sent();
+    return count(s, "trigger cameras_b/cam_b") == count(s, "trigger landmarks/cam_a");
+  })) << "both cameras in every cycle";
+  const auto s = r.recorder.sent();
+  EXPECT_EQ(count(s, "trigger cameras_b/cam_b") + count(s, "trigger landmarks/cam_a"),
+            static_cast<long>(s.size()))
+      << "no frame mode: frame_modes is not set";
+}
+
 std::string with_params(const std::string& params) {
   std::string text = kSystem;
   const auto from = text.find("params:"), to = text.find("bundles:");
