@@ -119,12 +119,14 @@ class CobraControl final : public oscar::coordinator::Applet {
     if (mode && mode != applied_mode_) set_frame_mode(*mode);
     // Each module's cameras in order; the modules side by side (seed 004 §4.2: on two PCs both
     // images are grabbed and evaluated in parallel), the first module's from this thread.
+    const auto started = std::chrono::steady_clock::now();
     std::vector<std::future<void>> others;
     for (std::size_t i = 1; i < lanes_.size(); ++i) {
       others.push_back(std::async(std::launch::async, [this, i] { run_lane(lanes_[i]); }));
     }
     run_lane(lanes_.front());
     for (auto& f : others) f.get();
+    report(std::chrono::steady_clock::now() - started);
   }
 
   std::chrono::milliseconds period() const override { return cycle_; }
@@ -148,6 +150,19 @@ class CobraControl final : public oscar::coordinator::Applet {
         return;
       }
     }
+  }
+
+  // Every kReportEvery cycles: how long the triggers took, from the first sent to the last
+  // answered (commands from the coordinator's process to the cameras' modules over DDS).
+  void report(std::chrono::steady_clock::duration sequence) {
+    constexpr std::size_t kReportEvery = 100;
+    sequence_ms_.push_back(std::chrono::duration<double, std::milli>(sequence).count());
+    if (sequence_ms_.size() < kReportEvery) return;
+    std::sort(sequence_ms_.begin(), sequence_ms_.end());
+    spdlog::info("applet {}: {} cycles; triggers sent -> answered p50 {:.2f} ms, max {:.2f} ms",
+                 name(), sequence_ms_.size(), sequence_ms_[sequence_ms_.size() / 2],
+                 sequence_ms_.back());
+    sequence_ms_.clear();
   }
 
   std::optional<std::string> mode_for(std::uint64_t cycle) const {
@@ -194,6 +209,7 @@ class CobraControl final : public oscar::coordinator::Applet {
   std::atomic<std::uint64_t> refused_ = 0;  // counted by the lanes
   std::optional<std::string> applied_mode_;
   std::optional<std::chrono::steady_clock::time_point> last_;
+  std::vector<double> sequence_ms_;  // since the last report
 };
 
 }  // namespace
