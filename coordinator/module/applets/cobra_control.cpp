@@ -105,16 +105,16 @@ class CobraControl final : public oscar::coordinator::Applet {
     }
     // The applet runs every cycle at a fixed rate. After a cycle that overran (the first one
     // waits until the modules are found), the steps that are due come at once: those are
-    // skipped, or the cameras would be triggered back to back.
-    const auto now = std::chrono::steady_clock::now();
-    if (last_ && now - *last_ < cycle_ / 2) {
+    // skipped until half a cycle after the overrun one ended. A camera triggered again before
+    // its last image went through its chain would take the two triggers as one and fall a
+    // frame behind the other camera.
+    if (last_end_ && std::chrono::steady_clock::now() - *last_end_ < cycle_ / 2) {
       if (++skipped_ == 1 || skipped_ % 100 == 0) {
         spdlog::warn("applet {}: cycle skipped after one that overran ({} so far)", name(),
                      skipped_);
       }
       return;
     }
-    last_ = now;
     const auto mode = mode_for(cycles_++);
     if (mode && mode != applied_mode_) set_frame_mode(*mode);
     // Each module's cameras in order; the modules side by side (seed 004 §4.2: on two PCs both
@@ -126,7 +126,8 @@ class CobraControl final : public oscar::coordinator::Applet {
     }
     run_lane(lanes_.front());
     for (auto& f : others) f.get();
-    report(std::chrono::steady_clock::now() - started);
+    last_end_ = std::chrono::steady_clock::now();
+    report(*last_end_ - started);
   }
 
   std::chrono::milliseconds period() const override { return cycle_; }
@@ -208,8 +209,8 @@ class CobraControl final : public oscar::coordinator::Applet {
   std::uint64_t skipped_ = 0;
   std::atomic<std::uint64_t> refused_ = 0;  // counted by the lanes
   std::optional<std::string> applied_mode_;
-  std::optional<std::chrono::steady_clock::time_point> last_;
-  std::vector<double> sequence_ms_;  // since the last report
+  std::optional<std::chrono::steady_clock::time_point> last_end_;  // of the last sequence
+  std::vector<double> sequence_ms_;                                // since the last report
 };
 
 }  // namespace
