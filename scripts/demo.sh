@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The README's main command: seed 004's landmark application (config/landmarks-1host.yaml: two
-# synthetic cameras, MarkADetect, MarkBDetect, pose fusion and the sequencing coordinator in one
-# multi-core module) booted with `oscar boot` on this host, its detections and fused poses shown
-# live in the merged log, every cue recorded to an MCAP file by `oscar record`. Ctrl-C (or
-# --duration SECONDS) shuts everything down in order and prints how to replay the recording into
-# the detectors. Installs what is missing and builds first.
+# synthetic cameras, MarkADetect, MarkBDetect and the pose fusion in one multi-core module,
+# sequenced by CobraControl, an applet in the coordinator) booted with `oscar boot` on this
+# host, its detections and fused poses shown live in the merged log, every cue recorded to an
+# MCAP file by `oscar record`. Ctrl-C (or --duration SECONDS) shuts everything down in order and
+# prints how to replay the recording into the detectors. Installs what is missing and builds
+# first.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 args=()

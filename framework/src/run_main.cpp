@@ -2,7 +2,6 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
 #include <iostream>
 #include <string>
 #include <thread>
@@ -122,13 +121,9 @@ int run_main(int argc, char** argv) {
       return 0;
     }
     const int d = domain >= 0 ? domain : module.spec().domain.value_or(domain_from_env(0));
-    // What a kernel that talks to other modules (the landmark sequencer) needs to join the same
-    // domain with the same network profile.
+    // The module's domain for what in this process reads it from the environment
+    // (domain_from_env).
     setenv("OSCAR_DOMAIN", std::to_string(d).c_str(), 1);
-    if (!file.empty()) {
-      setenv("OSCAR_SYSTEM_FILE", std::filesystem::absolute(file).c_str(), 1);
-      setenv("OSCAR_HOST", module.spec().host.c_str(), 1);
-    }
     module.start(d);
     std::thread signal_waiter([&] {
       int sig = 0;

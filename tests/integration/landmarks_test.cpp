@@ -1,7 +1,8 @@
 // Seed 004 §4.2 on one host (issue 7): config/landmarks-1host.yaml booted by oscar boot; the
 // test watches MarkADetect's tags and the fused pose over DDS and compares them with the
-// synthetic scene's ground truth; the sequencer switches the frame mode by configuration. A
-// logger kernel in another process records the application's own cues.
+// synthetic scene's ground truth. CobraControl, an applet in the coordinator, sequences the
+// cameras while it holds them and switches their frame mode. A logger kernel in another
+// process records the application's own cues.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -18,10 +19,13 @@
 
 #include "booted_system.hpp"
 #include "landmark_summary.hpp"  // tests/common
+#include "oscar/config_client.hpp"
+#include "oscar/coordinator/plan_json.hpp"  // AppletEvent
 #include "oscar/cue_type_info.hpp"
 #include "oscar/idl_texts.hpp"
 #include "oscar/mcap/reader.hpp"
 #include "oscar/perception_types.hpp"
+#include "oscar/testing/eventually.hpp"
 #include "oscar/topic_io.hpp"
 
 namespace oscar {
@@ -29,12 +33,15 @@ namespace {
 using namespace std::chrono_literals;
 namespace dds = eprosima::fastdds::dds;
 
-std::string landmark_system(const std::string& file) {
+// The shipped file on the test's domain; `frame_modes` replaces CobraControl's if not empty.
+std::string landmark_system(const std::string& file, const std::string& frame_modes = "") {
   auto root = YAML::LoadFile(std::string(OSCAR_SOURCE_DIR) + "/config/" + file);
   root.remove("domain");  // the test's own domain
   // As the other booted-system tests: with the default 300 ms lease this module was declared
   // lost when the test's first configuration command reached it on the loaded test machine.
   root["lease"] = "1s";
+  if (!frame_modes.empty())
+    root["coordinator"]["applets"][0]["params"]["frame_modes"] = frame_modes;
   YAML::Emitter out;
   out << root;
   return out.c_str();
@@ -79,10 +86,10 @@ TEST(Landmarks, OneHostDetectsTheTagsOncePerCycleAndFusesThePoseOfTheGroundTruth
   const auto got_tags = tags.take();
   const auto got_poses = poses.take();
 
-  // The sequencer's cycle is 100 ms: at most 40 sequences in 4 s, and one pose per sequence.
+  // CobraControl's cycle is 100 ms: at most 40 sequences in 4 s, and one pose per sequence.
   // How many of the 40 a cycle fits is the machine's speed (`oscar bench landmarks` measures
   // it; under a sanitizer detection alone can overrun the cycle): the test asks only that the
-  // system keeps producing, never more often than the cycle, one pose per pair of detections.
+  // applet keeps sequencing, never more often than the cycle, one pose per pair of detections.
   std::printf("in 4 s: %zu poses, %zu tag cues of camera A\n", got_poses.size(), got_tags.size());
   EXPECT_GE(got_poses.size(), 8u);
   EXPECT_LE(got_poses.size(), 44u);
@@ -110,17 +117,36 @@ TEST(Landmarks, OneHostDetectsTheTagsOncePerCycleAndFusesThePoseOfTheGroundTruth
     EXPECT_LT((t - truth).norm(), 0.01);  // 1 cm
   }
 
-  // Frame mode by configuration: the coordinator tells the sequencer, which sets both grabbers.
-  for (const auto& [mode, width] : {std::pair{"half", 320}, std::pair{"quarter", 160}}) {
-    const auto reply = sys.configure("landmarks", CMD_SET_PARAM, {"control", "frame_mode", mode});
-    ASSERT_TRUE(reply.ok()) << reply.error();
-    bool seen = false;
-    for (int i = 0; i < 50 && !seen; ++i) {
-      std::this_thread::sleep_for(100ms);
-      for (const auto& t : tags.take()) seen = seen || t.width() == width;
-    }
-    EXPECT_TRUE(seen) << "no " << width << " px wide image after frame_mode " << mode;
-  }
+  // The cameras run only while CobraControl holds them: released (the coordinator's command
+  // port `applet`), they are deactivated and no pose comes; requested again, it sequences again.
+  ConfigClient operator_client(p, "boot");
+  const auto event = [&](const char* what) {
+    AppletEvent e;
+    e.applet("cobra");
+    e.bundle("cameras");
+    e.event(what);
+    return operator_client.command("coordinator", "coordinator", "applet", e);
+  };
+  const auto cam_a_mode = [&](const std::string& mode) {
+    sys.wait_for([&](const SystemState& st) {
+      const auto* m = test::entry(st, "landmarks");
+      const auto* k = m ? test::kernel_state(*m, "cam_a") : nullptr;
+      return k && k->mode() == mode;
+    });
+  };
+  auto reply = event("release");
+  ASSERT_TRUE(reply.ok()) << reply.error();
+  cam_a_mode("deactivated");
+  std::this_thread::sleep_for(500ms);  // a pose under way when the cameras went
+  poses.take();
+  std::this_thread::sleep_for(1s);
+  EXPECT_TRUE(poses.take().empty()) << "poses without CobraControl holding the cameras";
+  reply = event("request");
+  ASSERT_TRUE(reply.ok()) << reply.error();
+  cam_a_mode("single_step");
+  EXPECT_TRUE(eventually([&] { return !poses.take().empty(); }, 30s))
+      << "no pose after CobraControl got the cameras back:\n"
+      << sys.boot_output();
   EXPECT_EQ(sys.shut_down(), 0);
 
   // The summary landmark_pose logs once a second says the same.
@@ -128,6 +154,42 @@ TEST(Landmarks, OneHostDetectsTheTagsOncePerCycleAndFusesThePoseOfTheGroundTruth
   ASSERT_GE(summaries.size(), 3u);
   EXPECT_TRUE(summaries[2].truth);
   EXPECT_LT(summaries[2].worst_mm, 10);
+}
+
+// Seed 004 §4.2: MARVIN's coordinator switches the framegrabber between quarter and half frames.
+// CobraControl does it by its schedule, through the framegrabbers' command port `frame_mode`:
+// MarkADetect's images alternate between 320 and 160 px wide (in quarter frames the 0.1 m tags
+// are too small to be found).
+TEST(Landmarks, CobraControlSwitchesTheCamerasBetweenHalfAndQuarterFrames) {
+  test::BootedSystem sys("landmarks_modes",
+                         landmark_system("landmarks-1host.yaml", "half:5, quarter:5"));
+  sys.running();
+  DdsParticipant p(test::test_domain(), "test:landmarks");
+  Watch<TagDetections> tags;
+  TopicReader<TagDetections, TagDetectionsPubSubType> tag_reader(
+      p, "oscar/cue/mark_a/tags", watch_qos(), [&](const TagDetections& t, const auto&) {
+        std::lock_guard lock(tags.mutex);
+        tags.cues.push_back(t);
+      });
+  std::vector<int> widths;  // in the order they come, each change once
+  const auto changes = [&] {
+    for (const auto& t : tags.take()) {
+      const int width = t.width();
+      if (widths.empty() || widths.back() != width) widths.push_back(width);
+      if (width == 320) {
+        EXPECT_EQ(t.detections().size(), 1u) << "tag 0 in a half frame";
+      }
+    }
+    return widths.size() >= 4;
+  };
+  EXPECT_TRUE(eventually(changes, 60s)) << sys.boot_output();
+  ASSERT_GE(widths.size(), 2u);
+  for (std::size_t i = 1; i < widths.size(); ++i) {
+    EXPECT_TRUE((widths[i - 1] == 320 && widths[i] == 160) ||
+                (widths[i - 1] == 160 && widths[i] == 320))
+        << "width " << widths[i - 1] << " then " << widths[i];
+  }
+  EXPECT_NE(sys.boot_output().find("applet cobra: frame mode -> quarter"), std::string::npos);
 }
 
 // The application's own cue types, which the logger does not name: wired in the system file like

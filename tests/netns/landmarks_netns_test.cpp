@@ -42,7 +42,7 @@ TEST(LandmarksOnTwoHosts, BootsAndFusesBothCamerasAsOnOneHost) {
   const auto summaries = test::landmark_summaries(log_dir + "/pc1/landmarks.log");
   ASSERT_GE(summaries.size(), 4u) << boot.output();
   // The first seconds include discovery across the hosts; from the third summary on, every
-  // cycle's pose uses both cameras, at the sequencer's 10 Hz, near the ground truth.
+  // cycle's pose uses both cameras, at CobraControl's 10 Hz, near the ground truth.
   for (std::size_t i = 2; i < summaries.size(); ++i) {
     const auto& s = summaries[i];
     EXPECT_GE(s.rate_hz, 8.0) << "summary " << i;

@@ -56,12 +56,16 @@ class AppletHost::Impl final : public AppletGateway {
                       const std::string& module, const std::string& kernel,
                       const std::string& command, const std::string& type,
                       std::vector<std::uint8_t> cdr) override;
+  ConfigReply trigger(const std::string& applet, const std::string& service,
+                      const std::string& module, const std::string& kernel) override;
   std::string bundle_name(BundleId bundle) const override {
     return config_.model.bundle(bundle).name;
   }
 
  private:
   class Context;
+  // Sends an applet's command or trigger to the coordinator and waits for its reply.
+  ConfigReply send(SchedCommand command);
   struct Chain {  // a chain of negotiation rounds under way (applet thread only)
     std::shared_ptr<const applets::NegotiationRound> next;
     Clock::time_point round_started;
@@ -666,6 +670,31 @@ ConfigReply AppletHost::Impl::command(const std::string& applet, const std::stri
                                       const std::string& module, const std::string& kernel,
                                       const std::string& command, const std::string& type,
                                       std::vector<std::uint8_t> cdr) {
+  SchedCommand c;
+  c.applet(applet);
+  c.service(service);
+  c.module_name(module);
+  c.kernel(kernel);
+  c.command(command);
+  c.payload_type(type);
+  c.payload(std::move(cdr));
+  return send(std::move(c));
+}
+
+ConfigReply AppletHost::Impl::trigger(const std::string& applet, const std::string& service,
+                                      const std::string& module, const std::string& kernel) {
+  SchedCommand c;
+  c.applet(applet);
+  c.service(service);
+  c.module_name(module);
+  c.kernel(kernel);
+  c.trigger(true);
+  return send(std::move(c));
+}
+
+ConfigReply AppletHost::Impl::send(SchedCommand c) {
+  const auto applet = c.applet();
+  const auto module = c.module_name();
   auto& h = hosted(applet);
   std::unique_lock lock(mutex_);
   if (!h.welcomed) {
@@ -673,16 +702,8 @@ ConfigReply AppletHost::Impl::command(const std::string& applet, const std::stri
                    fmt::format("applet '{}' is not announced to the coordinator (yet)", applet));
   }
   const auto seq = h.next_seq++;
-  SchedCommand c;
-  c.applet(applet);
   c.session(h.session);
   c.seq(seq);
-  c.service(service);
-  c.module_name(module);
-  c.kernel(kernel);
-  c.command(command);
-  c.payload_type(type);
-  c.payload(std::move(cdr));
   lock.unlock();
   command_writer_.write(c);
   lock.lock();

@@ -50,6 +50,10 @@ class NoGateway final : public AppletGateway {
                       std::vector<std::uint8_t>) override {
     throw std::logic_error("an applet commanded a module while being checked");
   }
+  ConfigReply trigger(const std::string&, const std::string&, const std::string&,
+                      const std::string&) override {
+    throw std::logic_error("an applet triggered a module while being checked");
+  }
   std::string bundle_name(applets::BundleId) const override { return {}; }
 };
 }  // namespace

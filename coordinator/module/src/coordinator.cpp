@@ -288,10 +288,10 @@ std::string Coordinator::bundle_name(applets::BundleId bundle) const {
   return config_.model.bundle(bundle).name;
 }
 
-ConfigReply Coordinator::command(const std::string& applet, const std::string& service,
-                                 const std::string& module, const std::string& kernel,
-                                 const std::string& command, const std::string& type,
-                                 std::vector<std::uint8_t> cdr) {
+std::optional<ConfigReply> Coordinator::refuse_unless_held(const std::string& applet,
+                                                           const std::string& service,
+                                                           const std::string& module,
+                                                           const std::string& kernel) {
   const auto* svc = system_.find_service(service);
   if (!svc) return refused(module, fmt::format("no service '{}' in the system", service));
   const bool provides = std::any_of(svc->providers.begin(), svc->providers.end(), [&](auto& p) {
@@ -314,15 +314,16 @@ ConfigReply Coordinator::command(const std::string& applet, const std::string& s
     }
     holder = s.active_holder(id);
   });
-  if (!holds) {
-    return refused(module,
-                   fmt::format("applet '{}' does not hold service '{}': {}", applet, service,
-                               holder == "none" ? std::string("nobody holds it now")
-                                                : fmt::format("it is held by '{}'", holder)));
-  }
-  std::lock_guard reconciling(reconcile_mutex_);
+  if (holds) return std::nullopt;
+  return refused(module, fmt::format("applet '{}' does not hold service '{}': {}", applet, service,
+                                     holder == "none" ? std::string("nobody holds it now")
+                                                      : fmt::format("it is held by '{}'", holder)));
+}
+
+std::optional<ConfigReply> Coordinator::await_providers(const std::string& service,
+                                                        const std::string& module) {
   // The holder may be quicker than the loop: configure the providers first (a deactivated
-  // kernel refuses commands).
+  // kernel refuses commands and triggers).
   const auto until = std::chrono::steady_clock::now() + kReadyWait;
   reconcile();
   while (!providers_->ready(service)) {
@@ -334,10 +335,36 @@ ConfigReply Coordinator::command(const std::string& applet, const std::string& s
     std::this_thread::sleep_for(kTick);
     reconcile();
   }
+  return std::nullopt;
+}
+
+ConfigReply Coordinator::command(const std::string& applet, const std::string& service,
+                                 const std::string& module, const std::string& kernel,
+                                 const std::string& command, const std::string& type,
+                                 std::vector<std::uint8_t> cdr) {
+  if (auto refusal = refuse_unless_held(applet, service, module, kernel)) return *refusal;
+  std::lock_guard reconciling(reconcile_mutex_);
+  if (auto refusal = await_providers(service, module)) return *refusal;
   try {
     auto reply = client_->send_command(module, kernel, command, type, cdr);
     if (reply.ok()) providers_->record(service, module, kernel, command, type, std::move(cdr));
     return reply;
+  } catch (const std::exception& e) {
+    return refused(module, e.what());
+  }
+}
+
+ConfigReply Coordinator::trigger(const std::string& applet, const std::string& service,
+                                 const std::string& module, const std::string& kernel) {
+  if (auto refusal = refuse_unless_held(applet, service, module, kernel)) return *refusal;
+  {
+    std::lock_guard reconciling(reconcile_mutex_);
+    if (auto refusal = await_providers(service, module)) return *refusal;
+  }
+  // Sent without the lock: a trigger is not recorded (a restarted module gets configuration
+  // back, not past cycles), so triggers of modules on different hosts may go out side by side.
+  try {
+    return client_->send(module, CMD_TRIGGER, {kernel});
   } catch (const std::exception& e) {
     return refused(module, e.what());
   }

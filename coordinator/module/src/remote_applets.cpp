@@ -483,8 +483,10 @@ void RemoteApplets::commands() {
                         c.applet()));
         out.reply(r);
       } else {
-        out.reply(gateway_.command(c.applet(), c.service(), c.module_name(), c.kernel(),
-                                   c.command(), c.payload_type(), c.payload()));
+        out.reply(c.trigger()
+                      ? gateway_.trigger(c.applet(), c.service(), c.module_name(), c.kernel())
+                      : gateway_.command(c.applet(), c.service(), c.module_name(), c.kernel(),
+                                         c.command(), c.payload_type(), c.payload()));
       }
       command_reply_writer_.write(out);
     }

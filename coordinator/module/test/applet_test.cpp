@@ -24,6 +24,13 @@ class RecordingGateway final : public AppletGateway {
     r.ok(true);
     return r;
   }
+  ConfigReply trigger(const std::string& applet, const std::string& service,
+                      const std::string& module, const std::string& kernel) override {
+    sent = applet + " " + service + " " + module + "/" + kernel + " trigger";
+    ConfigReply r;
+    r.ok(true);
+    return r;
+  }
   std::string bundle_name(applets::BundleId) const override { return "b"; }
   std::string sent;
   std::size_t bytes = 0;

@@ -32,6 +32,10 @@ class AppletGateway {
                               const std::string& module, const std::string& kernel,
                               const std::string& command, const std::string& type,
                               std::vector<std::uint8_t> cdr) = 0;
+  /// Triggers the single-step kernel `kernel` in `module` (the configuration flow's trigger: it
+  /// runs once), which must provide `service`, on behalf of `applet`. Refused as command() is.
+  virtual ConfigReply trigger(const std::string& applet, const std::string& service,
+                              const std::string& module, const std::string& kernel) = 0;
   /// The name of a bundle (notifications name bundles by id).
   virtual std::string bundle_name(applets::BundleId bundle) const = 0;
 };
@@ -92,6 +96,13 @@ class Applet {
     const auto& type = idl_type_info<T>();
     return gateway_.command(name_, service, module, kernel, command, type.name,
                             type.serialize(&request));
+  }
+  /// Triggers the single-step kernel `kernel` in `module`, a provider of `service`, through the
+  /// coordinator: it runs once (its mode's trigger is `command`). Refused as command() is. (Not
+  /// AppletContext::trigger, which raises a bundle's priority.)
+  ConfigReply trigger(const std::string& service, const std::string& module,
+                      const std::string& kernel) {
+    return gateway_.trigger(name_, service, module, kernel);
   }
   /// The name of the bundle a notification is about.
   std::string bundle_name(const applets::Notification& n) const {

@@ -54,6 +54,8 @@ class Coordinator final : public AppletGateway {
                       const std::string& module, const std::string& kernel,
                       const std::string& command, const std::string& type,
                       std::vector<std::uint8_t> cdr) override;
+  ConfigReply trigger(const std::string& applet, const std::string& service,
+                      const std::string& module, const std::string& kernel) override;
   std::string bundle_name(applets::BundleId bundle) const override;
 
   /// The plan as it is now (what the coordinator publishes).
@@ -72,6 +74,15 @@ class Coordinator final : public AppletGateway {
   // Applies what the snapshot's services need to their providers, then publishes if changed.
   void reconcile();
   void wake();
+  // An applet's command or trigger: refused unless `module`/`kernel` provides `service` and
+  // `applet` holds it now.
+  std::optional<ConfigReply> refuse_unless_held(const std::string& applet,
+                                                const std::string& service,
+                                                const std::string& module,
+                                                const std::string& kernel);
+  // Refused unless the providers of `service` are (or become) configured for its holder; with
+  // reconcile_mutex_ held.
+  std::optional<ConfigReply> await_providers(const std::string& service, const std::string& module);
 
   const SystemSpec& system_;
   applets::SystemConfig config_;
