@@ -273,6 +273,9 @@ SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
   internal::parse_services(s, root["services"]);
   internal::parse_coordinator(s, root["coordinator"]);
   if (s.coordinator) add_coordinator_module(s, root["coordinator"], plugins);
+  std::vector<std::string> names;
+  for (const auto& m : s.modules) names.push_back(m.spec.name);
+  for (auto& m : s.modules) m.spec.system_modules = names;
   return s;
 }
 

@@ -55,12 +55,19 @@ class DdsParticipant {
   /// The names of the other participants on the domain that discovery sees now (a module's is
   /// "oscar:<module>").
   std::vector<std::string> discovered_participants() const;
+  /// The names of the participants in the process of `writer` (this one's included, if it is
+  /// the same process), as discovery knows them: all participants of one process share the
+  /// first 8 bytes of their GUID prefix (host and process). What a sample's writer really is,
+  /// whatever the sample says.
+  std::vector<std::string> participants_in_process_of(
+      const eprosima::fastrtps::rtps::GUID_t& writer) const;
   /// The last remote writer discovery has seen on `topic`, if any.
   std::optional<DiscoveredWriter> discovered_writer(const std::string& topic) const;
 
  private:
   class Listener;
   int domain_;
+  std::string name_;
   std::unique_ptr<Listener> listener_;
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   std::unique_ptr<internal::ParticipantIdClaim> id_claim_;  ///< released after the participant

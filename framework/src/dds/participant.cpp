@@ -204,6 +204,18 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
     for (const auto& [prefix, name] : participants_) names.push_back(name);
     return names;
   }
+  std::vector<std::string> participants_in_process_of(
+      const eprosima::fastrtps::rtps::GUID_t& writer) const {
+    std::lock_guard lock(mutex_);
+    std::vector<std::string> names;
+    for (const auto& [prefix, name] : participants_) {
+      if (writer.is_on_same_process_as(
+              {prefix, eprosima::fastrtps::rtps::c_EntityId_RTPSParticipant})) {
+        names.push_back(name);
+      }
+    }
+    return names;
+  }
   void on_publisher_discovery(dds::DomainParticipant*,
                               eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
     note(info.info.topicName().to_string(), info.info.typeName().to_string());
@@ -252,7 +264,7 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
 };
 
 DdsParticipant::DdsParticipant(int domain, const std::string& name, const NetworkConfig& network)
-    : domain_(domain), listener_(std::make_unique<Listener>()) {
+    : domain_(domain), name_(name), listener_(std::make_unique<Listener>()) {
   if (network.interfaces.empty()) throw std::invalid_argument("network: no interface given");
   auto* factory = dds::DomainParticipantFactory::get_instance();
   dds_log_level_from_env();
@@ -320,6 +332,13 @@ std::optional<std::string> DdsParticipant::discovered_type(const std::string& to
 
 std::map<std::string, DdsParticipant::DiscoveredWriter> DdsParticipant::discovered_writers() const {
   return listener_->writers();
+}
+
+std::vector<std::string> DdsParticipant::participants_in_process_of(
+    const eprosima::fastrtps::rtps::GUID_t& writer) const {
+  auto names = listener_->participants_in_process_of(writer);
+  if (writer.is_on_same_process_as(participant_->guid())) names.push_back(name_);
+  return names;
 }
 
 std::vector<std::string> DdsParticipant::discovered_participants() const {
