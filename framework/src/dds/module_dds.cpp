@@ -390,22 +390,18 @@ void Module::Dds::start_config() {
   module_.log_sink_->attach(&log_writer_->dds_writer());
 }
 
-// A module's participant is named "oscar:<module>" (the constructor above), and every participant
-// of a process shares its GUID prefix's host and process part: a kernel that writes a command
-// from a participant of its own, under any name, is still seen coming from its module's process.
-// Only modules of this module's system count (not a test's embedded modules, nor the
-// coordinator's second participant "oscar:coordinator-plan").
+// Every participant of a process shares its GUID prefix's host and process part, and those made
+// in a module's process say which modules it hosts (DdsParticipant::modules_in_process_of): a
+// kernel that writes a command from a participant of its own, under any name, is still seen
+// coming from its module's process. Only modules of this module's system count (not a test's
+// embedded modules).
 CommandOrigin Module::Dds::origin_of(const eprosima::fastdds::dds::SampleInfo& info) {
   CommandOrigin origin;
   const auto& system = module_.spec_.system_modules;
-  for (const auto& n :
-       participant_.participants_in_process_of(info.sample_identity.writer_guid())) {
-    constexpr std::string_view kPrefix = "oscar:";
-    if (!n.starts_with(kPrefix)) continue;
-    auto module = n.substr(kPrefix.size());
-    if (std::find(system.begin(), system.end(), module) != system.end() &&
-        std::find(origin.modules.begin(), origin.modules.end(), module) == origin.modules.end()) {
-      origin.modules.push_back(std::move(module));
+  for (auto& m : participant_.modules_in_process_of(info.sample_identity.writer_guid())) {
+    if (std::find(system.begin(), system.end(), m) != system.end() &&
+        std::find(origin.modules.begin(), origin.modules.end(), m) == origin.modules.end()) {
+      origin.modules.push_back(std::move(m));
     }
   }
   return origin;
