@@ -39,6 +39,13 @@ TEST(Topics, TheWriterAndReaderOfEveryCatalogueTopicMatch) {
   expect_both_sides_match(p, topics::registry_reply());
   expect_both_sides_match(p, topics::system_state());
   expect_both_sides_match(p, topics::applet_plan());
+  expect_both_sides_match(p, topics::sched_hello());
+  expect_both_sides_match(p, topics::sched_beat());
+  expect_both_sides_match(p, topics::sched_call());
+  expect_both_sides_match(p, topics::sched_reply());
+  expect_both_sides_match(p, topics::sched_notice());
+  expect_both_sides_match(p, topics::sched_command());
+  expect_both_sides_match(p, topics::sched_command_reply());
   expect_both_sides_match(p, topics::pull_request("k/out"));
   expect_both_sides_match(p, topics::pull_reply("k/out"));
 }
@@ -56,10 +63,17 @@ TEST(Topics, EveryCatalogueTopicHasANameOfItsOwn) {
                                     topics::registry_reply().name,
                                     topics::system_state().name,
                                     topics::applet_plan().name,
+                                    topics::sched_hello().name,
+                                    topics::sched_beat().name,
+                                    topics::sched_call().name,
+                                    topics::sched_reply().name,
+                                    topics::sched_notice().name,
+                                    topics::sched_command().name,
+                                    topics::sched_command_reply().name,
                                     topics::pull_request("k/out").name,
                                     topics::pull_reply("k/out").name,
                                     topics::cue("k/out")};
-  EXPECT_EQ(names.size(), 15u);
+  EXPECT_EQ(names.size(), 22u);
 }
 
 TEST(Topics, CueTopicsAreNamedAfterTheirOutput) {

@@ -112,7 +112,9 @@ int main(int argc, char** argv) {
             auto args = q.argv();
             for (auto& a : args) {
               // Only OSCAR's own programs, found next to the monitor.
-              if (a == "oscar-run" || a == "oscar-coordinator") a = oscar::sibling_program(a);
+              if (a == "oscar-run" || a == "oscar-coordinator" || a == "oscar-applet") {
+                a = oscar::sibling_program(a);
+              }
             }
             try {
               const auto pid = supervisor.start(q.module_name(), q.incarnation(), args, q.env());

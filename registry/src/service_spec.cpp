@@ -1,12 +1,15 @@
 #include "service_spec.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <functional>
 #include <map>
 #include <stdexcept>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+
+#include "oscar/time.hpp"
 
 namespace oscar::internal {
 namespace {
@@ -215,29 +218,101 @@ void parse_coordinator(SystemSpec& s, const YAML::Node& node) {
     return;
   }
   if (!node.IsMap()) fail(s.file, node, "coordinator: expected a map with host and applets");
-  check_yaml_keys(node, s.file, "coordinator", {"host", "applets", "scheduler", "restart"});
+  check_yaml_keys(node, s.file, "coordinator",
+                  {"host", "applets", "scheduler", "restart", "applet_lease"});
   CoordinatorSpec c;
   c.where = yaml_where(s.file, node);
+  auto known_host = [&](const std::string& h) {
+    return std::any_of(s.hosts.begin(), s.hosts.end(),
+                       [&](const HostSpec& x) { return x.name == h; });
+  };
   if (node["host"]) {
     c.host = text(s.file, node["host"], "coordinator.host");
-    const bool known = std::any_of(s.hosts.begin(), s.hosts.end(),
-                                   [&](const HostSpec& h) { return h.name == c.host; });
-    if (!known) fail(s.file, node["host"], fmt::format("coordinator: unknown host '{}'", c.host));
+    if (!known_host(c.host)) {
+      fail(s.file, node["host"], fmt::format("coordinator: unknown host '{}'", c.host));
+    }
   } else {
     if (s.hosts.size() != 1)
       fail(s.file, node, "coordinator: name its host (several are declared)");
     c.host = s.hosts.front().name;
   }
   if (node["scheduler"]) c.scheduler = node["scheduler"];
+  if (const auto lease = node["applet_lease"]) {
+    try {
+      c.applet_lease = std::chrono::duration_cast<std::chrono::milliseconds>(
+          parse_duration(text(s.file, lease, "coordinator.applet_lease")));
+      if (c.applet_lease.count() <= 0) throw std::invalid_argument("must be positive");
+    } catch (const std::exception& e) {
+      fail(s.file, lease, fmt::format("coordinator.applet_lease: {}", e.what()));
+    }
+  }
+  std::map<std::string, std::string> process_hosts;  // process -> host
   if (node["applets"]) {
     for (const auto& a :
          list(s.file, node["applets"], "coordinator.applets", "[{type: T, name: N}]")) {
       if (!a.IsMap())
         fail(s.file, a, "coordinator.applets: each applet is a map with type and name");
-      check_yaml_keys(a, s.file, "applet",
-                      {"type", "name", "params", "bundles", "fail_stop", "provides"});
+      check_yaml_keys(
+          a, s.file, "applet",
+          {"type", "name", "params", "bundles", "fail_stop", "process", "host", "provides"});
       AppletSpec spec{text(s.file, a["type"], "applet type"),
-                      text(s.file, a["name"], "applet name"), a, yaml_where(s.file, a)};
+                      text(s.file, a["name"], "applet name"),
+                      a,
+                      yaml_where(s.file, a),
+                      "",
+                      ""};
+      const auto what = fmt::format("applet '{}'", spec.name);
+      if (a["host"]) {
+        spec.host = text(s.file, a["host"], what + ".host");
+        if (!known_host(spec.host)) {
+          std::vector<std::string> names;
+          for (const auto& h : s.hosts) names.push_back(h.name);
+          fail(s.file, a["host"],
+               fmt::format("{}: unknown host '{}' (hosts: {})", what, spec.host,
+                           fmt::join(names, ", ")));
+        }
+      }
+      if (a["process"]) {
+        spec.process = text(s.file, a["process"], what + ".process");
+        const bool identifier = !spec.process.empty() &&
+                                !std::isdigit(static_cast<unsigned char>(spec.process[0])) &&
+                                std::all_of(spec.process.begin(), spec.process.end(), [](char ch) {
+                                  return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
+                                });
+        if (!identifier) {
+          fail(s.file, a["process"],
+               fmt::format("{}.process '{}': a process name is a module name, an identifier "
+                           "(letters, digits, _)",
+                           what, spec.process));
+        }
+        if (spec.process == SystemSpec::kCoordinatorModule) {
+          fail(s.file, a["process"],
+               fmt::format("{}.process: '{}' is the coordinator's own process; leave process: "
+                           "out to run the applet there",
+                           what, spec.process));
+        }
+        if (s.find_module(spec.process)) {
+          fail(s.file, a["process"],
+               fmt::format("{}.process: '{}' is a module of the system; an applet process is a "
+                           "module of its own, name it differently",
+                           what, spec.process));
+        }
+      } else if (!spec.host.empty()) {
+        spec.process = "applets_" + spec.host;
+        for (char& ch : spec.process) {
+          if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+        }
+      }
+      if (spec.remote()) {
+        if (spec.host.empty()) spec.host = c.host;
+        const auto [it, added] = process_hosts.emplace(spec.process, spec.host);
+        if (!added && it->second != spec.host) {
+          fail(s.file, a["host"] ? a["host"] : a["process"],
+               fmt::format("{}: process '{}' runs on host '{}' (an applet before says so); a "
+                           "process has one host",
+                           what, spec.process, it->second));
+        }
+      }
       c.applets.push_back(std::move(spec));
     }
   }

@@ -185,6 +185,41 @@ void add_coordinator_module(SystemSpec& s, const YAML::Node& node,
   s.modules.push_back(std::move(m));
 }
 
+// Each process of applets (an applet's `process:`) runs as a module of its own (oscar-applet),
+// supervised and restarted by the registry like any other; its kernel, named after it, only
+// keeps the module frame (announcement, heartbeat) going.
+void add_applet_modules(SystemSpec& s, const std::vector<std::string>& plugins) {
+  std::set<std::string> kernels;
+  for (const auto& m : s.modules) {
+    for (const auto& k : m.spec.kernels) kernels.insert(k.name);
+  }
+  for (const auto& a : s.coordinator->applets) {
+    if (!a.remote() || s.find_module(a.process)) continue;
+    if (kernels.contains(a.process)) {
+      fail(a.where, fmt::format("applet '{}'.process: '{}' is a kernel's name; the process's "
+                                "module and kernel take that name, name it differently",
+                                a.name, a.process));
+    }
+    YAML::Node module;
+    module["name"] = a.process;
+    module["host"] = a.host;
+    YAML::Node kernel;
+    kernel["type"] = "applet_host";
+    kernel["name"] = a.process;
+    module["kernels"].push_back(kernel);
+    module["mode"] = "single_step";  // never triggered
+    SystemModule m;
+    m.spec = ModuleSpec::from_yaml(module, s.file);
+    m.spec.where = a.where;
+    m.spec.domain = s.domain;
+    m.spec.network = NetworkConfig::for_host(s.root, a.host);
+    m.spec.lease = s.lease;
+    m.spec.plugins = plugins;
+    m.program = "oscar-applet";
+    s.modules.push_back(std::move(m));
+  }
+}
+
 }  // namespace
 
 std::string DebugSpec::describe() const {
@@ -272,7 +307,10 @@ SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
   check_replace_chains(s);
   internal::parse_services(s, root["services"]);
   internal::parse_coordinator(s, root["coordinator"]);
-  if (s.coordinator) add_coordinator_module(s, root["coordinator"], plugins);
+  if (s.coordinator) {
+    add_coordinator_module(s, root["coordinator"], plugins);
+    add_applet_modules(s, plugins);
+  }
   std::vector<std::string> names;
   for (const auto& m : s.modules) names.push_back(m.spec.name);
   for (auto& m : s.modules) m.spec.system_modules = names;

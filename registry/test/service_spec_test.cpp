@@ -1,4 +1,6 @@
 // The services: and coordinator: sections of a system file (docs/coordinator.md).
+#include <algorithm>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -200,6 +202,92 @@ coordinator:
 TEST(ServiceSpec, TheCoordinatorsHostMustBeDeclared) {
   EXPECT_THAT(error_of("coordinator: { host: mars }\n"),
               HasSubstr("s.yaml:5: coordinator: unknown host 'mars'"));
+}
+
+}  // namespace
+}  // namespace oscar
+
+namespace oscar {
+namespace {
+
+constexpr const char* kRemote = R"(services: { Camera: { provided_by: [cam] } }
+coordinator:
+  applet_lease: 2s
+  applets:
+    - { type: t, name: a, process: helpers }
+    - { type: t, name: b, process: helpers }
+    - { type: t, name: c }
+)";
+
+TEST(ServiceSpec, AnAppletWithAProcessRunsInAModuleOfItsOwnProgramOscarApplet) {
+  const auto s = parse(kRemote);
+  ASSERT_TRUE(s.coordinator);
+  EXPECT_EQ(s.coordinator->applet_lease, std::chrono::milliseconds(2000));
+  ASSERT_EQ(s.coordinator->applets.size(), 3u);
+  EXPECT_EQ(s.coordinator->applets[0].process, "helpers");
+  EXPECT_EQ(s.coordinator->applets[0].host, "localhost");  // the coordinator's
+  EXPECT_TRUE(s.coordinator->applets[1].remote());
+  EXPECT_FALSE(s.coordinator->applets[2].remote());
+  const auto* m = s.find_module("helpers");
+  ASSERT_NE(m, nullptr);  // one process for both applets
+  EXPECT_EQ(m->program, "oscar-applet");
+  EXPECT_EQ(m->spec.host, "localhost");
+  EXPECT_EQ(m->restart.kind, RestartPolicy::Kind::kAuto);
+  EXPECT_EQ(std::count_if(s.modules.begin(), s.modules.end(),
+                          [](const SystemModule& x) { return x.program == "oscar-applet"; }),
+            1);
+  // host: alone names a process of its own on that host.
+  const auto h = parse("coordinator: { applets: [ { type: t, name: a, host: localhost } ] }\n");
+  EXPECT_EQ(h.coordinator->applets[0].process, "applets_localhost");
+  EXPECT_NE(h.find_module("applets_localhost"), nullptr);
+  // Without either key the applet runs in the coordinator.
+  EXPECT_EQ(parse(kGood).coordinator->applet_lease, std::chrono::milliseconds(1500));
+}
+
+TEST(ServiceSpec, BadAppletProcessesAndLeasesAreErrorsWithTheirLine) {
+  EXPECT_THAT(error_of("coordinator: { applets: [ { type: t, name: a, proces: p } ] }\n"),
+              HasSubstr("s.yaml:5"));
+  EXPECT_THAT(error_of("coordinator: { applets: [ { type: t, name: a, proces: p } ] }\n"),
+              HasSubstr("proces"));
+  EXPECT_THAT(error_of("coordinator: { applets: [ { type: t, name: a, host: mars } ] }\n"),
+              HasSubstr("s.yaml:5: applet 'a': unknown host 'mars' (hosts: localhost)"));
+  EXPECT_THAT(error_of("coordinator: { applets: [ { type: t, name: a, process: cam } ] }\n"),
+              HasSubstr("s.yaml:5: applet 'a'.process: 'cam' is a module of the system"));
+  EXPECT_THAT(error_of("coordinator: { applets: [ { type: t, name: a, process: grab } ] }\n"),
+              HasSubstr("applet 'a'.process: 'grab' is a kernel's name"));
+  EXPECT_THAT(
+      error_of("coordinator: { applets: [ { type: t, name: a, process: coordinator } ] }\n"),
+      HasSubstr("applet 'a'.process: 'coordinator' is the coordinator's own process"));
+  EXPECT_THAT(
+      error_of("coordinator: { applets: [ { type: t, name: a, process: 'x/y' } ] }\n"),
+      HasSubstr("applet 'a'.process 'x/y': a process name is a module name, an identifier"));
+  EXPECT_THAT(error_of("coordinator: { applet_lease: soon }\n"),
+              HasSubstr("s.yaml:5: coordinator.applet_lease:"));
+  EXPECT_THAT(error_of("coordinator: { applet_lease: 0ms }\n"),
+              HasSubstr("coordinator.applet_lease: must be positive"));
+  EXPECT_THAT(error_of("coordinator: { aplet_lease: 1s }\n"), HasSubstr("aplet_lease"));
+}
+
+TEST(ServiceSpec, AProcessOfAppletsHasOneHost) {
+  const auto e = [] {
+    try {
+      SystemSpec::parse(YAML::Load(R"(system: t
+hosts: { a: { local: true }, b: { netns: nb } }
+modules:
+  - { name: cam, host: a, kernels: [ { type: relay, name: grab } ] }
+coordinator:
+  host: a
+  applets:
+    - { type: t, name: x, process: p }
+    - { type: t, name: y, process: p, host: b }
+)"),
+                        "s.yaml");
+    } catch (const std::invalid_argument& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  }();
+  EXPECT_THAT(e, HasSubstr("s.yaml:9: applet 'y': process 'p' runs on host 'a'"));
 }
 
 }  // namespace

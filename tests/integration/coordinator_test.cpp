@@ -17,6 +17,7 @@
 #include "booted_system.hpp"
 #include "oscar/config_client.hpp"
 #include "oscar/coordinator/plan_json.hpp"
+#include "oscar/time.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
 
@@ -38,8 +39,8 @@ std::string camera_system() {
 // applets' events with boot's authority.
 class CoordinatedSystem {
  public:
-  explicit CoordinatedSystem(const std::string& name)
-      : sys(name, camera_system()),
+  explicit CoordinatedSystem(const std::string& name, const std::string& yaml = camera_system())
+      : sys(name, yaml),
         plans_(sys.participant(), topics::applet_plan(),
                [this](const AppletPlan& p, const auto&) {
                  std::lock_guard lock(mutex_);
@@ -59,6 +60,14 @@ class CoordinatedSystem {
                   << "\nboot output:\n"
                   << sys.boot_output();
     return plan_.value_or(AppletPlan{});
+  }
+
+  // The applet's entry in the plan: "process state", or "(none)".
+  static std::string applet(const AppletPlan& p, const std::string& name) {
+    for (const auto& a : p.applets()) {
+      if (a.name() == name) return a.process() + " " + a.state();
+    }
+    return "(none)";
   }
 
   static std::vector<std::string> holders(const AppletPlan& p, const std::string& service) {
@@ -234,6 +243,189 @@ TEST(Coordinator, AnEventForAnUnknownBundleIsRefusedWithTheReason) {
   const auto reply = c.event("nobody", "request");
   EXPECT_FALSE(reply.ok());
   EXPECT_THAT(reply.error(), HasSubstr("unknown applet 'nobody'"));
+}
+
+// Applets in other processes (docs/coordinator.md): the camera system with `applet` in a
+// process of its own, "applets", an applet lease of 1 s and a module lease long enough that the
+// applet lease, not the registry, is what takes a hung applet's service.
+std::string remote_system(const std::string& applet, bool requested_at_start = false) {
+  auto yaml = camera_system();
+  auto replace = [&](const std::string& from, const std::string& to) {
+    const auto at = yaml.find(from);
+    if (at == std::string::npos) throw std::logic_error("the example changed: no " + from);
+    yaml.replace(at, from.size(), to);
+  };
+  replace("domain: 44\n", "domain: 44\nlease: 3s\n");
+  replace("coordinator:\n", "coordinator:\n  applet_lease: 1s\n");
+  replace("      name: " + applet + "\n", "      name: " + applet + "\n      process: applets\n");
+  if (requested_at_start) {
+    const std::string bundle = "priority: " + std::string(applet == "high" ? "high" : "low") +
+                               ", resources: [ { service: Camera } ]";
+    replace(bundle, bundle + ", requested: true");
+  }
+  return yaml;
+}
+
+bool present(const AppletPlan& p, const std::string& applet, const std::string& state) {
+  return CoordinatedSystem::applet(p, applet) == "applets " + state;
+}
+
+TEST(RemoteApplet, AcquiresTheServiceAndItsCommandReachesTheModuleThenReleasesIt) {
+  CoordinatedSystem c("remote_grant", remote_system("high"));
+  c.sys.running();
+  // It announced itself from its process (oscar applets ps shows the process).
+  c.wait_plan([](const AppletPlan& p) { return present(p, "high", "idle"); },
+              "high announced from process applets");
+  ASSERT_TRUE(c.accepted("high", "request"));
+  c.wait_plan(
+      [](const AppletPlan& p) {
+        return CoordinatedSystem::holders(p, "Camera") == Strings{"high"} &&
+               present(p, "high", "holding");
+      },
+      "Camera held by the remote high");
+  c.wait_cam_mode("continuous");
+  // Its command went over DDS to the coordinator, which forwarded it to the framegrabber.
+  EXPECT_TRUE(c.logged("applet high: frame mode -> half"));
+
+  test::Process ps(
+      {test::bin("oscar-applets"), "ps", "--json", "-d", std::to_string(c.sys.domain())},
+      test::temp_path("remote_ps") + ".out");
+  ASSERT_EQ(ps.wait(std::chrono::seconds(30)), 0) << ps.output();
+  const auto j = nlohmann::json::parse(ps.output());
+  ASSERT_EQ(j["applets"].size(), 2u);
+  EXPECT_EQ(j["applets"][0]["process"], "coordinator");
+  EXPECT_EQ(j["applets"][1]["name"], "high");
+  EXPECT_EQ(j["applets"][1]["process"], "applets");
+
+  ASSERT_TRUE(c.accepted("high", "release"));
+  c.wait_plan([](const AppletPlan& p) { return CoordinatedSystem::holders(p, "Camera").empty(); },
+              "Camera released by the remote high");
+  c.wait_cam_mode("deactivated");
+}
+
+TEST(RemoteApplet, ARemoteHigherPriorityPreemptsALocalHolderWhoseCommandIsThenRefused) {
+  CoordinatedSystem c("remote_preempts", remote_system("high"));
+  c.sys.running();
+  c.wait_plan([](const AppletPlan& p) { return present(p, "high", "idle"); }, "high announced");
+  ASSERT_TRUE(c.accepted("low", "request"));
+  c.wait_plan(
+      [](const AppletPlan& p) { return CoordinatedSystem::holders(p, "Camera") == Strings{"low"}; },
+      "Camera held by the local low");
+  ASSERT_TRUE(c.accepted("high", "request"));
+  c.wait_plan(
+      [](const AppletPlan& p) {
+        return CoordinatedSystem::holders(p, "Camera") == Strings{"high"};
+      },
+      "Camera taken by the remote high");
+  EXPECT_TRUE(c.logged("applet high: frame mode -> half"));
+  EXPECT_TRUE(
+      c.logged("applet low: frame mode quarter refused: applet 'low' does not hold "
+               "service 'Camera': it is held by 'high'"));
+}
+
+TEST(RemoteApplet, ALocalHigherPriorityPreemptsARemoteHolderWhoseCommandIsThenRefused) {
+  CoordinatedSystem c("remote_preempted", remote_system("low"));
+  c.sys.running();
+  c.wait_plan([](const AppletPlan& p) { return present(p, "low", "idle"); }, "low announced");
+  ASSERT_TRUE(c.accepted("low", "request"));
+  c.wait_plan(
+      [](const AppletPlan& p) { return CoordinatedSystem::holders(p, "Camera") == Strings{"low"}; },
+      "Camera held by the remote low");
+  EXPECT_TRUE(c.logged("applet low: frame mode -> quarter"));
+  ASSERT_TRUE(c.accepted("high", "request"));
+  c.wait_plan(
+      [](const AppletPlan& p) {
+        return CoordinatedSystem::holders(p, "Camera") == Strings{"high"} &&
+               present(p, "low", "waiting");
+      },
+      "Camera taken from the remote low");
+  // The remote applet (insist: true) keeps sending; the coordinator refuses naming the holder.
+  EXPECT_TRUE(
+      c.logged("applet low: frame mode quarter refused: applet 'low' does not hold "
+               "service 'Camera': it is held by 'high'"));
+}
+
+TEST(RemoteApplet, AKilledRemoteHoldersServiceGoesToTheWaitingAppletWithinTheLease) {
+  CoordinatedSystem c("remote_killed", remote_system("high"));
+  c.sys.running();
+  c.wait_plan([](const AppletPlan& p) { return present(p, "high", "idle"); }, "high announced");
+  ASSERT_TRUE(c.accepted("low", "request"));
+  ASSERT_TRUE(c.accepted("high", "request"));
+  c.wait_plan(
+      [](const AppletPlan& p) {
+        return CoordinatedSystem::holders(p, "Camera") == Strings{"high"} &&
+               present(p, "high", "holding");
+      },
+      "Camera held by the remote high, low waiting");
+  const auto s = c.sys.wait_for([](const SystemState& st) { return entry(st, "applets"); });
+  ASSERT_EQ(kill(static_cast<pid_t>(entry(s, "applets")->pid()), SIGKILL), 0);
+  // The lease runs out, or the restarted process announces a new session first (the registry
+  // restarts it after 200 ms): either way what the dead process held is taken.
+  c.wait_plan(
+      [](const AppletPlan& p) { return CoordinatedSystem::holders(p, "Camera") == Strings{"low"}; },
+      "Camera given to the waiting low");
+  EXPECT_TRUE(c.logged("applet low: frame mode -> quarter"));
+  // The registry restarts the process; the applet announces itself again (asking for nothing:
+  // its request was an event, gone with the process) and low keeps the camera.
+  c.wait_plan(
+      [](const AppletPlan& p) {
+        return present(p, "high", "idle") &&
+               CoordinatedSystem::holders(p, "Camera") == Strings{"low"};
+      },
+      "high back, idle");
+}
+
+TEST(RemoteApplet, AHungRemoteHolderLosesItsGrantByLeaseAndAsksAgainWhenItGoesOn) {
+  CoordinatedSystem c("remote_hung", remote_system("high", /*requested_at_start=*/true));
+  c.sys.running();
+  c.wait_plan(
+      [](const AppletPlan& p) {
+        return CoordinatedSystem::holders(p, "Camera") == Strings{"high"};
+      },
+      "Camera held by the remote high (requested at start)");
+  ASSERT_TRUE(c.accepted("low", "request"));
+  const auto s = c.sys.wait_for([](const SystemState& st) { return entry(st, "applets"); });
+  const auto pid = static_cast<pid_t>(entry(s, "applets")->pid());
+  ASSERT_EQ(kill(pid, SIGSTOP), 0);
+  const bool lost = c.logged("coordinator: applet 'high' in process 'applets' missed its lease");
+  c.wait_plan(
+      [](const AppletPlan& p) { return CoordinatedSystem::holders(p, "Camera") == Strings{"low"}; },
+      "Camera given to the waiting low while high hangs");
+  ASSERT_EQ(kill(pid, SIGCONT), 0);
+  EXPECT_TRUE(lost);
+  // It goes on (or the registry restarted it): it announces itself with its request again, and
+  // its priority takes the camera back.
+  c.wait_plan(
+      [](const AppletPlan& p) {
+        return CoordinatedSystem::holders(p, "Camera") == Strings{"high"} &&
+               present(p, "high", "holding");
+      },
+      "Camera back with high");
+}
+
+TEST(RemoteApplet, ARestartedCoordinatorRebuildsThePlanFromTheRemoteAppletsRequests) {
+  CoordinatedSystem c("remote_coord_killed", remote_system("high"));
+  c.sys.running();
+  c.wait_plan([](const AppletPlan& p) { return present(p, "high", "idle"); }, "high announced");
+  ASSERT_TRUE(c.accepted("high", "request"));
+  c.wait_cam_mode("continuous");
+  const auto s =
+      c.sys.wait_for([](const SystemState& st) { return entry(st, "coordinator") != nullptr; });
+  const auto killed_at = static_cast<unsigned long long>(wall_now());
+  ASSERT_EQ(kill(static_cast<pid_t>(entry(s, "coordinator")->pid()), SIGKILL), 0);
+  c.sys.wait_for([](const SystemState& st) {
+    const auto* m = entry(st, "coordinator");
+    return m && m->incarnation() == 2 && m->status() == "running";
+  });
+  // The remote applet kept its request; the new coordinator hears it announced again.
+  c.wait_plan(
+      [&](const AppletPlan& p) {
+        return p.stamp_ns() > killed_at &&
+               CoordinatedSystem::holders(p, "Camera") == Strings{"high"} &&
+               present(p, "high", "holding");
+      },
+      "Camera held by high again after the coordinator's restart");
+  c.wait_cam_mode("continuous");
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "oscar/applets/runtime_context.hpp"
+
 namespace oscar::applets {
 namespace {
 
@@ -36,8 +38,23 @@ void Runtime::set_code(const std::string& applet, AppletCode code) {
   const AppletId id = scheduler_.model().applet_id(applet);
   if (running_) throw std::invalid_argument("applet '" + applet + "': set code before start()");
   if (!code.step) throw std::invalid_argument("applet '" + applet + "': code needs a step");
+  if (slots_[id]->forward) {
+    throw std::invalid_argument("applet '" + applet + "' runs elsewhere: it has no code here");
+  }
   slots_[id]->code = std::move(code);
   slots_[id]->has_code = true;
+}
+
+void Runtime::set_remote(const std::string& applet,
+                         std::function<void(const Notification&)> forward) {
+  std::lock_guard lock(mutex_);
+  const AppletId id = scheduler_.model().applet_id(applet);
+  if (running_)
+    throw std::invalid_argument("applet '" + applet + "': set it remote before start()");
+  if (slots_[id]->has_code) {
+    throw std::invalid_argument("applet '" + applet + "' has code here: it cannot be remote");
+  }
+  slots_[id]->forward = std::move(forward);
 }
 
 void Runtime::start() {
@@ -111,6 +128,10 @@ void Runtime::deliver() {
     }
     if (n.kind == Notification::Kind::kRevokedByForce) waiting_since_[n.bundle] = Clock::now();
     Slot& slot = *slots_[n.applet];
+    if (slot.forward) {  // its code runs elsewhere
+      slot.forward(n);
+      continue;
+    }
     slot.interrupts.push_back(std::move(n));
     if (std::find(to_wake_.begin(), to_wake_.end(), &slot) == to_wake_.end()) {
       to_wake_.push_back(&slot);
@@ -128,7 +149,7 @@ RuntimeStats Runtime::stats() const {
 // else goes on.
 void Runtime::applet_main(AppletId id) {
   Slot& slot = *slots_[id];
-  AppletContext ctx(*this, id);
+  RuntimeContext ctx(*this, id);
   try {
     if (slot.code.init) slot.code.init(ctx);  // Abb. 4.12 lines 1–3
     auto next = Clock::now();

@@ -390,3 +390,51 @@ TEST(Runtime, FailStopAppletGetsAnExceptionInsteadOfBlocking) {
 
 }  // namespace
 }  // namespace oscar::applets
+
+namespace oscar::applets {
+namespace {
+
+// An applet whose code runs in another process has no thread here: its notifications go to
+// the forwarder, in order, and its bundles move by scheduler calls (what the coordinator does
+// with an applet's messages over DDS).
+TEST(Runtime, ARemoteAppletsNotificationsGoToItsForwarderAndItRunsNoCodeHere) {
+  Model m;
+  const ServiceId s = m.add_service("S");
+  const BundleId remote =
+      m.add_bundle(m.add_applet("Remote"), "s", {{s, Access::kExclusive}}, kPriorityHigh);
+  m.add_bundle(m.add_applet("Local"), "s", {{s, Access::kExclusive}});
+  Runtime rt(m);
+  std::mutex mu;
+  std::vector<Notification::Kind> forwarded;
+  rt.set_remote("Remote", [&](const Notification& n) {
+    std::lock_guard lock(mu);
+    forwarded.push_back(n.kind);
+  });
+  EXPECT_THROW(rt.set_code("Remote", {{}, [](AppletContext&) {}, {}, std::chrono::milliseconds(2)}),
+               std::invalid_argument);
+  std::atomic<int> local_uses{0};
+  rt.set_code("Local", {[](AppletContext& c) { c.request("s"); },
+                        [&](AppletContext& c) { c.use("s", [&] { ++local_uses; }); },
+                        {},
+                        std::chrono::milliseconds(2)});
+  rt.start();
+  ASSERT_TRUE(testing::eventually([&] { return local_uses > 0; }));
+  rt.with_scheduler([&](Scheduler& sch) { sch.request(remote); });
+  // The local holder yields by default; the remote bundle is granted.
+  ASSERT_TRUE(testing::eventually([&] {
+    bool active = false;
+    rt.with_scheduler([&](Scheduler& sch) { active = sch.active(remote); });
+    return active;
+  }));
+  {
+    std::lock_guard lock(mu);
+    EXPECT_EQ(forwarded, std::vector<Notification::Kind>{Notification::Kind::kGranted});
+  }
+  rt.with_scheduler([&](Scheduler& sch) { sch.release(remote); });
+  const int before = local_uses;
+  ASSERT_TRUE(testing::eventually([&] { return local_uses > before; }));
+  rt.stop();
+}
+
+}  // namespace
+}  // namespace oscar::applets

@@ -32,7 +32,9 @@ applets::SystemConfig applet_system(const SystemSpec& system) {
   for (const auto& a : c.applets) {
     YAML::Node applet;
     for (const auto& kv : a.node) {
-      if (kv.first.as<std::string>() != "type") applet[kv.first] = kv.second;
+      // type and where it runs (process, host) are the coordinator's, not the scheduler's.
+      const auto key = kv.first.as<std::string>();
+      if (key != "type" && key != "process" && key != "host") applet[kv.first] = kv.second;
     }
     doc["applets"].push_back(applet);
   }

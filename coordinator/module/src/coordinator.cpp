@@ -11,6 +11,7 @@
 #include "oscar/coordinator/applet_system.hpp"
 #include "oscar/time.hpp"
 #include "providers.hpp"
+#include "remote_applets.hpp"
 
 namespace oscar::coordinator {
 namespace {
@@ -46,6 +47,7 @@ Coordinator::Coordinator(const SystemSpec& system, DdsParticipant& participant,
   applets_.resize(config_.model.applets().size());
   if (system.coordinator) {
     for (const auto& a : system.coordinator->applets) {
+      if (a.remote()) continue;  // made and run in its own process
       AppletSetup setup(a.name, config_.applet_params[a.name], *this);
       try {
         applets_.at(config_.model.applet_id(a.name)) = make_applet(a.type, setup, plugin_path);
@@ -56,7 +58,7 @@ Coordinator::Coordinator(const SystemSpec& system, DdsParticipant& participant,
   }
   for (std::size_t id = 0; id < applets_.size(); ++id) {
     Applet* a = applets_[id].get();
-    if (!a) continue;  // a service applet without code of its own (none from system files yet)
+    if (!a) continue;  // runs in another process (or a service applet without code of its own)
     applets::AppletCode code;
     code.init = [a](applets::AppletContext& ctx) { a->init(ctx); };
     code.step = [a](applets::AppletContext& ctx) { a->step(ctx); };
@@ -77,6 +79,8 @@ Coordinator::Coordinator(const SystemSpec& system, DdsParticipant& participant,
   for (const auto& a : config_.model.applets()) {
     for (const ServiceId s : a.provides) providers_of_.at(s).push_back("applet:" + a.name);
   }
+  remote_ =
+      std::make_unique<RemoteApplets>(system, *runtime_, *this, participant, [this] { wake(); });
   client_ = std::make_unique<ConfigClient>(participant, "coordinator");
   providers_ = std::make_unique<Providers>(system, *client_);
   system_reader_ = std::make_unique<TopicReader<SystemState, SystemStatePubSubType>>(
@@ -87,6 +91,13 @@ Coordinator::Coordinator(const SystemSpec& system, DdsParticipant& participant,
 Coordinator::~Coordinator() {
   stop();
   system_reader_.reset();  // no callback into a half-destroyed object
+  remote_.reset();
+}
+
+void Coordinator::wake() {
+  std::lock_guard lock(mutex_);
+  woken_ = true;
+  wake_.notify_all();
 }
 
 void Coordinator::start() {
@@ -97,8 +108,12 @@ void Coordinator::start() {
   }
   runtime_->start();
   runtime_->with_scheduler([&](applets::Scheduler& s) {
-    for (const BundleId b : config_.requested_at_start) s.request(b);
+    for (const BundleId b : config_.requested_at_start) {
+      // A remote applet asks for its bundles itself when it announces itself.
+      if (!remote_->remote(s.model().applet(s.model().bundle(b).applet).name)) s.request(b);
+    }
   });
+  remote_->start();
   thread_ = std::thread([this] { loop(); });
 }
 
@@ -110,6 +125,7 @@ void Coordinator::stop() {
   }
   wake_.notify_all();
   if (thread_.joinable()) thread_.join();
+  remote_->stop();
   runtime_->stop();
 }
 
@@ -192,10 +208,15 @@ Coordinator::Snapshot Coordinator::snapshot() {
     AppletEntry e;
     e.name(config_.model.applet(static_cast<applets::AppletId>(id)).name);
     e.process(SystemSpec::kCoordinatorModule);
-    e.state(runtime_->crashed(e.name()) ? "crashed"
-            : holding[id]               ? "holding"
-            : waiting[id]               ? "waiting"
-                                        : "idle");
+    std::optional<std::string> state;
+    if (remote_->remote(e.name())) {
+      auto seen = remote_->seen(e.name());
+      e.process(seen.process);
+      state = seen.state;
+    } else if (runtime_->crashed(e.name())) {
+      state = "crashed";
+    }
+    e.state(state ? *state : holding[id] ? "holding" : waiting[id] ? "waiting" : "idle");
     plan.applets().push_back(std::move(e));
   }
   return snap;
@@ -246,6 +267,9 @@ AppletPlan Coordinator::plan() { return snapshot().plan; }
 std::optional<std::string> Coordinator::apply_event(const std::string& applet,
                                                     const std::string& bundle,
                                                     const std::string& event) {
+  // An applet in another process applies the event as its own call (it keeps what it asks for,
+  // and announces it again after a restart of either side).
+  if (remote_->remote(applet)) return remote_->event(applet, bundle, event);
   std::optional<std::string> error;
   runtime_->with_scheduler([&](applets::Scheduler& s) {
     try {

@@ -65,6 +65,7 @@ const char* state_colour(const std::string& state) {
   if (state == "holding") return "palegreen";
   if (state == "waiting") return "khaki";
   if (state == "crashed") return "salmon";
+  if (state == "absent") return "lightgrey";
   return "white";
 }
 
@@ -118,7 +119,7 @@ std::string plan_dot(const AppletPlan& plan) {
   out +=
       "  subgraph cluster_legend {\n    label=\"legend\";\n"
       "    node [shape=box, style=filled, fontsize=9];\n";
-  for (const char* state : {"holding", "waiting", "idle", "crashed"}) {
+  for (const char* state : {"holding", "waiting", "idle", "crashed", "absent"}) {
     out += fmt::format("    {} [fillcolor={}, label={}];\n", quote(std::string("legend:") + state),
                        state_colour(state), quote(std::string("applet ") + state));
   }

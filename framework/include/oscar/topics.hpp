@@ -15,6 +15,7 @@
 #include <oscar/coordinatorPubSubTypes.h>
 #include <oscar/pullPubSubTypes.h>
 #include <oscar/registryPubSubTypes.h>
+#include <oscar/schedPubSubTypes.h>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
@@ -70,6 +71,22 @@ TopicSpec<RegistryReply, RegistryReplyPubSubType> registry_reply();
 TopicSpec<SystemState, SystemStatePubSubType> system_state();
 /// The coordinator's plan: services, holders, applets (keep last 1; `oscar applets ps`).
 TopicSpec<AppletPlan, AppletPlanPubSubType> applet_plan();
+
+/// The applet protocol between the coordinator and applets in other processes
+/// (docs/coordinator.md): reliable, volatile, keep all (nothing dropped; a restarted process
+/// starts afresh and announces itself), except the beats (a stream, 16 deep).
+/// An applet's announcement with all it asks for.
+TopicSpec<SchedHello, SchedHelloPubSubType> sched_hello();
+/// An applet's heartbeat from its loop (the coordinator's lease).
+TopicSpec<SchedBeat, SchedBeatPubSubType> sched_beat();
+/// An applet's scheduler calls and the coordinator's replies.
+TopicSpec<SchedCall, SchedCallPubSubType> sched_call();
+TopicSpec<SchedReply, SchedReplyPubSubType> sched_reply();
+/// The coordinator's notifications to applets.
+TopicSpec<SchedNotice, SchedNoticePubSubType> sched_notice();
+/// An applet's commands to modules through the coordinator, and their replies.
+TopicSpec<SchedCommand, SchedCommandPubSubType> sched_command();
+TopicSpec<SchedCommandReply, SchedCommandReplyPubSubType> sched_command_reply();
 
 }  // namespace topics
 }  // namespace oscar

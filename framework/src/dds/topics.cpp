@@ -79,4 +79,32 @@ TopicSpec<AppletPlan, AppletPlanPubSubType> applet_plan() {
   return {"oscar/coordinator/plan", qos::state_writer(1), qos::state_reader(1)};
 }
 
+TopicSpec<SchedHello, SchedHelloPubSubType> sched_hello() {
+  return {"oscar/sched/hello", qos::command_writer(), qos::command_reader()};
+}
+
+TopicSpec<SchedBeat, SchedBeatPubSubType> sched_beat() {
+  return {"oscar/sched/beat", qos::stream_writer(16), qos::stream_reader(16)};
+}
+
+TopicSpec<SchedCall, SchedCallPubSubType> sched_call() {
+  return {"oscar/sched/call", qos::command_writer(), qos::command_reader()};
+}
+
+TopicSpec<SchedReply, SchedReplyPubSubType> sched_reply() {
+  return {"oscar/sched/reply", qos::command_writer(), qos::command_reader()};
+}
+
+TopicSpec<SchedNotice, SchedNoticePubSubType> sched_notice() {
+  return {"oscar/sched/notice", qos::command_writer(), qos::command_reader()};
+}
+
+TopicSpec<SchedCommand, SchedCommandPubSubType> sched_command() {
+  return {"oscar/sched/command", qos::command_writer(), qos::command_reader()};
+}
+
+TopicSpec<SchedCommandReply, SchedCommandReplyPubSubType> sched_command_reply() {
+  return {"oscar/sched/command_reply", qos::command_writer(), qos::command_reader()};
+}
+
 }  // namespace oscar::topics

@@ -52,8 +52,8 @@ struct SystemModule {
   RestartPolicy restart;
   DebugSpec debug;
   bool standby = false;  ///< started only as another module's replacement
-  /// The program the monitor starts: "oscar-run", or "oscar-coordinator" for the module the
-  /// `coordinator:` section makes.
+  /// The program the monitor starts: "oscar-run", "oscar-coordinator" for the module the
+  /// `coordinator:` section makes, or "oscar-applet" for a process of applets (`process:`).
   std::string program = "oscar-run";
 };
 
@@ -80,12 +80,18 @@ struct ServiceSpec {
 };
 
 /// One applet the coordinator runs: its type (a registered applet class) and its configuration
-/// in the applet scheduler's vocabulary (name, params, bundles, fail_stop).
+/// in the applet scheduler's vocabulary (name, params, bundles, fail_stop), and where it runs.
 struct AppletSpec {
   std::string type;
   std::string name;
   YAML::Node node;
   std::string where;
+  /// The process it runs in: empty for the coordinator's own; else a process of its own that
+  /// boot starts (program oscar-applet, a module of this name) and that talks to the
+  /// coordinator over DDS (`process: NAME`, or `host: H` alone: "applets_H").
+  std::string process;
+  std::string host;  ///< the host of `process` (default: the coordinator's)
+  bool remote() const { return !process.empty(); }
 };
 
 /// The `coordinator:` section: where the coordinator runs and what it runs.
@@ -93,6 +99,9 @@ struct CoordinatorSpec {
   std::string host;
   YAML::Node scheduler;  ///< scheduler options, as the applet scheduler reads them
   std::vector<AppletSpec> applets;
+  /// How long the coordinator waits for a beat of an applet in another process before it takes
+  /// the applet's bundles (`applet_lease:`).
+  std::chrono::milliseconds applet_lease{1500};
   std::string where;
 };
 

@@ -51,6 +51,11 @@ class Runtime {
 
   /// Sets the code of a configured applet. @throws std::invalid_argument if unknown or started.
   void set_code(const std::string& applet, AppletCode code);
+  /// The applet's code runs elsewhere (another process, docs/coordinator.md): it gets no thread
+  /// here, and each of its notifications is handed to `forward`, in order, under the runtime's
+  /// lock — so `forward` only queues; it must not call back into the runtime.
+  /// @throws std::invalid_argument if unknown, started, or the applet has code.
+  void set_remote(const std::string& applet, std::function<void(const Notification&)> forward);
   /// Starts one thread per applet with code, and the reassigner.
   void start();
   /// Stops and joins all threads (also called by the destructor).
@@ -65,13 +70,14 @@ class Runtime {
   RuntimeStats stats() const;
 
  private:
-  friend class AppletContext;
+  friend class RuntimeContext;
   struct Slot {
     AppletCode code;
     std::deque<Notification> interrupts;
     bool paused = false;
     bool crashed = false;
     bool has_code = false;
+    std::function<void(const Notification&)> forward;  // set: the applet runs elsewhere
     /// A chain of negotiation rounds under way (seed §4.5.3). Applet thread only.
     struct Chain {
       std::shared_ptr<const NegotiationRound> next;  ///< The follow-up to run.

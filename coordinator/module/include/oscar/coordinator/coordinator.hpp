@@ -4,6 +4,8 @@
 /// says (activate in a mode), idling it deactivates them. Applets run in threads of their own
 /// (the scheduler's Runtime) and command the modules of the services they hold through it; it is
 /// the only configuration authority for modules. It publishes its plan on oscar/coordinator/plan.
+/// Applets configured with a `process:` run in processes of their own and keep their slot here,
+/// driven over DDS (oscar/sched/..., AppletHost on their side).
 
 #include <condition_variable>
 #include <map>
@@ -29,6 +31,7 @@
 namespace oscar::coordinator {
 
 class Providers;
+class RemoteApplets;
 
 class Coordinator final : public AppletGateway {
  public:
@@ -68,6 +71,7 @@ class Coordinator final : public AppletGateway {
   void on_system_state(const SystemState& state);
   // Applies what the snapshot's services need to their providers, then publishes if changed.
   void reconcile();
+  void wake();
 
   const SystemSpec& system_;
   applets::SystemConfig config_;
@@ -76,6 +80,7 @@ class Coordinator final : public AppletGateway {
   std::vector<std::vector<std::string>> providers_of_;  // by ServiceId, as the plan shows them
   std::unique_ptr<ConfigClient> client_;
   std::unique_ptr<Providers> providers_;
+  std::unique_ptr<RemoteApplets> remote_;
   TopicWriter<AppletPlan, AppletPlanPubSubType> plan_writer_;
   std::unique_ptr<TopicReader<SystemState, SystemStatePubSubType>> system_reader_;
 

@@ -1,4 +1,4 @@
-#include "oscar/applets/applet_context.hpp"
+#include "oscar/applets/runtime_context.hpp"
 
 #include <algorithm>
 
@@ -12,29 +12,29 @@ double ms_between(std::chrono::steady_clock::time_point a,
 }
 }  // namespace
 
-BundleId AppletContext::bundle_id(const std::string& bundle) const {
+BundleId RuntimeContext::bundle_id(const std::string& bundle) const {
   return runtime_.scheduler_.model().bundle_id(applet_, bundle);
 }
 
-void AppletContext::request(const std::string& bundle) {
+void RuntimeContext::request(const std::string& bundle) {
   const BundleId b = bundle_id(bundle);
   runtime_.with_scheduler([&](Scheduler& s) {
     if (!s.requested(b)) runtime_.waiting_since_[b] = Runtime::Clock::now();
     s.request(b);
   });
 }
-void AppletContext::release(const std::string& bundle) {
+void RuntimeContext::release(const std::string& bundle) {
   const BundleId b = bundle_id(bundle);
   runtime_.with_scheduler([&](Scheduler& s) { s.release(b); });
 }
-void AppletContext::yield(const std::string& bundle) {
+void RuntimeContext::yield(const std::string& bundle) {
   const BundleId b = bundle_id(bundle);
   runtime_.with_scheduler([&](Scheduler& s) {
     if (s.revoke_deadline(b)) runtime_.waiting_since_[b] = Runtime::Clock::now();
     s.yield(b);
   });
 }
-void AppletContext::refuse_reprioritising(const std::string& bundle, const char* what) const {
+void RuntimeContext::refuse_reprioritising(const std::string& bundle, const char* what) const {
   const auto& revoked = runtime_.slots_[applet_]->reacting_to_revocation;
   if (!revoked) return;
   const Model& m = runtime_.scheduler_.model();
@@ -44,51 +44,51 @@ void AppletContext::refuse_reprioritising(const std::string& bundle, const char*
       "'; an applet never re-prioritises in reaction to a revocation (seed 000 §4.5.2, footnote "
       "11: it would make the plan oscillate) — yield or negotiate instead");
 }
-void AppletContext::trigger(const std::string& bundle) {
+void RuntimeContext::trigger(const std::string& bundle) {
   const BundleId b = bundle_id(bundle);
   refuse_reprioritising(bundle, "triggers");
   runtime_.with_scheduler([&](Scheduler& s) { s.trigger(b); });
 }
-void AppletContext::set_priority(const std::string& bundle, int priority) {
+void RuntimeContext::set_priority(const std::string& bundle, int priority) {
   const BundleId b = bundle_id(bundle);
   refuse_reprioritising(bundle, "changes the priority of");
   runtime_.with_scheduler([&](Scheduler& s) { s.set_priority(b, priority); });
 }
-void AppletContext::set_deadline(const std::string& bundle, std::optional<Deadline> deadline) {
+void RuntimeContext::set_deadline(const std::string& bundle, std::optional<Deadline> deadline) {
   const BundleId b = bundle_id(bundle);
   runtime_.with_scheduler([&](Scheduler& s) { s.set_deadline(b, deadline); });
 }
-Notification AppletContext::negotiate(const std::string& bundle, const Negotiation& answer) {
+Notification RuntimeContext::negotiate(const std::string& bundle, const Negotiation& answer) {
   const BundleId b = bundle_id(bundle);
   Notification n;
   runtime_.with_scheduler([&](Scheduler& s) { n = s.negotiate(b, answer); });
   return n;
 }
 
-std::optional<Notification> AppletContext::negotiate(const std::string& bundle,
-                                                     const NegotiationRound& round) {
+std::optional<Notification> RuntimeContext::negotiate(const std::string& bundle,
+                                                      const NegotiationRound& round) {
   const BundleId b = bundle_id(bundle);
   if (runtime_.slots_[applet_]->negotiations.count(b) != 0) return std::nullopt;
   return runtime_.run_round(*this, b, round);
 }
 
-bool AppletContext::negotiating(const std::string& bundle) const {
+bool RuntimeContext::negotiating(const std::string& bundle) const {
   return runtime_.slots_[applet_]->negotiations.count(bundle_id(bundle)) != 0;
 }
 
-bool AppletContext::being_revoked(const std::string& bundle) const {
+bool RuntimeContext::being_revoked(const std::string& bundle) const {
   const BundleId b = bundle_id(bundle);
   std::lock_guard lock(runtime_.mutex_);
   return runtime_.scheduler_.revoke_deadline(b).has_value();
 }
 
-bool AppletContext::granted(const std::string& bundle) const {
+bool RuntimeContext::granted(const std::string& bundle) const {
   const BundleId b = bundle_id(bundle);
   std::lock_guard lock(runtime_.mutex_);
   return runtime_.scheduler_.active(b);
 }
 
-bool AppletContext::use(const std::string& bundle, const std::function<void()>& body) {
+bool RuntimeContext::use(const std::string& bundle, const std::function<void()>& body) {
   const BundleId b = bundle_id(bundle);
   {
     std::unique_lock lock(runtime_.mutex_);
