@@ -16,6 +16,7 @@
 #include "dds/log_sink.hpp"
 #include "dds/module_dds.hpp"
 #include "module_slot.hpp"
+#include "oscar/dds_participant.hpp"
 #include "repeat_filter_sink.hpp"
 #include "ring_pull_source.hpp"
 #include "sequence_store.hpp"
@@ -33,6 +34,8 @@ std::string source_channel(const std::string& source) {
 
 Module::Module(ModuleSpec spec, const std::vector<std::string>& plugin_path)
     : spec_(std::move(spec)) {
+  // Before any kernel exists: a participant a kernel makes says whose process it is in.
+  if (!spec_.system_modules.empty()) internal::note_hosted_module(spec_.name);
   // Every line goes to stdout and, once the module is on DDS, to oscar/log; a line repeated
   // within a second is held back and counted.
   log_sink_ = std::make_shared<internal::DdsLogSink>(spec_.name);

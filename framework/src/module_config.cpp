@@ -45,14 +45,35 @@ const char* kind_name(CommandKind k) {
   return "?";
 }
 
+// The module the `coordinator:` section's process announces itself as (SystemSpec).
+constexpr const char* kCoordinatorModule = "coordinator";
+
 // Seed 004 §2.4: only the coordinator configures modules; the registry suspends, resumes and
 // re-applies a restarted module's configuration; boot applies the initial configuration.
 // Kernels' command ports are the coordinator's (and boot's) too: the registry restores
-// configuration, it does not command actuators.
-bool authorised(const std::string& sender, CommandKind kind) {
-  if (sender == "coordinator" || sender == "boot") return true;
-  if (sender == "registry") return kind != CMD_TRIGGER && kind != CMD_COMMAND;
-  return false;
+// configuration, it does not command actuators. The sender's name counts only from a process
+// that hosts no module of the system (boot, the registry, an operator's tool): a kernel cannot
+// borrow the coordinator's name, because the command comes from its module's process. (On the
+// wire, DDS Security's permissions make this hold against any participant, see docs/security.)
+std::optional<std::string> refusal(const ConfigCommand& c, const CommandOrigin& origin,
+                                   const std::string& kind, const std::string& module) {
+  constexpr const char* kRule =
+      "only the coordinator configures modules (the registry may suspend, resume and re-apply; "
+      "boot applies the initial configuration)";
+  const bool from_coordinator =
+      origin.modules.size() == 1 && origin.modules.front() == kCoordinatorModule;
+  if (!origin.modules.empty() && !from_coordinator) {
+    return fmt::format(
+        "refused: '{}' may not {} module '{}': the command comes from the process of module "
+        "'{}', and {}",
+        c.sender(), kind, module, fmt::join(origin.modules, "', '"), kRule);
+  }
+  const std::string& sender = from_coordinator ? kCoordinatorModule : c.sender();
+  if (sender == kCoordinatorModule || sender == "boot") return std::nullopt;
+  if (sender == "registry" && c.kind() != CMD_TRIGGER && c.kind() != CMD_COMMAND) {
+    return std::nullopt;
+  }
+  return fmt::format("refused: '{}' may not {} module '{}': {}", c.sender(), kind, module, kRule);
 }
 
 void need_args(const ConfigCommand& c, std::size_t n, const char* form) {
@@ -85,17 +106,14 @@ std::vector<Module::Slot*> Module::slots_for(const std::string& kernel_or_all,
   return out;
 }
 
-ConfigReply Module::apply(const ConfigCommand& c) {
+ConfigReply Module::apply(const ConfigCommand& c, const CommandOrigin& origin) {
   ConfigReply reply;
   reply.id(c.id());
   reply.module_name(spec_.name);
   const std::string kind = kind_name(c.kind());
-  if (!authorised(c.sender(), c.kind())) {
+  if (auto why = refusal(c, origin, kind, spec_.name)) {
     reply.ok(false);
-    reply.error(fmt::format(
-        "refused: '{}' may not {} module '{}': only the coordinator configures modules (the "
-        "registry may suspend, resume and re-apply; boot applies the initial configuration)",
-        c.sender(), kind, spec_.name));
+    reply.error(std::move(*why));
     log_->warn("{}", reply.error());
     reply.state(state());
     return reply;

@@ -328,6 +328,13 @@ ModuleSpec ModuleSpec::load(const std::string& path, const std::string& module) 
           spec.lease = std::chrono::duration_cast<std::chrono::milliseconds>(
               parse_duration(root["lease"].as<std::string>()));
         }
+        for (const auto& other : modules) {
+          if (other["name"] && other["name"].IsScalar()) {
+            spec.system_modules.push_back(other["name"].Scalar());
+          }
+        }
+        // The `coordinator:` section runs as a module of this name (SystemSpec).
+        if (root["coordinator"]) spec.system_modules.push_back("coordinator");
         return spec;
       }
     }

@@ -104,6 +104,45 @@ void check_cycles(const SystemSpec& s) {
   }
 }
 
+// A service is provided by modules (provided_by) or by one applet (its provides:, seed 000
+// §4.2.3: the UI service of §5.3 is the UIService applet's), never by both or by nobody.
+void check_service_providers(const SystemSpec& s, const CoordinatorSpec& c) {
+  std::map<std::string, std::string> by_applet;  // service -> applet
+  for (const auto& a : c.applets) {
+    const auto provides = a.node["provides"];
+    if (!provides) continue;
+    for (const auto& p : list(s.file, provides, "applet '" + a.name + "'.provides", "[UI]")) {
+      const auto service = text(s.file, p, "applet '" + a.name + "'.provides entry");
+      const auto* svc = s.find_service(service);
+      if (!svc) {
+        fail(s.file, p,
+             fmt::format("applet '{}' provides service '{}', which is not declared under "
+                         "services:",
+                         a.name, service));
+      }
+      if (!svc->providers.empty()) {
+        fail(s.file, p,
+             fmt::format("applet '{}' provides service '{}', which modules provide already "
+                         "(provided_by at {}): a service has one kind of provider",
+                         a.name, service, svc->where));
+      }
+      if (const auto [it, fresh] = by_applet.emplace(service, a.name); !fresh) {
+        fail(s.file, p,
+             fmt::format("service '{}' is provided by two applets, '{}' and '{}'", service,
+                         it->second, a.name));
+      }
+    }
+  }
+  for (const auto& svc : s.services) {
+    if (svc.providers.empty() && !by_applet.contains(svc.name)) {
+      throw std::invalid_argument(fmt::format(
+          "{}: service '{}': nobody provides it: name its modules in provided_by, or list it "
+          "under an applet's provides:",
+          svc.where, svc.name));
+    }
+  }
+}
+
 }  // namespace
 
 void parse_services(SystemSpec& s, const YAML::Node& node) {
@@ -117,10 +156,12 @@ void parse_services(SystemSpec& s, const YAML::Node& node) {
     const auto& n = kv.second;
     if (!n.IsMap()) fail(s.file, n, what + ": expected a map with provided_by");
     check_yaml_keys(n, s.file, what, {"provided_by", "access", "needs", "granted", "idle"});
-    if (!n["provided_by"]) fail(s.file, n, what + ": provided_by is missing");
-    for (const auto& p :
-         list(s.file, n["provided_by"], what + ".provided_by", "[cam, marks/mark_a]")) {
-      svc.providers.push_back(provider_of(s, p, what + ".provided_by"));
+    // No provided_by: an applet provides it (checked with the applets, parse_coordinator).
+    if (n["provided_by"]) {
+      for (const auto& p :
+           list(s.file, n["provided_by"], what + ".provided_by", "[cam, marks/mark_a]")) {
+        svc.providers.push_back(provider_of(s, p, what + ".provided_by"));
+      }
     }
     if (n["access"]) {
       const auto a = text(s.file, n["access"], what + ".access");
@@ -211,8 +252,9 @@ void parse_coordinator(SystemSpec& s, const YAML::Node& node) {
          list(s.file, node["applets"], "coordinator.applets", "[{type: T, name: N}]")) {
       if (!a.IsMap())
         fail(s.file, a, "coordinator.applets: each applet is a map with type and name");
-      check_yaml_keys(a, s.file, "applet",
-                      {"type", "name", "params", "bundles", "fail_stop", "process", "host"});
+      check_yaml_keys(
+          a, s.file, "applet",
+          {"type", "name", "params", "bundles", "fail_stop", "process", "host", "provides"});
       AppletSpec spec{text(s.file, a["type"], "applet type"),
                       text(s.file, a["name"], "applet name"),
                       a,
@@ -274,6 +316,7 @@ void parse_coordinator(SystemSpec& s, const YAML::Node& node) {
       c.applets.push_back(std::move(spec));
     }
   }
+  check_service_providers(s, c);
   s.coordinator = std::move(c);
 }
 

@@ -311,6 +311,9 @@ SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
     add_coordinator_module(s, root["coordinator"], plugins);
     add_applet_modules(s, plugins);
   }
+  std::vector<std::string> names;
+  for (const auto& m : s.modules) names.push_back(m.spec.name);
+  for (auto& m : s.modules) m.spec.system_modules = names;
   return s;
 }
 

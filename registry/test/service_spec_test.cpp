@@ -151,6 +151,54 @@ TEST(ServiceSpec, ServicesNeedACoordinatorAndTheCoordinatorsNameIsReserved) {
   }
 }
 
+// Seed 000 §5.3: the UI service is provided by the UIService applet, which needs other services.
+constexpr const char* kAppletProvided = R"(services:
+  UI: { access: exclusive }
+  Monitor: { provided_by: [cam], access: exclusive }
+coordinator:
+  applets:
+    - type: event_applet
+      name: UIService
+      provides: [UI]
+      bundles: [ { name: io, priority: system, resources: [ { service: Monitor } ] } ]
+)";
+
+TEST(ServiceSpec, AServiceAnAppletProvidesHasNoModules) {
+  const auto s = parse(kAppletProvided);
+  EXPECT_TRUE(s.find_service("UI")->providers.empty());
+  EXPECT_TRUE(s.coordinator->applets[0].node["provides"]);
+}
+
+TEST(ServiceSpec, AServiceNobodyProvidesIsAnErrorWithItsLine) {
+  EXPECT_THAT(error_of("services: { UI: { access: exclusive } }\ncoordinator: {}\n"),
+              HasSubstr("s.yaml:5: service 'UI': nobody provides it: name its modules in "
+                        "provided_by, or list it under an applet's provides:"));
+}
+
+TEST(ServiceSpec, AServiceHasOneKindOfProviderAndOneProvidingApplet) {
+  EXPECT_THAT(error_of(R"(services: { Monitor: { provided_by: [cam] } }
+coordinator:
+  applets: [ { type: t, name: A, provides: [Monitor] } ]
+)"),
+              HasSubstr("s.yaml:7: applet 'A' provides service 'Monitor', which modules provide "
+                        "already (provided_by at s.yaml:5)"));
+  EXPECT_THAT(error_of(R"(services: { UI: {} }
+coordinator:
+  applets: [ { type: t, name: A, provides: [UI] }, { type: t, name: B, provides: [UI] } ]
+)"),
+              HasSubstr("s.yaml:7: service 'UI' is provided by two applets, 'A' and 'B'"));
+  EXPECT_THAT(error_of(R"(services: { UI: {} }
+coordinator:
+  applets: [ { type: t, name: A, provides: [Screen] } ]
+)"),
+              HasSubstr("applet 'A' provides service 'Screen', which is not declared"));
+  EXPECT_THAT(error_of(R"(services: { UI: {} }
+coordinator:
+  applets: [ { type: t, name: A, provides: UI } ]
+)"),
+              HasSubstr("applet 'A'.provides must be a list, such as [UI]"));
+}
+
 TEST(ServiceSpec, TheCoordinatorsHostMustBeDeclared) {
   EXPECT_THAT(error_of("coordinator: { host: mars }\n"),
               HasSubstr("s.yaml:5: coordinator: unknown host 'mars'"));

@@ -1,6 +1,7 @@
 // oscar-applets run SCENARIO.yaml [--json] [--svg FILE] — runs an applet scenario on the
 // deterministic scheduler and prints the holder of every service after each step.
 // oscar-applets ps [--json] — the plan of the running system's coordinator.
+// oscar-applets graph [-o FILE.svg] — the same plan as a picture.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
@@ -29,14 +30,17 @@ int main(int argc, char** argv) {
 #ifdef OSCAR_APPLETS_LIVE
   oscar::tools::PsOptions ps;
   oscar::tools::add_ps(app, ps);
+  oscar::tools::GraphOptions graph;
+  oscar::tools::add_graph(app, graph);
 #endif
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 #ifdef OSCAR_APPLETS_LIVE
-  if (ps.command->parsed()) {
+  if (ps.command->parsed() || graph.command->parsed()) {
     try {
-      return oscar::tools::run_ps(ps);
+      return ps.command->parsed() ? oscar::tools::run_ps(ps) : oscar::tools::run_graph(graph);
     } catch (const std::exception& e) {
-      std::cerr << "oscar applets ps: " << e.what() << "\n";
+      std::cerr << "oscar applets " << (ps.command->parsed() ? "ps" : "graph") << ": " << e.what()
+                << "\n";
       return 2;
     }
   }

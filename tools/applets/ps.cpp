@@ -1,4 +1,5 @@
-// oscar applets ps [--json]: the plan of the running system's coordinator (docs/coordinator.md).
+// oscar applets ps [--json] and oscar applets graph [-o FILE.svg]: the plan of the running
+// system's coordinator (docs/coordinator.md).
 #include "ps.hpp"
 
 #include <condition_variable>
@@ -6,6 +7,7 @@
 #include <mutex>
 #include <optional>
 
+#include "oscar/applets/dot.hpp"
 #include "oscar/coordinator/plan_json.hpp"
 #include "oscar/registry/system_options.hpp"
 #include "oscar/topic_io.hpp"
@@ -23,8 +25,11 @@ void add_ps(CLI::App& app, PsOptions& options) {
   options.command = ps;
 }
 
-int run_ps(const PsOptions& options) {
-  auto participant = options.tool.participant("oscar-applets-ps");
+namespace {
+
+// The plan the coordinator publishes, or nothing (and a message) if none arrives in time.
+std::optional<AppletPlan> live_plan(const SystemOptions& tool, double timeout_s, const char* who) {
+  auto participant = tool.participant(who);
   std::mutex mutex;
   std::condition_variable arrived;
   std::optional<AppletPlan> plan;
@@ -35,17 +40,53 @@ int run_ps(const PsOptions& options) {
                                                          arrived.notify_all();
                                                        });
   std::unique_lock lock(mutex);
-  const auto timeout = std::chrono::milliseconds(static_cast<long>(options.timeout_s * 1000));
+  const auto timeout = std::chrono::milliseconds(static_cast<long>(timeout_s * 1000));
   if (!arrived.wait_for(lock, timeout, [&] { return plan.has_value(); })) {
     std::fprintf(stderr,
-                 "oscar applets ps: no coordinator published its plan on domain %d within %.1f s "
+                 "oscar applets: no coordinator published its plan on domain %d within %.1f s "
                  "(does the system file have a coordinator: section?)\n",
-                 participant->domain(), options.timeout_s);
-    return 1;
+                 participant->domain(), timeout_s);
   }
+  return plan;
+}
+
+}  // namespace
+
+int run_ps(const PsOptions& options) {
+  const auto plan = live_plan(options.tool, options.timeout_s, "oscar-applets-ps");
+  if (!plan) return 1;
   const auto text =
       options.json ? coordinator::plan_json(*plan) + "\n" : coordinator::plan_table(*plan);
   std::fputs(text.c_str(), stdout);
+  return 0;
+}
+
+void add_graph(CLI::App& app, GraphOptions& options) {
+  auto* graph = app.add_subcommand("graph", "Draw the running system's plan (Graphviz)");
+  options.tool.add_to(*graph);
+  graph->add_option("-o,--output", options.output,
+                    "FILE.svg (drawn with Graphviz; FILE.svg.dot is kept beside it) or FILE.dot; "
+                    "without it the DOT text goes to stdout");
+  graph->add_option("--timeout", options.timeout_s, "seconds to wait for the coordinator's plan");
+  options.command = graph;
+}
+
+int run_graph(const GraphOptions& options) {
+  const auto plan = live_plan(options.tool, options.timeout_s, "oscar-applets-graph");
+  if (!plan) return 1;
+  const auto dot = coordinator::plan_dot(*plan);
+  if (options.output.empty()) {
+    std::fputs(dot.c_str(), stdout);
+    return 0;
+  }
+  if (!applets::write_picture(dot, options.output)) {
+    std::fprintf(stderr,
+                 "oscar applets graph: wrote %s.dot; Graphviz (dot) is not installed to draw "
+                 "the SVG\n",
+                 options.output.c_str());
+    return 1;
+  }
+  std::printf("wrote %s\n", options.output.c_str());
   return 0;
 }
 

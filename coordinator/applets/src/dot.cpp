@@ -143,12 +143,16 @@ std::string to_dot(const Scheduler& s) {
 }
 
 bool write_picture(const Scheduler& s, const std::string& path) {
+  return write_picture(to_dot(s), path);
+}
+
+bool write_picture(const std::string& dot, const std::string& path) {
   const bool svg = path.size() > 4 && path.substr(path.size() - 4) == ".svg";
   const std::string dot_path = svg ? path + ".dot" : path;
   {
     std::ofstream out(dot_path);
     if (!out) throw std::invalid_argument(dot_path + ": cannot write the picture");
-    out << to_dot(s);
+    out << dot;
   }
   if (!svg) return true;
   if (std::system("command -v dot >/dev/null 2>&1") != 0) return false;

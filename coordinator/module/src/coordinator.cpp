@@ -70,6 +70,15 @@ Coordinator::Coordinator(const SystemSpec& system, DdsParticipant& participant,
     code.period = a->period();
     runtime_->set_code(a->name(), std::move(code));
   }
+  // Who provides each service, as the plan shows it.
+  providers_of_.resize(config_.model.services().size());
+  for (const auto& svc : system.services) {
+    auto& names = providers_of_.at(config_.model.service_id(svc.name));
+    for (const auto& p : svc.providers) names.push_back(p.text());
+  }
+  for (const auto& a : config_.model.applets()) {
+    for (const ServiceId s : a.provides) providers_of_.at(s).push_back("applet:" + a.name);
+  }
   remote_ =
       std::make_unique<RemoteApplets>(system, *runtime_, *this, participant, [this] { wake(); });
   client_ = std::make_unique<ConfigClient>(participant, "coordinator");
@@ -188,6 +197,9 @@ Coordinator::Snapshot Coordinator::snapshot() {
                           holders[id].end(), std::inserter(w, w.end()));
       p.waiting(sorted(w));
       p.available(s.available(id));
+      p.plan(s.holder(id));
+      for (const auto& u : m.needs(id)) p.needs().push_back(m.service(u.service).name);
+      p.providers(providers_of_[id]);
       plan.services().push_back(std::move(p));
     }
     plan.plans(s.plans_computed());

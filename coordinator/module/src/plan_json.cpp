@@ -1,5 +1,7 @@
 #include "oscar/coordinator/plan_json.hpp"
 
+#include <set>
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
@@ -13,6 +15,7 @@ std::string plan_json(const AppletPlan& plan) {
     entry["holders"] = s.holders();
     entry["access"] = s.access();
     entry["waiting"] = s.waiting();
+    entry["plan"] = s.plan();
     if (!s.available()) entry["available"] = false;
     services[s.name()] = std::move(entry);
   }
@@ -40,6 +43,90 @@ std::string plan_table(const AppletPlan& plan) {
   for (const auto& a : plan.applets()) {
     out += fmt::format("{:<20} {:<14} {}\n", a.name(), a.process(), a.state());
   }
+  return out;
+}
+
+namespace {
+
+std::string quote(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '\n') {
+      out += "\\n";
+      continue;
+    }
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+const char* state_colour(const std::string& state) {
+  if (state == "holding") return "palegreen";
+  if (state == "waiting") return "khaki";
+  if (state == "crashed") return "salmon";
+  if (state == "absent") return "lightgrey";
+  return "white";
+}
+
+}  // namespace
+
+std::string plan_dot(const AppletPlan& plan) {
+  std::string out =
+      "digraph plan {\n  rankdir=LR;\n  fontname=\"Helvetica\";\n"
+      "  node [fontname=\"Helvetica\", fontsize=11];\n"
+      "  edge [fontname=\"Helvetica\", fontsize=9];\n";
+  out += fmt::format("  label={};\n  labelloc=t;\n",
+                     quote(fmt::format("{}: the coordinator's plan ({} plans so far)",
+                                       plan.system(), plan.plans())));
+  for (const auto& a : plan.applets()) {
+    out += fmt::format("  {} [shape=box, style=filled, fillcolor={}, label={}];\n",
+                       quote("a:" + a.name()), state_colour(a.state()),
+                       quote(a.name() + "\n" + a.state() + " in " + a.process()));
+  }
+  std::set<std::string> modules;
+  for (const auto& s : plan.services()) {
+    const char* fill = !s.available() ? "lightgrey" : !s.holders().empty() ? "lightblue" : "white";
+    out += fmt::format("  {} [shape=ellipse, style=filled, fillcolor={}, label={}];\n",
+                       quote("s:" + s.name()), fill,
+                       quote(s.name() + "\n" + s.access() + (s.available() ? "" : ", unavailable") +
+                             "\nplan: " + s.plan()));
+    for (const auto& h : s.holders()) {
+      out += fmt::format("  {} -> {} [color=darkgreen, penwidth=2, label=holds];\n",
+                         quote("a:" + h), quote("s:" + s.name()));
+    }
+    for (const auto& w : s.waiting()) {
+      out += fmt::format("  {} -> {} [color=grey, style=dashed, label=waits];\n", quote("a:" + w),
+                         quote("s:" + s.name()));
+    }
+    for (const auto& n : s.needs()) {
+      out += fmt::format("  {} -> {} [style=bold, label=needs];\n", quote("s:" + s.name()),
+                         quote("s:" + n));
+    }
+    for (const auto& p : s.providers()) {
+      if (p.starts_with("applet:")) {
+        out += fmt::format("  {} -> {} [dir=back, color=blue, label=provides];\n",
+                           quote("s:" + s.name()), quote("a:" + p.substr(7)));
+        continue;
+      }
+      if (modules.insert(p).second) {
+        out += fmt::format("  {} [shape=component, label={}];\n", quote("m:" + p), quote(p));
+      }
+      out += fmt::format("  {} -> {} [style=dotted, arrowhead=none, label=\"provided by\"];\n",
+                         quote("s:" + s.name()), quote("m:" + p));
+    }
+  }
+  out +=
+      "  subgraph cluster_legend {\n    label=\"legend\";\n"
+      "    node [shape=box, style=filled, fontsize=9];\n";
+  for (const char* state : {"holding", "waiting", "idle", "crashed", "absent"}) {
+    out += fmt::format("    {} [fillcolor={}, label={}];\n", quote(std::string("legend:") + state),
+                       state_colour(state), quote(std::string("applet ") + state));
+  }
+  out +=
+      "    \"legend:service\" [shape=ellipse, fillcolor=lightblue, label=\"service held\"];\n"
+      "    \"legend:module\" [shape=component, style=solid, label=\"provider module\"];\n"
+      "  }\n}\n";
   return out;
 }
 

@@ -68,6 +68,21 @@ TEST(Applet, ARegisteredTypeIsMadeWithItsNameAndParams) {
   EXPECT_GT(gateway.bytes, 0u);
 }
 
+TEST(Applet, AnEventAppletsSettlePriorityMustBeAPriority) {
+  RecordingGateway gateway;
+  AppletSetup good("Menu", {{"settle_priority", "normal"}}, gateway);
+  EXPECT_NO_THROW(make_applet("event_applet", good, {}));
+  AppletSetup bad("Menu", {{"settle_priority", "urgent"}}, gateway);
+  try {
+    make_applet("event_applet", bad, {});
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("applet 'Menu': settle_priority: "));
+    EXPECT_THAT(e.what(), HasSubstr("priority 'urgent' must be low, normal, high, system or a "
+                                    "whole number >= 0"));
+  }
+}
+
 TEST(Applet, AnUnknownTypeIsAnErrorNamingTheFoldersAndTheKnownTypes) {
   RecordingGateway gateway;
   AppletSetup setup("e", {}, gateway);

@@ -14,10 +14,12 @@ AppletPlan two_services() {
   camera.holders({"high"});
   camera.waiting({"low"});
   camera.available(true);
+  camera.plan("high");
   ServicePlan pilot;
   pilot.name("Pilot");
   pilot.access("shared");
   pilot.available(false);
+  pilot.plan("unavailable");
   plan.services({camera, pilot});
   AppletEntry a;
   a.name("high");
@@ -27,10 +29,12 @@ AppletPlan two_services() {
   return plan;
 }
 
-TEST(PlanJson, ServicesWithHoldersAccessAndWaitingThenApplets) {
+TEST(PlanJson, ServicesWithHoldersAccessWaitingAndPlanThenApplets) {
   EXPECT_EQ(plan_json(two_services()),
-            R"({"services":{"Camera":{"holders":["high"],"access":"exclusive","waiting":["low"]},)"
-            R"("Pilot":{"holders":[],"access":"shared","waiting":[],"available":false}},)"
+            R"({"services":{"Camera":{"holders":["high"],"access":"exclusive","waiting":["low"],)"
+            R"("plan":"high"},)"
+            R"("Pilot":{"holders":[],"access":"shared","waiting":[],"plan":"unavailable",)"
+            R"("available":false}},)"
             R"("applets":[{"name":"high","process":"coordinator","state":"holding"}]})");
 }
 

@@ -23,6 +23,13 @@ namespace internal {
 class ParticipantIdClaim;
 }
 
+namespace internal {
+/// Marks this process as hosting `module` (a module of a system file): every participant it
+/// creates from then on carries the names in discovery (property "oscar.modules"), whatever
+/// its own name. Called by Module before it constructs its kernels.
+void note_hosted_module(const std::string& module);
+}  // namespace internal
+
 class DdsParticipant {
  public:
   /// @throws std::runtime_error if no participant can be created (e.g. all ports taken).
@@ -55,12 +62,20 @@ class DdsParticipant {
   /// The names of the other participants on the domain that discovery sees now (a module's is
   /// "oscar:<module>").
   std::vector<std::string> discovered_participants() const;
+  /// The modules hosted by the process of `writer`, as discovery shows them: all participants
+  /// of one process share the first 8 bytes of their GUID prefix (host and process); a module's
+  /// participant is named "oscar:<module>", and every participant made in a process that hosts a
+  /// module of a system file says so (internal::note_hosted_module). Where a sample really comes
+  /// from, whatever it says.
+  std::vector<std::string> modules_in_process_of(
+      const eprosima::fastrtps::rtps::GUID_t& writer) const;
   /// The last remote writer discovery has seen on `topic`, if any.
   std::optional<DiscoveredWriter> discovered_writer(const std::string& topic) const;
 
  private:
   class Listener;
   int domain_;
+  std::string name_;
   std::unique_ptr<Listener> listener_;
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   std::unique_ptr<internal::ParticipantIdClaim> id_claim_;  ///< released after the participant

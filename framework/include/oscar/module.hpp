@@ -28,6 +28,13 @@ class DdsLogSink;
 class SequenceStore;
 }  // namespace internal
 
+/// Where a configuration command came from as the transport saw it, whatever it says about its
+/// sender: the modules of the running system that live in the process that wrote it.
+struct CommandOrigin {
+  /// Empty for a process that hosts no module of the system: boot, the registry, a tool.
+  std::vector<std::string> modules;
+};
+
 class Module {
  public:
   /// Loads the kernel types, constructs the kernels, checks the multi-core rules and wires the
@@ -47,8 +54,11 @@ class Module {
   /// Stops threads and leaves the domain (also done by the destructor).
   void stop();
 
-  /// Applies a configuration command (as one arriving on oscar/config/<module> would be).
-  ConfigReply apply(const ConfigCommand& command);
+  /// Applies a configuration command (as one arriving on oscar/config/<module> would be) if its
+  /// sender may give it: only the coordinator configures (the registry suspends, resumes and
+  /// re-applies; boot applies the initial configuration), and a command from the process of a
+  /// module other than the coordinator is refused whatever name it claims.
+  ConfigReply apply(const ConfigCommand& command, const CommandOrigin& origin = {});
   ModuleState state() const;
   /// True while one kernel call has run longer than the watchdog limit (the heartbeat stops).
   bool hung() const;

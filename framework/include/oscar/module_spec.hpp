@@ -91,6 +91,10 @@ struct ModuleSpec {
   /// Plugin files and folders of plugins the file names (`plugins:`), absolute: searched before
   /// $OSCAR_PLUGIN_PATH (with_plugins()).
   std::vector<std::string> plugins;
+  /// The names of all modules of the system file it comes from, the coordinator's included; empty
+  /// for a module file. A configuration command written from the process of one of them is that
+  /// module's, whatever sender it names (Module::apply).
+  std::vector<std::string> system_modules;
 
   /// Parses one module map. `file` names the source in messages ("file:line: ...").
   /// @throws std::invalid_argument for unknown keys, missing names, duplicate kernel names,

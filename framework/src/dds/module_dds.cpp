@@ -6,6 +6,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <optional>
 #include <stdexcept>
@@ -366,9 +367,11 @@ void Module::Dds::start_config() {
   reply_writer_ = std::make_unique<TopicWriter<ConfigReply, ConfigReplyPubSubType>>(
       participant_, topics::config_reply(name));
   config_reader_ = std::make_unique<TopicReader<ConfigCommand, ConfigCommandPubSubType>>(
-      participant_, topics::config(name), [this](const ConfigCommand& c, const auto&) {
+      participant_, topics::config(name),
+      [this](const ConfigCommand& c, const eprosima::fastdds::dds::SampleInfo& info) {
+        auto origin = origin_of(info);
         std::lock_guard lock(queue_mutex_);
-        queue_.push_back(c);
+        queue_.push_back({c, std::move(origin)});
         queue_cv_.notify_all();
       });
   log_writer_ =
@@ -385,6 +388,23 @@ void Module::Dds::start_config() {
   config_thread_ = std::thread([this] { serve_config(); });
   beat_thread_ = std::thread([this] { beat(); });
   module_.log_sink_->attach(&log_writer_->dds_writer());
+}
+
+// Every participant of a process shares its GUID prefix's host and process part, and those made
+// in a module's process say which modules it hosts (DdsParticipant::modules_in_process_of): a
+// kernel that writes a command from a participant of its own, under any name, is still seen
+// coming from its module's process. Only modules of this module's system count (not a test's
+// embedded modules).
+CommandOrigin Module::Dds::origin_of(const eprosima::fastdds::dds::SampleInfo& info) {
+  CommandOrigin origin;
+  const auto& system = module_.spec_.system_modules;
+  for (auto& m : participant_.modules_in_process_of(info.sample_identity.writer_guid())) {
+    if (std::find(system.begin(), system.end(), m) != system.end() &&
+        std::find(origin.modules.begin(), origin.modules.end(), m) == origin.modules.end()) {
+      origin.modules.push_back(std::move(m));
+    }
+  }
+  return origin;
 }
 
 // Commands are applied on their own thread, never inside a DDS callback: a rewire creates and
@@ -414,13 +434,15 @@ void Module::Dds::serve_config() {
       continue;
     }
     if (queue_.empty()) continue;
-    auto command = std::move(queue_.front());
+    auto [command, origin] = std::move(queue_.front());
     queue_.pop_front();
     lock.unlock();
     // A repeated command (same sender and id: the client did not see our reply) is answered
     // again, not applied twice.
     auto& last = last_reply_[command.sender()];
-    if (last.id() != command.id() || last.module_name().empty()) last = module_.apply(command);
+    if (last.id() != command.id() || last.module_name().empty()) {
+      last = module_.apply(command, origin);
+    }
     reply_writer_->write(last);
     lock.lock();
   }

@@ -10,6 +10,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <thread>
 
 #include <fastdds/dds/publisher/DataWriter.hpp>
@@ -83,7 +84,13 @@ class Module::Dds {
   std::unique_ptr<TopicReader<ConfigCommand, ConfigCommandPubSubType>> config_reader_;
   std::mutex queue_mutex_;
   std::condition_variable queue_cv_;
-  std::deque<ConfigCommand> queue_;
+  struct Command {
+    ConfigCommand command;
+    CommandOrigin origin;
+  };
+  // The modules of the running system living in the process that wrote a command.
+  CommandOrigin origin_of(const eprosima::fastdds::dds::SampleInfo& info);
+  std::deque<Command> queue_;
   std::deque<Refollow> refollow_;  // served by the configuration thread, like queue_
   std::map<InputPort*, std::string> awaiting_type_;  // raw inputs whose source is not seen yet
   std::map<std::string, ConfigReply> last_reply_;    // by sender: answers repeated commands

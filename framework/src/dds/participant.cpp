@@ -5,13 +5,16 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
+#include <sstream>
 #include <stdexcept>
 
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <yaml-cpp/yaml.h>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/log/Log.hpp>
@@ -44,10 +47,24 @@ bool udp_port_free(const std::string& address, std::uint32_t port) {
   return ok;
 }
 
+constexpr const char* kModulesProperty = "oscar.modules";
+
+std::mutex hosted_mutex;
+std::vector<std::string> hosted_modules;  // modules of system files this process hosts
+
+std::vector<std::string> hosted() {
+  std::lock_guard lock(hosted_mutex);
+  return hosted_modules;
+}
+
 dds::DomainParticipantQos participant_qos(const std::string& name, const NetworkConfig& net,
                                           int domain, int participant_id) {
   dds::DomainParticipantQos qos;
   qos.name(name);
+  if (const auto modules = hosted(); !modules.empty()) {
+    qos.properties().properties().emplace_back(
+        kModulesProperty, fmt::format("{}", fmt::join(modules, ",")), true);  // propagated
+  }
   auto& transport = qos.transport();
   transport.use_builtin_transports = false;
   auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
@@ -192,7 +209,14 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
     using Status = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo::DISCOVERY_STATUS;
     std::lock_guard lock(mutex_);
     if (info.status == Status::DISCOVERED_PARTICIPANT) {
-      participants_[info.info.m_guid.guidPrefix] = info.info.m_participantName.to_string();
+      auto& p = participants_[info.info.m_guid.guidPrefix];
+      p.name = info.info.m_participantName.to_string();
+      if (p.name.starts_with("oscar:")) p.modules.push_back(p.name.substr(6));
+      for (const auto& property : info.info.m_properties) {
+        if (property.first() != kModulesProperty) continue;
+        std::istringstream names(property.second());
+        for (std::string m; std::getline(names, m, ',');) p.modules.push_back(m);
+      }
     } else if (info.status == Status::REMOVED_PARTICIPANT ||
                info.status == Status::DROPPED_PARTICIPANT) {
       participants_.erase(info.info.m_guid.guidPrefix);
@@ -201,8 +225,21 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
   std::vector<std::string> participants() const {
     std::lock_guard lock(mutex_);
     std::vector<std::string> names;
-    for (const auto& [prefix, name] : participants_) names.push_back(name);
+    for (const auto& [prefix, p] : participants_) names.push_back(p.name);
     return names;
+  }
+  std::vector<std::string> modules_in_process_of(
+      const eprosima::fastrtps::rtps::GUID_t& writer) const {
+    std::lock_guard lock(mutex_);
+    std::vector<std::string> modules;
+    for (const auto& [prefix, p] : participants_) {
+      const eprosima::fastrtps::rtps::GUID_t participant(
+          prefix, eprosima::fastrtps::rtps::c_EntityId_RTPSParticipant);
+      if (writer.is_on_same_process_as(participant)) {
+        modules.insert(modules.end(), p.modules.begin(), p.modules.end());
+      }
+    }
+    return modules;
   }
   void on_publisher_discovery(dds::DomainParticipant*,
                               eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
@@ -248,7 +285,11 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
   mutable std::mutex mutex_;
   std::map<std::string, std::string> types_;
   std::map<std::string, DdsParticipant::DiscoveredWriter> writers_;
-  std::map<eprosima::fastrtps::rtps::GuidPrefix_t, std::string> participants_;
+  struct Participant {
+    std::string name;
+    std::vector<std::string> modules;  // the modules its process hosts, as it says
+  };
+  std::map<eprosima::fastrtps::rtps::GuidPrefix_t, Participant> participants_;
 };
 
 DdsParticipant::DdsParticipant(int domain, const std::string& name, const NetworkConfig& network)
@@ -320,6 +361,23 @@ std::optional<std::string> DdsParticipant::discovered_type(const std::string& to
 
 std::map<std::string, DdsParticipant::DiscoveredWriter> DdsParticipant::discovered_writers() const {
   return listener_->writers();
+}
+
+std::vector<std::string> DdsParticipant::modules_in_process_of(
+    const eprosima::fastrtps::rtps::GUID_t& writer) const {
+  auto modules = listener_->modules_in_process_of(writer);
+  if (writer.is_on_same_process_as(participant_->guid())) {
+    const auto here = hosted();
+    modules.insert(modules.end(), here.begin(), here.end());
+  }
+  return modules;
+}
+
+void internal::note_hosted_module(const std::string& module) {
+  std::lock_guard lock(hosted_mutex);
+  if (std::find(hosted_modules.begin(), hosted_modules.end(), module) == hosted_modules.end()) {
+    hosted_modules.push_back(module);
+  }
 }
 
 std::vector<std::string> DdsParticipant::discovered_participants() const {

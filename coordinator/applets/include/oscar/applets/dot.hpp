@@ -15,5 +15,7 @@ std::string to_dot(const Scheduler& scheduler);
 /// and Graphviz `dot` renders the SVG when installed. Returns false if rendering was skipped.
 /// @throws std::invalid_argument if the file cannot be written.
 bool write_picture(const Scheduler& scheduler, const std::string& path);
+/// The same for DOT text made elsewhere (the live plan, `oscar applets graph`).
+bool write_picture(const std::string& dot, const std::string& path);
 
 }  // namespace oscar::applets

@@ -87,7 +87,8 @@ class Coordinator final : public AppletGateway {
   const SystemSpec& system_;
   applets::SystemConfig config_;
   std::unique_ptr<applets::Runtime> runtime_;
-  std::vector<std::unique_ptr<Applet>> applets_;  // by AppletId
+  std::vector<std::unique_ptr<Applet>> applets_;        // by AppletId
+  std::vector<std::vector<std::string>> providers_of_;  // by ServiceId, as the plan shows them
   std::unique_ptr<ConfigClient> client_;
   std::unique_ptr<Providers> providers_;
   std::unique_ptr<RemoteApplets> remote_;

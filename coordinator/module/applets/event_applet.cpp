@@ -1,0 +1,62 @@
+// An applet that does what the world's events tell it (docs/coordinator.md): its bundles are
+// requested, triggered and released through the coordinator's command port `applet` (a user's
+// click, a battery running low, an appointment due: the events of seed 000 §5.3) or asked for at
+// start (`requested: true`). It logs every grant and loss, so the log tells the plan's story.
+// With `settle_priority: LEVEL` it changes a bundle's priority to LEVEL once the bundle is first
+// granted: the main menu of §5.3 asks for the UI with high priority to be sure to get it, then
+// takes the priority of the other applets.
+#include <spdlog/spdlog.h>
+#include <oscar/applets/config.hpp>
+#include <oscar/coordinator/applet.hpp>
+
+#include <optional>
+#include <set>
+#include <stdexcept>
+
+namespace {
+
+using oscar::applets::Notification;
+
+class EventApplet final : public oscar::coordinator::Applet {
+ public:
+  explicit EventApplet(oscar::coordinator::AppletSetup& setup) : Applet(setup) {
+    const auto level = setup.param("settle_priority", "");
+    if (!level.empty()) {
+      try {
+        settle_ = oscar::applets::parse_priority(YAML::Load(level), "params");
+      } catch (const std::exception& e) {
+        throw std::invalid_argument("applet '" + name() + "': settle_priority: " + e.what());
+      }
+    }
+  }
+
+  void step(oscar::applets::AppletContext&) override {}
+
+  bool on_interrupt(oscar::applets::AppletContext& ctx, const Notification& n) override {
+    const auto bundle = bundle_name(n);
+    switch (n.kind) {
+      case Notification::Kind::kGranted:
+        spdlog::info("applet {}: {} granted", name(), bundle);
+        if (settle_ && settled_.insert(bundle).second) ctx.set_priority(bundle, *settle_);
+        return true;
+      case Notification::Kind::kRevokedByForce:
+        spdlog::info("applet {}: {} revoked", name(), bundle);
+        return true;
+      case Notification::Kind::kRevokeRequested:
+        spdlog::info("applet {}: {} yielded", name(), bundle);
+        return false;  // the default: yield at once
+      default:
+        return false;
+    }
+  }
+
+  std::chrono::milliseconds period() const override { return std::chrono::milliseconds(20); }
+
+ private:
+  std::optional<int> settle_;
+  std::set<std::string> settled_;  // bundles whose priority it has settled
+};
+
+}  // namespace
+
+OSCAR_REGISTER_APPLET(EventApplet, "event_applet")

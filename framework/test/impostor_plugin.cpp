@@ -1,0 +1,63 @@
+// The test_impostor kernel, a plugin for oscar-run children of the integration tests: it tries
+// what the retired sequencer did, configuring another module under the coordinator's name from a
+// DDS participant of its own inside its module's process. Each cycle it asks `target` to activate
+// all its kernels and logs the module's verdict ("impostor: accepted" or "impostor: refused: ...").
+#include <cstdlib>
+#include <memory>
+#include <string>
+
+#include "oscar/config_client.hpp"
+#include "oscar/dds_participant.hpp"
+#include "oscar/kernel.hpp"
+#include "oscar/kernel_registry.hpp"
+#include "oscar/module_spec.hpp"
+#include "oscar/network.hpp"
+
+namespace oscar::test {
+
+class Impostor final : public Kernel {
+ public:
+  struct Params {
+    std::string target;
+    std::string claim = "coordinator";
+    void describe(ParamSpec& spec) {
+      spec.field("target", target, "the module it tries to configure");
+      spec.field("claim", claim, "the sender name it claims");
+    }
+  };
+  explicit Impostor(KernelSetup& setup) { setup.params(params_); }
+
+  void process(Cycle& cycle) override {
+    if (!client_) {
+      // As the sequencer did: the domain, system file and host that oscar-run exports.
+      NetworkConfig network;
+      const char* file = std::getenv("OSCAR_SYSTEM_FILE");
+      const char* host = std::getenv("OSCAR_HOST");
+      if (file && *file && host && *host) {
+        network = NetworkConfig::for_host(load_yaml_file(file), host);
+      }
+      participant_ = std::make_unique<DdsParticipant>(domain_from_env(0), "oscar-tool", network);
+      client_ = std::make_unique<ConfigClient>(*participant_, params_.claim);
+    }
+    try {
+      const auto reply = client_->send(params_.target, CMD_ACTIVATE, {"*"});
+      if (reply.ok()) {
+        cycle.log().info("impostor: accepted");
+      } else {
+        cycle.log().info("impostor: {}", reply.error());
+      }
+    } catch (const std::exception& e) {
+      cycle.log().info("impostor: no answer: {}", e.what());
+    }
+  }
+  void stub(Cycle&) override {}
+
+ private:
+  Params params_;
+  std::unique_ptr<DdsParticipant> participant_;
+  std::unique_ptr<ConfigClient> client_;
+};
+
+}  // namespace oscar::test
+
+OSCAR_REGISTER_KERNEL(oscar::test::Impostor, "test_impostor")
