@@ -428,5 +428,36 @@ TEST(RemoteApplet, ARestartedCoordinatorRebuildsThePlanFromTheRemoteAppletsReque
   c.wait_cam_mode("continuous");
 }
 
+// A trigger of a single-step kernel goes the same way as a command: CobraControl in a process
+// of its own grabs frames from a camera that runs only when triggered.
+TEST(RemoteApplet, ARemoteAppletsTriggersReachTheSingleStepKernelItHolds) {
+  test::BootedSystem sys("remote_trigger", R"(system: remote_trigger
+modules:
+  - name: cam
+    kernels: [ { type: framegrabber, name: cam, params: { source: "synthetic:static" } } ]
+    mode: deactivated
+services:
+  Camera:
+    provided_by: [cam/cam]
+    access: exclusive
+    granted: { activate: "single_step:command" }
+    idle: deactivate
+coordinator:
+  applets:
+    - type: cobra_control
+      name: cobra
+      process: applets
+      params: { cameras: 'Camera:cam/cam', cycle_ms: 100 }
+      bundles: [ { name: cameras, requested: true, resources: [ { service: Camera } ] } ]
+)");
+  sys.running();
+  sys.wait_for([](const SystemState& st) {
+    const auto* m = entry(st, "cam");
+    const auto* k = m ? test::kernel_state(*m, "cam") : nullptr;
+    return k && k->mode() == "single_step" && k->cycles() >= 5;
+  });
+  EXPECT_THAT(sys.boot_output(), ::testing::Not(HasSubstr("refused")));
+}
+
 }  // namespace
 }  // namespace oscar
