@@ -249,6 +249,33 @@ TEST(Coordinator, AnEventForAnUnknownBundleIsRefusedWithTheReason) {
   EXPECT_THAT(reply.error(), HasSubstr("unknown applet 'nobody'"));
 }
 
+// The command port takes the scheduler's vocabulary for applets in the coordinator's process
+// too; crash only for applets in a process of their own.
+TEST(Coordinator, ASetPriorityEventReachesALocalAppletAndItsCrashIsRefused) {
+  CoordinatedSystem c("coord_local_events");
+  c.sys.running();
+  ASSERT_TRUE(c.accepted("high", "request"));
+  ASSERT_TRUE(c.accepted("low", "request"));
+  c.wait_plan(
+      [](const AppletPlan& p) {
+        return CoordinatedSystem::holders(p, "Camera") == Strings{"high"};
+      },
+      "Camera held by high");
+  AppletEvent raise;
+  raise.applet("low");
+  raise.bundle("camera");
+  raise.event("set_priority");
+  raise.priority(350);  // above high (300)
+  const auto reply = c.command(raise);
+  ASSERT_TRUE(reply.ok()) << reply.error();
+  c.wait_plan(
+      [](const AppletPlan& p) { return CoordinatedSystem::holders(p, "Camera") == Strings{"low"}; },
+      "Camera taken by low at priority 350");
+  const auto crash = c.event("low", "crash");
+  EXPECT_FALSE(crash.ok());
+  EXPECT_THAT(crash.error(), HasSubstr("event 'crash' is for applets in a process of their own"));
+}
+
 // Applets in other processes (docs/coordinator.md): the camera system with `applet` in a
 // process of its own, "applets", an applet lease of 1 s and a module lease long enough that the
 // applet lease, not the registry, is what takes a hung applet's service.
