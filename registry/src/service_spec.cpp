@@ -190,12 +190,13 @@ void parse_services(SystemSpec& s, const YAML::Node& node) {
     if (!needs) continue;
     for (const auto& d : list(s.file, needs, what + ".needs", "[Pilot]")) {
       ServiceSpec::Need need;
-      YAML::Node name = d;
+      // Not `YAML::Node name = d; name = d["service"];`: assigning to a node that refers to `d`
+      // rewrites `d` itself (yaml-cpp nodes are references), and d["access"] then fails.
       if (d.IsMap()) {
         check_yaml_keys(d, s.file, what + ".needs", {"service", "access"});
-        name = d["service"];
         if (d["access"]) need.exclusive = text(s.file, d["access"], "access") != "shared";
       }
+      const YAML::Node name = d.IsMap() ? d["service"] : d;
       need.service = text(s.file, name, what + ".needs entry");
       if (!s.find_service(need.service)) {
         fail(s.file, name,

@@ -64,6 +64,25 @@ TEST(ServiceSpec, ServicesNameTheirProvidersAccessNeedsAndWhatGrantingAndIdlingM
   EXPECT_EQ(pilot.needs[0].service, "Camera");
 }
 
+TEST(ServiceSpec, ANeedInLongFormGivesItsServiceAndAccess) {
+  const auto s = parse(R"(services:
+  Camera: { provided_by: [cam] }
+  Pilot: { provided_by: [drive], needs: [ { service: Camera, access: shared } ] }
+  Dock: { provided_by: [drive], needs: [ { service: Pilot, access: exclusive }, { service: Camera } ] }
+coordinator: {}
+)");
+  const auto& pilot = *s.find_service("Pilot");
+  ASSERT_EQ(pilot.needs.size(), 1u);
+  EXPECT_EQ(pilot.needs[0].service, "Camera");
+  EXPECT_FALSE(pilot.needs[0].exclusive);
+  const auto& dock = *s.find_service("Dock");
+  ASSERT_EQ(dock.needs.size(), 2u);
+  EXPECT_EQ(dock.needs[0].service, "Pilot");
+  EXPECT_TRUE(dock.needs[0].exclusive);
+  EXPECT_EQ(dock.needs[1].service, "Camera");
+  EXPECT_TRUE(dock.needs[1].exclusive);
+}
+
 TEST(ServiceSpec, TheCoordinatorBecomesASupervisedModuleOnItsHostWithItsApplets) {
   const auto s = parse(kGood);
   ASSERT_TRUE(s.coordinator);

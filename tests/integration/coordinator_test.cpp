@@ -85,6 +85,10 @@ class CoordinatedSystem {
     return client_.command("coordinator", "coordinator", "applet", e);
   }
 
+  ConfigReply command(const AppletEvent& e) {
+    return client_.command("coordinator", "coordinator", "applet", e);
+  }
+
   ::testing::AssertionResult accepted(const std::string& applet, const std::string& what) {
     const auto reply = event(applet, what);
     if (reply.ok()) return ::testing::AssertionSuccess();
@@ -245,6 +249,33 @@ TEST(Coordinator, AnEventForAnUnknownBundleIsRefusedWithTheReason) {
   EXPECT_THAT(reply.error(), HasSubstr("unknown applet 'nobody'"));
 }
 
+// The command port takes the scheduler's vocabulary for applets in the coordinator's process
+// too; crash only for applets in a process of their own.
+TEST(Coordinator, ASetPriorityEventReachesALocalAppletAndItsCrashIsRefused) {
+  CoordinatedSystem c("coord_local_events");
+  c.sys.running();
+  ASSERT_TRUE(c.accepted("high", "request"));
+  ASSERT_TRUE(c.accepted("low", "request"));
+  c.wait_plan(
+      [](const AppletPlan& p) {
+        return CoordinatedSystem::holders(p, "Camera") == Strings{"high"};
+      },
+      "Camera held by high");
+  AppletEvent raise;
+  raise.applet("low");
+  raise.bundle("camera");
+  raise.event("set_priority");
+  raise.priority(350);  // above high (300)
+  const auto reply = c.command(raise);
+  ASSERT_TRUE(reply.ok()) << reply.error();
+  c.wait_plan(
+      [](const AppletPlan& p) { return CoordinatedSystem::holders(p, "Camera") == Strings{"low"}; },
+      "Camera taken by low at priority 350");
+  const auto crash = c.event("low", "crash");
+  EXPECT_FALSE(crash.ok());
+  EXPECT_THAT(crash.error(), HasSubstr("event 'crash' is for applets in a process of their own"));
+}
+
 // Applets in other processes (docs/coordinator.md): the camera system with `applet` in a
 // process of its own, "applets", an applet lease of 1 s and a module lease long enough that the
 // applet lease, not the registry, is what takes a hung applet's service.
@@ -301,6 +332,41 @@ TEST(RemoteApplet, AcquiresTheServiceAndItsCommandReachesTheModuleThenReleasesIt
   c.wait_plan([](const AppletPlan& p) { return CoordinatedSystem::holders(p, "Camera").empty(); },
               "Camera released by the remote high");
   c.wait_cam_mode("deactivated");
+}
+
+// The command port answers an event for a remote applet once the applet has made the call: a
+// call the scheduler refuses is the event's refusal, and the events of the scheduler's whole
+// vocabulary reach it (here set_priority, which the plan then follows).
+TEST(RemoteApplet, AnEventIsAnsweredAfterTheAppletsCallAndCarriesItsRefusal) {
+  CoordinatedSystem c("remote_event", remote_system("low"));
+  c.sys.running();
+  c.wait_plan([](const AppletPlan& p) { return present(p, "low", "idle"); },
+              "low announced from process applets");
+  const auto refused = c.event("low", "trigger");  // not requested: the scheduler refuses
+  EXPECT_FALSE(refused.ok());
+  EXPECT_THAT(refused.error(), HasSubstr("low"));
+  EXPECT_THAT(refused.error(), HasSubstr("camera"));
+  ASSERT_TRUE(c.accepted("high", "request"));
+  ASSERT_TRUE(c.accepted("low", "request"));
+  c.wait_plan(
+      [](const AppletPlan& p) {
+        return CoordinatedSystem::holders(p, "Camera") == Strings{"high"};
+      },
+      "Camera held by high");
+  AppletEvent raise;
+  raise.applet("low");
+  raise.bundle("camera");
+  raise.event("set_priority");
+  raise.priority(350);  // above high (300)
+  const auto reply = c.command(raise);
+  ASSERT_TRUE(reply.ok()) << reply.error();
+  c.wait_plan(
+      [](const AppletPlan& p) { return CoordinatedSystem::holders(p, "Camera") == Strings{"low"}; },
+      "Camera taken by low at priority 350");
+  const auto unknown = c.event("low", "fly");
+  EXPECT_FALSE(unknown.ok());
+  EXPECT_THAT(unknown.error(), HasSubstr("unknown event 'fly' (events: request, release, trigger, "
+                                         "yield, set_priority, set_deadline, negotiate, crash)"));
 }
 
 TEST(RemoteApplet, ARemoteHigherPriorityPreemptsALocalHolderWhoseCommandIsThenRefused) {

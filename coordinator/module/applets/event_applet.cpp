@@ -4,7 +4,9 @@
 // start (`requested: true`). It logs every grant and loss, so the log tells the plan's story.
 // With `settle_priority: LEVEL` it changes a bundle's priority to LEVEL once the bundle is first
 // granted: the main menu of §5.3 asks for the UI with high priority to be sure to get it, then
-// takes the priority of the other applets.
+// takes the priority of the other applets. With `auto_yield: false` it keeps a bundle whose
+// revocation is requested until an event tells it to yield or negotiate (or the wait limit
+// passes): the applets of a scenario with `runner: {auto_yield: false}`.
 #include <spdlog/spdlog.h>
 #include <oscar/applets/config.hpp>
 #include <oscar/coordinator/applet.hpp>
@@ -20,6 +22,12 @@ using oscar::applets::Notification;
 class EventApplet final : public oscar::coordinator::Applet {
  public:
   explicit EventApplet(oscar::coordinator::AppletSetup& setup) : Applet(setup) {
+    const auto yield = setup.param("auto_yield", "true");
+    if (yield != "true" && yield != "false") {
+      throw std::invalid_argument("applet '" + name() +
+                                  "': auto_yield must be true or false, not '" + yield + "'");
+    }
+    auto_yield_ = yield == "true";
     const auto level = setup.param("settle_priority", "");
     if (!level.empty()) {
       try {
@@ -43,6 +51,10 @@ class EventApplet final : public oscar::coordinator::Applet {
         spdlog::info("applet {}: {} revoked", name(), bundle);
         return true;
       case Notification::Kind::kRevokeRequested:
+        if (!auto_yield_) {
+          spdlog::info("applet {}: {} is to be given back; it keeps it for now", name(), bundle);
+          return true;
+        }
         spdlog::info("applet {}: {} yielded", name(), bundle);
         return false;  // the default: yield at once
       default:
@@ -53,6 +65,7 @@ class EventApplet final : public oscar::coordinator::Applet {
   std::chrono::milliseconds period() const override { return std::chrono::milliseconds(20); }
 
  private:
+  bool auto_yield_ = true;
   std::optional<int> settle_;
   std::set<std::string> settled_;  // bundles whose priority it has settled
 };

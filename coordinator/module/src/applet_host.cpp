@@ -121,6 +121,9 @@ class AppletHost::Impl final : public AppletGateway {
   std::optional<Notification> run_round(Context& ctx, Hosted& h, BundleId bundle,
                                         const applets::NegotiationRound& round);
   void run_negotiations(Context& ctx, Hosted& h);
+  // Applies an operator's event (a notice of kind event) as the applet's own call and tells the
+  // coordinator (event_done, with the refusal if any). False for "crash": the caller throws.
+  bool apply_event(Context& ctx, Hosted& h, const SchedNotice& n);
 
   const SystemSpec& system_;
   applets::SystemConfig config_;
@@ -593,11 +596,51 @@ void AppletHost::Impl::run_negotiations(Context& ctx, Hosted& h) {
   }
 }
 
+bool AppletHost::Impl::apply_event(Context& ctx, Hosted& h, const SchedNotice& n) {
+  const AppletEvent& e = n.args();
+  const auto& what = e.event();
+  if (what == "crash") return false;
+  std::string error;
+  try {
+    if (what == "request") ctx.request(e.bundle());
+    if (what == "release") ctx.release(e.bundle());
+    if (what == "trigger") ctx.trigger(e.bundle());
+    if (what == "yield") ctx.yield(e.bundle());
+    if (what == "set_priority") ctx.set_priority(e.bundle(), e.priority());
+    if (what == "set_deadline") {
+      std::optional<applets::Deadline> d;
+      if (e.has_deadline()) {
+        d = applets::Deadline{milliseconds(e.t_early_ms()), milliseconds(e.t_duration_ms()),
+                              milliseconds(e.t_finish_ms())};
+      }
+      ctx.set_deadline(e.bundle(), d);
+    }
+    if (what == "negotiate") {
+      applets::Negotiation answer;
+      answer.min_needed = milliseconds(e.min_ms());
+      answer.max_needed = milliseconds(e.max_ms());
+      answer.accept = e.accept();
+      const auto reply = ctx.negotiate(e.bundle(), answer);
+      spdlog::info("applet {}: {} {}", h.name, e.bundle(), internal::notice_kind(reply.kind));
+    }
+  } catch (const std::invalid_argument& x) {
+    error = x.what();
+    spdlog::warn("applet {}: {} {}: {}", h.name, what, e.bundle(), error);
+  }
+  SchedCall done;
+  done.call("event_done");
+  done.event_id(n.event_id());
+  done.error(error);
+  call(h, done);
+  return true;
+}
+
 // The applet's loop, as in the coordinator's Runtime (seed Abb. 4.12): interrupts first, then
 // a step, every period; whatever the code throws ends this applet only (it loses its bundles).
 void AppletHost::Impl::applet_main(Hosted& h) {
   Context ctx(*this, h);
   Applet& applet = *h.applet;
+  std::uint64_t crash_event = 0;  // the operator's event "crash" that ended the applet, if any
   try {
     {
       // Announced first, so that init()'s calls reach a coordinator that knows the applet.
@@ -620,14 +663,9 @@ void AppletHost::Impl::applet_main(Hosted& h) {
       }
       for (const auto& n : queue) {
         if (n.kind() == "event") {  // an operator's event: the applet's own call
-          try {
-            if (n.event() == "request") ctx.request(n.bundle());
-            if (n.event() == "release") ctx.release(n.bundle());
-            if (n.event() == "trigger") ctx.trigger(n.bundle());
-          } catch (const std::invalid_argument& e) {
-            spdlog::warn("applet {}: {} {}: {}", h.name, n.event(), n.bundle(), e.what());
-          }
-          continue;
+          if (apply_event(ctx, h, n)) continue;
+          crash_event = n.event_id();
+          throw std::runtime_error("an operator's event 'crash' made its code throw");
         }
         if (!internal::notice_kind(n.kind())) continue;  // a kind this build does not know
         const auto notification = notification_of(h, n);
@@ -661,6 +699,12 @@ void AppletHost::Impl::applet_main(Hosted& h) {
   SchedCall c;
   c.call("crash");
   call(h, c);
+  if (crash_event != 0) {
+    SchedCall done;
+    done.call("event_done");
+    done.event_id(crash_event);
+    call(h, done);
+  }
   std::lock_guard lock(mutex_);
   h.requested.clear();
   h.crashed = true;  // no hello again: a crashed applet stays out until its process restarts

@@ -12,6 +12,7 @@
 #include "oscar/time.hpp"
 #include "providers.hpp"
 #include "remote_applets.hpp"
+#include "sched_wire.hpp"
 
 namespace oscar::coordinator {
 namespace {
@@ -198,6 +199,7 @@ Coordinator::Snapshot Coordinator::snapshot() {
       p.waiting(sorted(w));
       p.available(s.available(id));
       p.plan(s.holder(id));
+      p.active(s.active_holder(id));
       for (const auto& u : m.needs(id)) p.needs().push_back(m.service(u.service).name);
       p.providers(providers_of_[id]);
       plan.services().push_back(std::move(p));
@@ -258,34 +260,57 @@ void Coordinator::reconcile() {
     published_ = unstamped;
     published_any_ = true;
     snap.plan.stamp_ns(static_cast<unsigned long long>(wall_now()));
+    runtime_->with_scheduler([&](applets::Scheduler& s) { snap.plan.clock_ms(s.now().count()); });
     plan_writer_.write(snap.plan);
   }
 }
 
 AppletPlan Coordinator::plan() { return snapshot().plan; }
 
-std::optional<std::string> Coordinator::apply_event(const std::string& applet,
-                                                    const std::string& bundle,
-                                                    const std::string& event) {
+std::optional<std::string> Coordinator::apply_event(const AppletEvent& e) {
   // An applet in another process applies the event as its own call (it keeps what it asks for,
   // and announces it again after a restart of either side).
-  if (remote_->remote(applet)) return remote_->event(applet, bundle, event);
+  if (remote_->remote(e.applet())) return remote_->event(e);
   std::optional<std::string> error;
   runtime_->with_scheduler([&](applets::Scheduler& s) {
     try {
       const auto& m = s.model();
-      const auto b = m.bundle_id(m.applet_id(applet), bundle);
-      if (event == "request") {
+      const auto b = m.bundle_id(m.applet_id(e.applet()), e.bundle());
+      const auto& what = e.event();
+      if (what == "request") {
         s.request(b);
-      } else if (event == "release") {
+      } else if (what == "release") {
         s.release(b);
-      } else if (event == "trigger") {
+      } else if (what == "trigger") {
         s.trigger(b);
+      } else if (what == "yield") {
+        s.yield(b);
+      } else if (what == "set_priority") {
+        s.set_priority(b, e.priority());
+      } else if (what == "set_deadline") {
+        std::optional<applets::Deadline> d;
+        if (e.has_deadline()) {
+          d = applets::Deadline{std::chrono::milliseconds(e.t_early_ms()),
+                                std::chrono::milliseconds(e.t_duration_ms()),
+                                std::chrono::milliseconds(e.t_finish_ms())};
+        }
+        s.set_deadline(b, d);
+      } else if (what == "negotiate") {
+        applets::Negotiation answer;
+        answer.min_needed = std::chrono::milliseconds(e.min_ms());
+        answer.max_needed = std::chrono::milliseconds(e.max_ms());
+        answer.accept = e.accept();
+        s.negotiate(b, answer);
+      } else if (what == "crash") {
+        error = fmt::format(
+            "event 'crash' is for applets in a process of their own (applet '{}' runs in the "
+            "coordinator's process, which it would end)",
+            e.applet());
       } else {
-        error = fmt::format("unknown event '{}' (events: request, release, trigger)", event);
+        error = fmt::format("unknown event '{}' (events: {})", what, internal::kAppletEvents);
       }
-    } catch (const std::invalid_argument& e) {
-      error = e.what();
+    } catch (const std::invalid_argument& x) {
+      error = x.what();
     }
   });
   if (!error) {

@@ -38,7 +38,7 @@ class CoordinatorKernel final : public Kernel {
     setup.command<AppletEvent>("applet", [](const AppletEvent& e) {
       auto* c = the_coordinator.load();
       if (!c) return CommandAnswer::refuse("the coordinator is starting");
-      if (const auto error = c->apply_event(e.applet(), e.bundle(), e.event())) {
+      if (const auto error = c->apply_event(e)) {
         return CommandAnswer::refuse(*error);
       }
       return CommandAnswer::accept(e.applet() + "/" + e.bundle() + ": " + e.event());

@@ -16,6 +16,8 @@ using Clock = std::chrono::steady_clock;
 constexpr std::chrono::milliseconds kWorkerTick{20};
 // How often an applet the coordinator does not know is asked to announce itself.
 constexpr std::chrono::milliseconds kAskAgain{300};
+// How long the command port `applet` waits for a remote applet to apply an operator's event.
+constexpr std::chrono::milliseconds kEventTimeout{3000};
 
 SchedNotice notice_of(const applets::Model& m, const Notification& n) {
   SchedNotice out;
@@ -108,6 +110,7 @@ void RemoteApplets::stop() {
     stopping_ = true;
   }
   wake_.notify_all();
+  events_done_.notify_all();
   if (worker_.joinable()) worker_.join();
   if (commands_thread_.joinable()) commands_thread_.join();
 }
@@ -125,9 +128,8 @@ RemoteApplets::Seen RemoteApplets::seen(const std::string& applet) const {
   return {a.process, std::nullopt};
 }
 
-std::optional<std::string> RemoteApplets::event(const std::string& applet,
-                                                const std::string& bundle,
-                                                const std::string& event) {
+std::optional<std::string> RemoteApplets::event(const AppletEvent& e) {
+  const auto& applet = e.applet();
   std::uint64_t session = 0;
   {
     std::lock_guard lock(mutex_);
@@ -140,23 +142,45 @@ std::optional<std::string> RemoteApplets::event(const std::string& applet,
     }
     session = a.session;
   }
-  try {
-    runtime_.with_scheduler([&](applets::Scheduler& s) {
-      s.model().bundle_id(s.model().applet_id(applet), bundle);  // throws if unknown
-    });
-  } catch (const std::invalid_argument& e) {
-    return std::string(e.what());
+  if (e.event() != "crash") {
+    try {
+      runtime_.with_scheduler([&](applets::Scheduler& s) {
+        s.model().bundle_id(s.model().applet_id(applet), e.bundle());  // throws if unknown
+      });
+    } catch (const std::invalid_argument& error) {
+      return std::string(error.what());
+    }
   }
-  if (event != "request" && event != "release" && event != "trigger") {
-    return fmt::format("unknown event '{}' (events: request, release, trigger)", event);
+  if (!internal::known_applet_event(e.event())) {
+    return fmt::format("unknown event '{}' (events: {})", e.event(), internal::kAppletEvents);
+  }
+  std::uint64_t id = 0;
+  {
+    std::lock_guard lock(mutex_);
+    id = next_event_id_++;
+    events_[id] = std::nullopt;
   }
   SchedNotice n;
   n.applet(applet);
   n.session(session);
   n.kind("event");
-  n.bundle(bundle);
-  n.event(event);
+  n.bundle(e.bundle());
+  n.event(e.event());
+  n.args(e);
+  n.event_id(id);
   send({applet, std::nullopt, std::move(n)});
+  // The reply waits for the applet's word, so that events sent one after the other are applied
+  // in that order (a scenario's timeline), and a refused call is the event's refusal.
+  std::unique_lock lock(mutex_);
+  const bool done = events_done_.wait_for(lock, kEventTimeout,
+                                          [&] { return stopping_ || events_.at(id).has_value(); });
+  const auto result = events_.at(id);
+  events_.erase(id);
+  if (!done || !result) {
+    return fmt::format("applet '{}' did not confirm the event '{}' within {} ms", applet, e.event(),
+                       kEventTimeout.count());
+  }
+  if (!result->empty()) return *result;
   return std::nullopt;
 }
 
@@ -289,6 +313,18 @@ void RemoteApplets::on_call(const SchedCall& call) {
   reply.session(call.session());
   reply.seq(call.seq());
   reply.coordinator(coordinator_id_);
+  if (call.call() == "event_done") {
+    // The applet applied an operator's event (its calls came before): also after its crash.
+    {
+      std::lock_guard lock(mutex_);
+      const auto it = events_.find(call.event_id());
+      if (it != events_.end()) it->second = call.error();
+    }
+    events_done_.notify_all();
+    reply.ok(true);
+    reply_writer_.write(reply);
+    return;
+  }
   if (!current(call.applet(), call.session())) {
     reply.ok(false);
     reply.kind("announce");

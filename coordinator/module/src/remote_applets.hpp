@@ -53,10 +53,11 @@ class RemoteApplets {
     std::optional<std::string> state;
   };
   Seen seen(const std::string& applet) const;
-  /// Passes an operator's event ("request", "release", "trigger") for a bundle to the remote
-  /// applet, which makes it its own call. Returns why not, if it cannot.
-  std::optional<std::string> event(const std::string& applet, const std::string& bundle,
-                                   const std::string& event);
+  /// Passes an operator's event (AppletEvent: request, release, trigger, yield, set_priority,
+  /// set_deadline, negotiate, crash) for a bundle to the remote applet, which makes it its own
+  /// call, and waits until the applet says it did (event_done). Returns why not, if it cannot
+  /// or the applet's call was refused.
+  std::optional<std::string> event(const AppletEvent& event);
 
  private:
   struct Applet {
@@ -104,6 +105,11 @@ class RemoteApplets {
   std::deque<Outgoing> outgoing_;
   bool stopping_ = false;
   bool started_ = false;
+  std::uint64_t next_event_id_ = 1;
+  // Operator's events sent to applets, until their event_done: nullopt while pending, then
+  // the applet's error ("" if its call was taken).
+  std::map<std::uint64_t, std::optional<std::string>> events_;
+  std::condition_variable events_done_;
 
   TopicWriter<SchedReply, SchedReplyPubSubType> reply_writer_;
   TopicWriter<SchedNotice, SchedNoticePubSubType> notice_writer_;

@@ -42,6 +42,14 @@ bool is_revocation(Kind kind) {
          kind == Kind::kNegotiationRejected || kind == Kind::kRevokedByForce;
 }
 
+bool known_applet_event(const std::string& event) {
+  for (const char* e : {"request", "release", "trigger", "yield", "set_priority", "set_deadline",
+                        "negotiate", "crash"}) {
+    if (event == e) return true;
+  }
+  return false;
+}
+
 std::uint64_t fresh_id() {
   std::random_device device;
   std::mt19937_64 gen(

@@ -16,6 +16,11 @@ const char* notice_kind(applets::Notification::Kind kind);
 std::optional<applets::Notification::Kind> notice_kind(const std::string& text);
 /// Whether a notification is about taking a bundle away (seed footnote 11).
 bool is_revocation(applets::Notification::Kind kind);
+/// The operator's events an applet takes (AppletEvent.event), for messages: "request, ...".
+inline constexpr const char* kAppletEvents =
+    "request, release, trigger, yield, set_priority, set_deadline, negotiate, crash";
+/// Whether `event` is one of kAppletEvents.
+bool known_applet_event(const std::string& event);
 /// A random number, never 0 (a session, a start of the coordinator).
 std::uint64_t fresh_id();
 

@@ -69,6 +69,8 @@ class Scenario {
 
   const SystemConfig& system() const { return system_; }
   const std::vector<Step>& steps() const { return steps_; }
+  /// runner.auto_yield: whether applets yield a bundle at once when its revocation is requested.
+  bool auto_yield() const { return auto_yield_; }
 
  private:
   SystemConfig system_;

@@ -61,10 +61,11 @@ class Coordinator final : public AppletGateway {
   /// The plan as it is now (what the coordinator publishes).
   AppletPlan plan();
 
-  /// An operator's event for an applet's bundle: "request", "release" or "trigger" (what the
-  /// coordinator kernel's command port `applet` takes). Returns why it was refused, if it was.
-  std::optional<std::string> apply_event(const std::string& applet, const std::string& bundle,
-                                         const std::string& event);
+  /// An operator's event for an applet's bundle (what the coordinator kernel's command port
+  /// `applet` takes): request, release, trigger, yield, set_priority, set_deadline, negotiate,
+  /// and crash for an applet in another process. An applet in another process applies it as
+  /// its own call; this returns once it did. Returns why it was refused, if it was.
+  std::optional<std::string> apply_event(const AppletEvent& event);
 
  private:
   struct Snapshot;
