@@ -6,9 +6,8 @@
 #include <utility>
 
 namespace oscar::applets {
-namespace {
 
-std::string quote(const std::string& s) {
+std::string dot_quote(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
     if (c == '\n') {
@@ -20,6 +19,8 @@ std::string quote(const std::string& s) {
   }
   return out + "\"";
 }
+
+namespace {
 
 std::string priority_name(int p) {
   switch (p) {
@@ -49,9 +50,9 @@ std::string legend() {
       {"idle", "white"}};
   std::string previous;
   for (const auto& [state, colour] : bundles) {
-    const auto id = quote(std::string("legend:") + state);
+    const auto id = dot_quote(std::string("legend:") + state);
     out += "    " + id + " [fillcolor=" + colour +
-           ", label=" + quote(std::string("bundle ") + state) + "];\n";
+           ", label=" + dot_quote(std::string("bundle ") + state) + "];\n";
     if (!previous.empty()) out += "    " + previous + " -> " + id + " [style=invis];\n";
     previous = id;
   }
@@ -63,9 +64,9 @@ std::string legend() {
       {"provides (from a service applet)", "color=darkgreen, dir=back"},
       {"needs (a service's dependency)", "style=dashed"}};
   for (const auto& [meaning, colour] : edges) {
-    const auto from = quote(std::string("legend:from ") + meaning);
+    const auto from = dot_quote(std::string("legend:from ") + meaning);
     out += "    " + from + " [shape=point, width=0.05];\n    " + from + " -> \"legend:service\" [" +
-           colour + ", label=" + quote(meaning) + ", fontsize=10];\n";
+           colour + ", label=" + dot_quote(meaning) + ", fontsize=10];\n";
   }
   return out + "  }\n";
 }
@@ -78,21 +79,22 @@ std::string to_dot(const Scheduler& s) {
   std::string out = "digraph applets {\n  rankdir=LR;\n  node [fontname=\"Helvetica\"];\n";
   for (ServiceId id = 0; id < m.services().size(); ++id) {
     const Service& svc = m.service(id);
-    out +=
-        "  " + quote("s:" + svc.name) + " [shape=ellipse, style=filled, fillcolor=" +
-        (plan.uses[id].empty() ? "white" : "lightblue") + ", label=" +
-        quote(svc.name + (svc.exclusive_only ? "\n(exclusive only)" : "") + "\n" + s.holder(id)) +
-        "];\n";
+    out += "  " + dot_quote("s:" + svc.name) + " [shape=ellipse, style=filled, fillcolor=" +
+           (plan.uses[id].empty() ? "white" : "lightblue") + ", label=" +
+           dot_quote(svc.name + (svc.exclusive_only ? "\n(exclusive only)" : "") + "\n" +
+                     s.holder(id)) +
+           "];\n";
     for (const Dependency& d : svc.dependencies) {
-      out += "  " + quote("s:" + svc.name) + " -> " + quote("s:" + m.service(d.service).name) +
-             " [style=dashed, label=" + quote("needs " + std::string(to_string(d.access))) + "];\n";
+      out += "  " + dot_quote("s:" + svc.name) + " -> " +
+             dot_quote("s:" + m.service(d.service).name) +
+             " [style=dashed, label=" + dot_quote("needs " + std::string(to_string(d.access))) +
+             "];\n";
     }
   }
   for (AppletId a = 0; a < m.applets().size(); ++a) {
     const Applet& ap = m.applet(a);
-    out += "  subgraph " + quote("cluster_" + ap.name) +
-           " {\n    label=" + quote(ap.name + (ap.provides.empty() ? "" : " (service applet)")) +
-           ";\n";
+    out += "  subgraph " + dot_quote("cluster_" + ap.name) + " {\n    label=" +
+           dot_quote(ap.name + (ap.provides.empty() ? "" : " (service applet)")) + ";\n";
     for (BundleId b : ap.bundles) {
       const Bundle& bundle = m.bundle(b);
       // A bundle given back is still in use until its reassigners' first wait limit (Abb. 4.13);
@@ -111,31 +113,32 @@ std::string to_dot(const Scheduler& s) {
                                  : state == "active"              ? "palegreen"
                                  : state.rfind("blocked", 0) == 0 ? "lightgrey"
                                                                   : "khaki";
-      out += "    " + quote("b:" + ap.name + "/" + bundle.name) + " [shape=box, style=filled, " +
-             "fillcolor=" + colour + ", label=" +
-             quote(bundle.name + "\nprio " + priority_name(s.priority(b)) + "\n" + state) + "];\n";
+      out += "    " + dot_quote("b:" + ap.name + "/" + bundle.name) +
+             " [shape=box, style=filled, " + "fillcolor=" + colour + ", label=" +
+             dot_quote(bundle.name + "\nprio " + priority_name(s.priority(b)) + "\n" + state) +
+             "];\n";
     }
     // A service applet's services start at its first bundle; one without bundles (its services
     // need nothing) gets a node of its own, so no edge points at a bundle that is not drawn.
     std::string provider =
         ap.bundles.empty() ? "a:" + ap.name : "b:" + ap.name + "/" + m.bundle(ap.bundles[0]).name;
     if (ap.bundles.empty() && !ap.provides.empty()) {
-      out += "    " + quote(provider) +
-             " [shape=box, style=dashed, label=" + quote(ap.name + "\nno bundles") + "];\n";
+      out += "    " + dot_quote(provider) +
+             " [shape=box, style=dashed, label=" + dot_quote(ap.name + "\nno bundles") + "];\n";
     }
     out += "  }\n";
     for (ServiceId p : ap.provides) {
-      out += "  " + quote(provider) + " -> " + quote("s:" + m.service(p).name) +
+      out += "  " + dot_quote(provider) + " -> " + dot_quote("s:" + m.service(p).name) +
              " [dir=back, color=darkgreen, label=provides];\n";
     }
     for (BundleId b : ap.bundles) {
       for (ResourceId r : m.bundle(b).resources) {
         const Resource& res = m.resource(r);
         const bool exclusive = res.access == Access::kExclusive;
-        out += "  " + quote("b:" + ap.name + "/" + m.bundle(b).name) + " -> " +
-               quote("s:" + m.service(res.service).name) +
+        out += "  " + dot_quote("b:" + ap.name + "/" + m.bundle(b).name) + " -> " +
+               dot_quote("s:" + m.service(res.service).name) +
                " [color=" + (plan.resource_granted[r] ? (exclusive ? "red" : "blue") : "grey") +
-               ", label=" + quote(std::string(to_string(res.access))) + "];\n";
+               ", label=" + dot_quote(std::string(to_string(res.access))) + "];\n";
       }
     }
   }

@@ -6,6 +6,8 @@
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
+#include "oscar/applets/dot.hpp"
+
 namespace oscar::coordinator {
 
 std::string plan_json(const AppletPlan& plan) {
@@ -48,19 +50,6 @@ std::string plan_table(const AppletPlan& plan) {
 
 namespace {
 
-std::string quote(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '\n') {
-      out += "\\n";
-      continue;
-    }
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-
 const char* state_colour(const std::string& state) {
   if (state == "holding") return "palegreen";
   if (state == "waiting") return "khaki";
@@ -77,51 +66,55 @@ std::string plan_dot(const AppletPlan& plan) {
       "  node [fontname=\"Helvetica\", fontsize=11];\n"
       "  edge [fontname=\"Helvetica\", fontsize=9];\n";
   out += fmt::format("  label={};\n  labelloc=t;\n",
-                     quote(fmt::format("{}: the coordinator's plan ({} plans so far)",
-                                       plan.system(), plan.plans())));
+                     applets::dot_quote(fmt::format("{}: the coordinator's plan ({} plans so far)",
+                                                    plan.system(), plan.plans())));
   for (const auto& a : plan.applets()) {
     out += fmt::format("  {} [shape=box, style=filled, fillcolor={}, label={}];\n",
-                       quote("a:" + a.name()), state_colour(a.state()),
-                       quote(a.name() + "\n" + a.state() + " in " + a.process()));
+                       applets::dot_quote("a:" + a.name()), state_colour(a.state()),
+                       applets::dot_quote(a.name() + "\n" + a.state() + " in " + a.process()));
   }
   std::set<std::string> modules;
   for (const auto& s : plan.services()) {
     const char* fill = !s.available() ? "lightgrey" : !s.holders().empty() ? "lightblue" : "white";
-    out += fmt::format("  {} [shape=ellipse, style=filled, fillcolor={}, label={}];\n",
-                       quote("s:" + s.name()), fill,
-                       quote(s.name() + "\n" + s.access() + (s.available() ? "" : ", unavailable") +
-                             "\nplan: " + s.plan()));
+    out += fmt::format(
+        "  {} [shape=ellipse, style=filled, fillcolor={}, label={}];\n",
+        applets::dot_quote("s:" + s.name()), fill,
+        applets::dot_quote(s.name() + "\n" + s.access() + (s.available() ? "" : ", unavailable") +
+                           "\nplan: " + s.plan()));
     for (const auto& h : s.holders()) {
       out += fmt::format("  {} -> {} [color=darkgreen, penwidth=2, label=holds];\n",
-                         quote("a:" + h), quote("s:" + s.name()));
+                         applets::dot_quote("a:" + h), applets::dot_quote("s:" + s.name()));
     }
     for (const auto& w : s.waiting()) {
-      out += fmt::format("  {} -> {} [color=grey, style=dashed, label=waits];\n", quote("a:" + w),
-                         quote("s:" + s.name()));
+      out += fmt::format("  {} -> {} [color=grey, style=dashed, label=waits];\n",
+                         applets::dot_quote("a:" + w), applets::dot_quote("s:" + s.name()));
     }
     for (const auto& n : s.needs()) {
-      out += fmt::format("  {} -> {} [style=bold, label=needs];\n", quote("s:" + s.name()),
-                         quote("s:" + n));
+      out += fmt::format("  {} -> {} [style=bold, label=needs];\n",
+                         applets::dot_quote("s:" + s.name()), applets::dot_quote("s:" + n));
     }
     for (const auto& p : s.providers()) {
       if (p.starts_with("applet:")) {
         out += fmt::format("  {} -> {} [dir=back, color=blue, label=provides];\n",
-                           quote("s:" + s.name()), quote("a:" + p.substr(7)));
+                           applets::dot_quote("s:" + s.name()),
+                           applets::dot_quote("a:" + p.substr(7)));
         continue;
       }
       if (modules.insert(p).second) {
-        out += fmt::format("  {} [shape=component, label={}];\n", quote("m:" + p), quote(p));
+        out += fmt::format("  {} [shape=component, label={}];\n", applets::dot_quote("m:" + p),
+                           applets::dot_quote(p));
       }
       out += fmt::format("  {} -> {} [style=dotted, arrowhead=none, label=\"provided by\"];\n",
-                         quote("s:" + s.name()), quote("m:" + p));
+                         applets::dot_quote("s:" + s.name()), applets::dot_quote("m:" + p));
     }
   }
   out +=
       "  subgraph cluster_legend {\n    label=\"legend\";\n"
       "    node [shape=box, style=filled, fontsize=9];\n";
   for (const char* state : {"holding", "waiting", "idle", "crashed", "absent"}) {
-    out += fmt::format("    {} [fillcolor={}, label={}];\n", quote(std::string("legend:") + state),
-                       state_colour(state), quote(std::string("applet ") + state));
+    out += fmt::format("    {} [fillcolor={}, label={}];\n",
+                       applets::dot_quote(std::string("legend:") + state), state_colour(state),
+                       applets::dot_quote(std::string("applet ") + state));
   }
   out +=
       "    \"legend:service\" [shape=ellipse, fillcolor=lightblue, label=\"service held\"];\n"

@@ -50,7 +50,11 @@ TEST(Coordinator, AnAppletsTriggerIsRefusedNamingTheHolderUnlessItHoldsTheServic
   EXPECT_FALSE(reply.ok());
   EXPECT_EQ(reply.error(), "applet 'holder' does not hold service 'Camera': nobody holds it now");
 
-  ASSERT_FALSE(c.apply_event("holder", "camera", "request"));
+  AppletEvent request;
+  request.applet("holder");
+  request.bundle("camera");
+  request.event("request");
+  ASSERT_FALSE(c.apply_event(request));
   reply = c.trigger("other", "Camera", "cam", "cam");
   EXPECT_FALSE(reply.ok());
   EXPECT_EQ(reply.error(), "applet 'other' does not hold service 'Camera': it is held by 'holder'");

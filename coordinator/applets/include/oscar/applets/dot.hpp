@@ -8,6 +8,9 @@
 
 namespace oscar::applets {
 
+/// `s` as a DOT string literal (quotes and backslashes escaped, newlines as \n).
+std::string dot_quote(const std::string& s);
+
 /// DOT text of the scheduler's current state. Always available.
 std::string to_dot(const Scheduler& scheduler);
 
