@@ -2,7 +2,6 @@
 // what the retired sequencer did, configuring another module under the coordinator's name from a
 // DDS participant of its own inside its module's process. Each cycle it asks `target` to activate
 // all its kernels and logs the module's verdict ("impostor: accepted" or "impostor: refused: ...").
-#include <cstdlib>
 #include <memory>
 #include <string>
 
@@ -10,7 +9,6 @@
 #include "oscar/dds_participant.hpp"
 #include "oscar/kernel.hpp"
 #include "oscar/kernel_registry.hpp"
-#include "oscar/module_spec.hpp"
 #include "oscar/network.hpp"
 
 namespace oscar::test {
@@ -29,14 +27,8 @@ class Impostor final : public Kernel {
 
   void process(Cycle& cycle) override {
     if (!client_) {
-      // As the sequencer did: the domain, system file and host that oscar-run exports.
-      NetworkConfig network;
-      const char* file = std::getenv("OSCAR_SYSTEM_FILE");
-      const char* host = std::getenv("OSCAR_HOST");
-      if (file && *file && host && *host) {
-        network = NetworkConfig::for_host(load_yaml_file(file), host);
-      }
-      participant_ = std::make_unique<DdsParticipant>(domain_from_env(0), "oscar-tool", network);
+      // The domain oscar-run exports, the default network (loopback).
+      participant_ = std::make_unique<DdsParticipant>(domain_from_env(0), "oscar-tool");
       client_ = std::make_unique<ConfigClient>(*participant_, params_.claim);
     }
     try {
