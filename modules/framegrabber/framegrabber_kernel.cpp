@@ -64,6 +64,7 @@ Framegrabber::Framegrabber(KernelSetup& setup)
   setup.command<SetFrameMode>("frame_mode",
                               [this](const SetFrameMode& r) { return set_frame_mode(r); });
   frame_mode_ = param_frame_mode_ = params_.frame_mode;
+  intrinsics_ = {params_.fx, params_.fy, params_.cx, params_.cy};  // fixed parameters
   name_ = params_.camera_id.empty() ? setup.kernel_name() : params_.camera_id;
   // Validate now (bad YAML is refused at load time); devices and files open on activation.
   source_ = parse_source(params_.source);
@@ -106,10 +107,10 @@ void Framegrabber::open() {
   o.seed = static_cast<std::uint64_t>(params_.seed);
   o.camera_position_m = position_;
   scene_ = std::make_unique<SyntheticScene>(o);
-  params_.fx = scene_->options().fx;  // the scene's defaults are the camera's intrinsics
-  params_.fy = scene_->options().fy;
-  params_.cx = scene_->options().cx;
-  params_.cy = scene_->options().cy;
+  // The scene's defaults are the camera's intrinsics. They are the kernel's own: the parameters
+  // belong to the frame, which reads them from other threads (oscar ps).
+  intrinsics_ = {scene_->options().fx, scene_->options().fy, scene_->options().cx,
+                 scene_->options().cy};
 }
 
 // The command changes only the kernel's own mode: the parameter values belong to the frame,
@@ -172,10 +173,10 @@ void Framegrabber::publish(const cv::Mat& full, GroundTruth truth, Stamp acquire
   frame.encoding("mono8");
   frame.width(static_cast<std::uint16_t>(img.cols));
   frame.height(static_cast<std::uint16_t>(img.rows));
-  frame.fx(params_.fx * f);
-  frame.fy(params_.fy * f);
-  frame.cx(params_.cx * f);
-  frame.cy(params_.cy * f);
+  frame.fx(intrinsics_.fx * f);
+  frame.fy(intrinsics_.fy * f);
+  frame.cx(intrinsics_.cx * f);
+  frame.cy(intrinsics_.cy * f);
   frame.position({position_.x(), position_.y(), position_.z()});
   frame.data().assign(img.data, img.data + img.total());
   frame.truth(std::move(truth));

@@ -59,6 +59,9 @@ class Framegrabber final : public Kernel {
   Eigen::Vector3d position_;
   std::unique_ptr<FrameSource> camera_;
   std::unique_ptr<SyntheticScene> scene_;
+  struct Intrinsics {
+    double fx = 0, fy = 0, cx = 0, cy = 0;  ///< full frame, px; 0 = unknown
+  } intrinsics_;  ///< the parameters', or the synthetic scene's defaults for those left 0
   std::uint64_t frames_ = 0;
   bool ended_ = false;
   std::string frame_mode_;        // what it grabs: the parameter or the command, the later one

@@ -47,7 +47,8 @@ class Cycle {
 };
 
 /// The base of every kernel. Constructors only declare ports and parameters (no DDS, threads,
-/// files or devices): devices open in on_activate().
+/// files or devices): devices open in on_activate(). A kernel reads its parameters and never
+/// writes them: the frame owns them and reads them from other threads.
 class Kernel {
  public:
   virtual ~Kernel() = default;

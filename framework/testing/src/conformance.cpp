@@ -36,6 +36,7 @@ void expect_kernel_conformance(const std::string& type, const YAML::Node& params
   for (const auto& p : ports.outputs) EXPECT_TRUE(names.insert(p->name()).second) << p->name();
 
   // process() with nothing on any input must neither throw nor crash.
+  const auto configured = ports.params.to_yaml();
   EXPECT_NO_THROW(h.step()) << "process() must survive empty inputs";
 
   // stub() writes every output.
@@ -46,8 +47,12 @@ void expect_kernel_conformance(const std::string& type, const YAML::Node& params
         << "stub() wrote nothing to output '" << p->name() << "'";
   }
 
-  // Parameters round-trip through YAML.
+  // The parameters are the frame's: it reads them from other threads (oscar ps) while the kernel
+  // runs, so a kernel keeps what it derives from them in members of its own.
   const auto yaml = ports.params.to_yaml();
+  EXPECT_EQ(yaml, configured) << "process() or stub() wrote to a parameter";
+
+  // Parameters round-trip through YAML.
   KernelHarness again(type, YAML::Load(yaml), "again");
   EXPECT_EQ(again.instance().ports().params.to_yaml(), yaml);
 }

@@ -1,7 +1,7 @@
 #pragma once
 /// @file The conformance suite every kernel passes (docs/kernels.md): construction has no side
 /// effects, port names are unique, stub() writes every output, process() survives empty
-/// inputs, and parameters round-trip through YAML.
+/// inputs, neither writes to a parameter, and parameters round-trip through YAML.
 
 #include <string>
 
