@@ -6,7 +6,10 @@
 
 #include <unistd.h>
 
+#include <mutex>
 #include <set>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -74,6 +77,34 @@ TEST(Topics, EveryCatalogueTopicHasANameOfItsOwn) {
                                     topics::pull_reply("k/out").name,
                                     topics::cue("k/out")};
   EXPECT_EQ(names.size(), 22u);
+}
+
+// A module's first log lines are written before boot's reader has discovered it (its process
+// has just started): they must still reach boot's merged log.
+TEST(Topics, ALogReaderThatMatchesLateGetsTheLinesWrittenBefore) {
+  DdsParticipant p(150 + getpid() % 50, "test:topics");
+  TopicWriter<LogRecord, LogRecordPubSubType> writer(p, topics::log());
+  for (int i = 0; i < 3; ++i) {
+    LogRecord r;
+    r.module_name("early");
+    r.message("line " + std::to_string(i));
+    writer.write(r);
+  }
+  std::mutex mutex;
+  std::vector<std::string> got;
+  TopicReader<LogRecord, LogRecordPubSubType> reader(p, topics::log(),
+                                                     [&](const LogRecord& r, const auto&) {
+                                                       std::lock_guard lock(mutex);
+                                                       got.push_back(r.message());
+                                                     });
+  EXPECT_TRUE(eventually(
+      [&] {
+        std::lock_guard lock(mutex);
+        return got.size() == 3;
+      },
+      5s));
+  std::lock_guard lock(mutex);
+  EXPECT_EQ(got, (std::vector<std::string>{"line 0", "line 1", "line 2"}));
 }
 
 TEST(Topics, CueTopicsAreNamedAfterTheirOutput) {

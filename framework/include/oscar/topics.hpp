@@ -52,7 +52,8 @@ TopicSpec<ConfigCommand, ConfigCommandPubSubType> config(const std::string& modu
 /// `module`'s replies to configuration commands (state class, 64 deep: a client that matches
 /// late still gets its reply).
 TopicSpec<ConfigReply, ConfigReplyPubSubType> config_reply(const std::string& module);
-/// Every module's and tool's log records (a stream: reliable, volatile, 100 deep).
+/// Every module's and tool's log records (reliable, transient-local, the last 100 per writer:
+/// a reader that matches a writer late still gets its recent lines).
 TopicSpec<LogRecord, LogRecordPubSubType> log();
 /// Each module's announcement and state (state class: late joiners get the latest).
 TopicSpec<ModuleState, ModuleStatePubSubType> module_state();

@@ -38,7 +38,9 @@ TopicSpec<ConfigReply, ConfigReplyPubSubType> config_reply(const std::string& mo
 }
 
 TopicSpec<LogRecord, LogRecordPubSubType> log() {
-  return {"oscar/log", qos::stream_writer(100), qos::stream_reader(100)};
+  // Transient-local: a reader that discovers a module after its first lines (boot, just after
+  // the module started, under load; `oscar log` started later) still gets its last 100.
+  return {"oscar/log", qos::state_writer(100), qos::state_reader(100)};
 }
 
 TopicSpec<ModuleState, ModuleStatePubSubType> module_state() {
