@@ -170,16 +170,20 @@ void Runtime::applet_main(AppletId id) {
         slot.reacting_to_revocation.reset();
       }
       run_negotiations(ctx);  // follow-up rounds run like interrupt handlers (§4.5.3)
-      bool paused;
-      {
-        std::lock_guard lock(mutex_);
-        paused = slot.paused;
+      if (Clock::now() >= next) {
+        bool paused;
+        {
+          std::lock_guard lock(mutex_);
+          paused = slot.paused;
+        }
+        if (!paused) slot.code.step(ctx);  // line 5
+        ++slot.steps;
+        next += slot.code.period;  // lines 6–7
       }
-      if (!paused) slot.code.step(ctx);  // line 5
-      ++slot.steps;
-      next += slot.code.period;  // lines 6–7
+      // An interrupt wakes the applet at once: its handler runs now, between two steps, and the
+      // steps keep their period (a holder asked to give a service back need not wait a period).
       std::unique_lock lock(mutex_);
-      slot.cv.wait_until(lock, next, [&] { return stopping_; });
+      slot.cv.wait_until(lock, next, [&] { return stopping_ || !slot.interrupts.empty(); });
       if (stopping_) return;
     }
   } catch (...) {  // the boundary of the applet: nothing may escape into the process

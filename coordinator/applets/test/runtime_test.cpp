@@ -167,6 +167,36 @@ TEST(Runtime, InterruptHandlersRunOnTheAppletThreadBetweenSteps) {
   EXPECT_NE(handler_thread, std::this_thread::get_id());
 }
 
+// An interrupt does not wait for the applet's next step: an applet stepping every 30 s hears of
+// its grant and of a revocation at once, and yields without having stepped again.
+TEST(Runtime, AnInterruptRunsAtOnceNotAtTheNextStep) {
+  Model m;
+  const ServiceId s = m.add_service("S");
+  m.add_bundle(m.add_applet("Slow"), "s", {{s, kX}});
+  const BundleId high = m.add_bundle(m.add_applet("Urgent"), "s", {{s, kX}}, kPriorityHigh);
+  Runtime rt(m);
+  std::atomic<int> steps{0};
+  std::atomic<bool> granted{false}, yielded{false};
+  rt.set_code("Slow", {[](AppletContext& c) { c.request("s"); }, [&](AppletContext&) { ++steps; },
+                       [&](AppletContext& c, const Notification& n) {
+                         if (n.kind == Notification::Kind::kGranted) granted = true;
+                         if (n.kind == Notification::Kind::kRevokeRequested) {
+                           c.yield("s");
+                           yielded = true;
+                         }
+                       },
+                       30s});
+  rt.start();
+  ASSERT_TRUE(eventually([&] { return granted.load(); }));
+  rt.with_scheduler([&](Scheduler& sch) { sch.request(high); });
+  ASSERT_TRUE(eventually([&] { return yielded.load(); }));
+  std::string holder;
+  rt.with_scheduler([&](Scheduler& sch) { holder = sch.holder(s); });
+  EXPECT_EQ(holder, "Urgent");
+  EXPECT_EQ(steps.load(), 1);  // the first, at start; the next is 30 s away
+  rt.stop();
+}
+
 TEST(Runtime, CrashedAppletLosesItsResourcesAndNothingElseIsAffected) {
   Model m;
   const ServiceId s = m.add_service("S");

@@ -53,6 +53,18 @@ class FrameModeSwitcher final : public oscar::coordinator::Applet {
     }
   }
 
+  // A new holder sets its mode at once, not at its next step.
+  bool on_interrupt(oscar::applets::AppletContext& ctx,
+                    const oscar::applets::Notification& n) override {
+    if (n.kind == oscar::applets::Notification::Kind::kGranted && bundle_name(n) == bundle_) {
+      current_.reset();  // granted anew (perhaps given back and granted again since its last step)
+      last_.reset();
+      granted_ = true;
+      step(ctx);
+    }
+    return false;  // the rest as by default: a revocation is yielded at once
+  }
+
   std::chrono::milliseconds period() const override { return std::chrono::milliseconds(20); }
 
  private:

@@ -635,8 +635,8 @@ bool AppletHost::Impl::apply_event(Context& ctx, Hosted& h, const SchedNotice& n
   return true;
 }
 
-// The applet's loop, as in the coordinator's Runtime (seed Abb. 4.12): interrupts first, then
-// a step, every period; whatever the code throws ends this applet only (it loses its bundles).
+// The applet's loop, as in the coordinator's Runtime (seed Abb. 4.12): interrupts as they come,
+// a step every period; whatever the code throws ends this applet only (it loses its bundles).
 void AppletHost::Impl::applet_main(Hosted& h) {
   Context ctx(*this, h);
   Applet& applet = *h.applet;
@@ -677,9 +677,11 @@ void AppletHost::Impl::applet_main(Hosted& h) {
         ctx.reacting(std::nullopt);
       }
       run_negotiations(ctx, h);
-      applet.step(ctx);
-      ++h.steps;
-      next += applet.period();
+      if (Clock::now() >= next) {
+        applet.step(ctx);
+        ++h.steps;
+        next += applet.period();
+      }
       std::unique_lock lock(mutex_);
       while (!stopping_ && Clock::now() < next) {
         lock.unlock();
@@ -687,7 +689,8 @@ void AppletHost::Impl::applet_main(Hosted& h) {
         lock.lock();
         h.cv.wait_until(lock, std::min(next, Clock::now() + kSlice),
                         [&] { return stopping_ || !h.notices.empty(); });
-        if (!h.notices.empty()) break;  // interrupts run at once, between steps
+        // Interrupts run at once, between two steps; the steps keep their period.
+        if (!h.notices.empty()) break;
       }
       if (stopping_) return;
     }
