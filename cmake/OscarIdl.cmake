@@ -25,19 +25,30 @@ function(oscar_generate_idl target)
       ${out}/${stem}TypeObject.h ${out}/${stem}TypeObject.cxx)
     # fastddsgen 2.3 makes every constructor of every generated type re-register all type
     # objects of its file (a locked factory, string keys): constructing a LineSeg3DSeq of 100
-    # lines costs ~300 us. The sed makes the registration happen once per process.
+    # lines costs ~300 us, a plan of 1000 applets 2/3 of the coordinator's time. The sed makes
+    # the registration happen once per process. fastddsgen also writes the files of every IDL
+    # it includes: it runs in a folder of its own per IDL, and only this IDL's files are copied
+    # out (else the run for perception.idl overwrote cue_header.cxx after its sed, and two runs
+    # at once wrote the same files).
+    set(own ${out}/.fastddsgen/${stem})
+    set(own_files ${own}/${stem}.h ${own}/${stem}.cxx ${own}/${stem}PubSubTypes.h
+                  ${own}/${stem}PubSubTypes.cxx ${own}/${stem}TypeObject.h
+                  ${own}/${stem}TypeObject.cxx)
     add_custom_command(
       OUTPUT ${generated}
+      COMMAND ${CMAKE_COMMAND} -E rm -rf ${own}
+      COMMAND ${CMAKE_COMMAND} -E make_directory ${own}
       # Its progress lines go to a log beside the output, shown only if it fails. Its
-      # preprocessed copy of the IDL goes to the output folder (-t): in the shared temporary
+      # preprocessed copy of the IDL goes to its own folder (-t): in the shared temporary
       # folder, two builds on one machine overwrote each other's copy of a file of the same name
       # and one generated a header without types.
       COMMAND sh -c "\"$0\" \"$@\" > \"${out}/${stem}.fastddsgen.log\" 2>&1 || { cat \"${out}/${stem}.fastddsgen.log\" >&2; exit 1; }"
-              ${OSCAR_FASTDDSGEN} -typeobject -replace -I ${idl_dir} ${include_flags} -d ${out} -t ${out}
+              ${OSCAR_FASTDDSGEN} -typeobject -replace -I ${idl_dir} ${include_flags} -d ${own} -t ${own}
               ${abs}
       COMMAND sed -i
         "s/^\\([ ]*\\)register\\([A-Za-z0-9_]*\\)Types();$/\\1static const bool oscar_registered = (register\\2Types(), true); (void)oscar_registered;/"
-        ${out}/${stem}.cxx
+        ${own}/${stem}.cxx
+      COMMAND ${CMAKE_COMMAND} -E copy ${own_files} ${out}
       DEPENDS ${A_IDL}
       COMMENT "fastddsgen ${stem}.idl"
       VERBATIM)
