@@ -178,8 +178,11 @@ void Scheduler::revoke_unavailable() {
 void Scheduler::replan() {
   plan_context_.now = now_;
   plan_context_.context_switch = options_.context_switch;
+  const auto started = std::chrono::steady_clock::now();
   Plan next =
       calculate_assignments(model_, state_, plan_.order, plan_.bundle_granted, plan_context_);
+  last_plan_time_ = std::chrono::duration_cast<std::chrono::nanoseconds>(
+      std::chrono::steady_clock::now() - started);
   ++plans_;
   for (const auto& pair : next.deadline_overlaps) {
     if (std::binary_search(plan_.deadline_overlaps.begin(), plan_.deadline_overlaps.end(), pair)) {

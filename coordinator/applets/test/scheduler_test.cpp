@@ -59,6 +59,16 @@ TEST(Scheduler, SameExclusiveServiceInTwoRequestedBundlesOfOneAppletIsRejected) 
   EXPECT_TRUE(s.requested(b2));
 }
 
+// The coordinator publishes it with every plan (AppletPlan.plan_us).
+TEST(Scheduler, KnowsHowLongItsLastPlanTookAndHowManyItMade) {
+  TwoApplets t;
+  Scheduler s(t.m);  // plans once: nothing requested
+  EXPECT_EQ(s.plans_computed(), 1u);
+  s.request(t.low);
+  EXPECT_EQ(s.plans_computed(), 2u);
+  EXPECT_GT(s.last_plan_time().count(), 0);
+}
+
 TEST(Scheduler, TriggerOfAnUnrequestedBundleIsRejected) {
   TwoApplets t;
   Scheduler s(t.m);

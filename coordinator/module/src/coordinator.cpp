@@ -205,6 +205,7 @@ Coordinator::Snapshot Coordinator::snapshot() {
       plan.services().push_back(std::move(p));
     }
     plan.plans(s.plans_computed());
+    plan.plan_us(std::chrono::duration<double, std::micro>(s.last_plan_time()).count());
   });
   for (std::size_t id = 0; id < holding.size(); ++id) {
     AppletEntry e;

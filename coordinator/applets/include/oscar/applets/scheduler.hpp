@@ -157,6 +157,8 @@ class Scheduler {
   std::vector<Notification> take_notifications();
   /// Number of plans computed so far.
   std::uint64_t plans_computed() const { return plans_; }
+  /// How long the last plan took to compute (wall time of calculate_assignments).
+  std::chrono::nanoseconds last_plan_time() const { return last_plan_time_; }
 
  private:
   /// One use of a service that granting a bundle brings along (its own resources and, down the
@@ -203,6 +205,7 @@ class Scheduler {
   PlanContext plan_context_;               // unavailable: per service
   std::vector<Notification> notifications_;
   std::uint64_t plans_ = 0;
+  std::chrono::nanoseconds last_plan_time_{0};
   mutable std::vector<std::optional<std::vector<FootUse>>> footprint_cache_;  // sorted by service
   mutable std::vector<std::optional<std::vector<ServiceId>>> services_cache_;
   mutable std::vector<std::optional<std::vector<ServiceId>>> own_cache_;  // sorted
