@@ -6,7 +6,8 @@
 // granted: the main menu of §5.3 asks for the UI with high priority to be sure to get it, then
 // takes the priority of the other applets. With `auto_yield: false` it keeps a bundle whose
 // revocation is requested until an event tells it to yield or negotiate (or the wait limit
-// passes): the applets of a scenario with `runner: {auto_yield: false}`.
+// passes): the applets of a scenario with `runner: {auto_yield: false}`. `period_ms` sets its
+// loop's period (default 20): many idle applets of a benchmark wake seldom.
 #include <spdlog/spdlog.h>
 #include <oscar/applets/config.hpp>
 #include <oscar/coordinator/applet.hpp>
@@ -28,6 +29,16 @@ class EventApplet final : public oscar::coordinator::Applet {
                                   "': auto_yield must be true or false, not '" + yield + "'");
     }
     auto_yield_ = yield == "true";
+    const auto period = setup.param("period_ms", "20");
+    try {
+      std::size_t used = 0;
+      period_ = std::chrono::milliseconds(std::stoi(period, &used));
+      if (used != period.size() || period_.count() < 1) throw std::invalid_argument("");
+    } catch (const std::exception&) {
+      throw std::invalid_argument("applet '" + name() +
+                                  "': period_ms must be a whole number of ms >= 1, not '" + period +
+                                  "'");
+    }
     const auto level = setup.param("settle_priority", "");
     if (!level.empty()) {
       try {
@@ -62,10 +73,11 @@ class EventApplet final : public oscar::coordinator::Applet {
     }
   }
 
-  std::chrono::milliseconds period() const override { return std::chrono::milliseconds(20); }
+  std::chrono::milliseconds period() const override { return period_; }
 
  private:
   bool auto_yield_ = true;
+  std::chrono::milliseconds period_{20};
   std::optional<int> settle_;
   std::set<std::string> settled_;  // bundles whose priority it has settled
 };

@@ -83,6 +83,23 @@ TEST(Applet, AnEventAppletsSettlePriorityMustBeAPriority) {
   }
 }
 
+TEST(Applet, AnEventAppletsPeriodIsAWholeNumberOfMilliseconds) {
+  RecordingGateway gateway;
+  AppletSetup good("Idle", {{"period_ms", "1000"}}, gateway);
+  EXPECT_EQ(make_applet("event_applet", good, {})->period(), std::chrono::milliseconds(1000));
+  for (const char* bad : {"0", "-5", "1.5", "fast", ""}) {
+    AppletSetup setup("Idle", {{"period_ms", bad}}, gateway);
+    try {
+      make_applet("event_applet", setup, {});
+      FAIL() << "no error for '" << bad << "'";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_THAT(e.what(), HasSubstr(std::string("applet 'Idle': period_ms must be a whole "
+                                                  "number of ms >= 1, not '") +
+                                      bad + "'"));
+    }
+  }
+}
+
 TEST(Applet, AnUnknownTypeIsAnErrorNamingTheFoldersAndTheKnownTypes) {
   RecordingGateway gateway;
   AppletSetup setup("e", {}, gateway);
