@@ -1,10 +1,12 @@
 // oscar-bench-applets [--json] [--duration-s S] [--reassignments N] [--max-resources N]
 //                     [--plan-only]
+// oscar-bench-applets --live [--json] [--grants N] [--applets N ...]
 // 1. The stress test of seed 000 §5.2.2: applets in threads do random things (request, trigger,
 //    use, release, change priority) until N reassignments happened or S seconds passed; prints
 //    the waiting time for a resource and the scheduling overhead beyond the applets' own cycles.
 // 2. The time of one plan (calculateAssignments) for 10 ... 100 000 resources: the thread's CPU
 //    time (user and system), and the wall time beside it in the text output.
+// 3. --live: grants and preemptions across processes on a booted system (live_bench.cpp).
 // A benchmark, not a test: it prints figures and never fails on time.
 #include <time.h>
 #include <CLI/CLI.hpp>
@@ -20,6 +22,7 @@
 #include <oscar/command_line.hpp>
 #include <random>
 
+#include "live_bench.hpp"
 #include "oscar/applets/runtime.hpp"
 
 using namespace oscar::applets;
@@ -185,16 +188,40 @@ int main(int argc, char** argv) {
   int period_ms = 10;
   unsigned seed = 1;
   bool plan_only = false;
+  bool live = false;
+  oscar::bench::LiveBenchOptions live_options;
   app.add_flag("--json", json, "Print JSON");
+  app.add_flag("--live", live,
+               "Grants and preemptions on a booted system, applets in processes of their own");
+  app.add_option("--grants", live_options.grants, "--live: grants (and preemptions) per run");
+  app.add_option("--applets", live_options.applets,
+                 "--live: applets in the plan, one run each (default 10 100 1000); "
+                 "else: applets in the stress test (default 24)");
   app.add_flag("--plan-only", plan_only, "Only the plan times (no stress test)");
   app.add_option("--duration-s", duration_s, "Longest stress-test time in seconds");
   app.add_option("--reassignments", target, "Stop the stress test after this many");
   app.add_option("--max-resources", max_resources, "Largest plan size (10, 100, ... up to it)");
-  app.add_option("--applets", applets, "Applets in the stress test");
   app.add_option("--services", services, "Services in the stress test (>= 3)");
   app.add_option("--seed", seed, "Random seed");
   app.add_option("--period-ms", period_ms, "Shortest applet cycle; cycles are 1-3 times it");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
+  if (live) {
+#ifdef OSCAR_BENCH_APPLETS_LIVE
+    live_options.json = json;
+    return oscar::bench::run_live_bench(live_options);
+#else
+    std::cerr << "oscar bench applets: --live needs a build with the framework "
+                 "(OSCAR_WITH_FRAMEWORK)\n";
+    return 2;
+#endif
+  }
+  if (app.count("--applets") > 0) {
+    if (live_options.applets.size() != 1) {
+      std::cerr << "oscar bench applets: --applets takes one number without --live\n";
+      return 2;
+    }
+    applets = live_options.applets.front();
+  }
   if (services < 3 || applets < 2 || period_ms < 1) {
     std::cerr << "oscar bench applets: needs --services >= 3, --applets >= 2, --period-ms >= 1\n";
     return 2;
