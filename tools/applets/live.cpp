@@ -203,18 +203,6 @@ class TempDir {
   fs::path path_;
 };
 
-// The programs (oscar-boot, oscar-coordinator, oscar-applet, ...) are beside this one, unless
-// $OSCAR_BIN_DIR says otherwise.
-void find_programs() {
-  const char* dir = std::getenv("OSCAR_BIN_DIR");
-  if (dir && *dir) return;
-  std::error_code ec;
-  const auto self = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec && fs::exists(self.parent_path() / "oscar-boot")) {
-    setenv("OSCAR_BIN_DIR", self.parent_path().c_str(), 1);
-  }
-}
-
 const ServicePlan* find(const AppletPlan& plan, const std::string& service) {
   for (const auto& s : plan.services()) {
     if (s.name() == service) return &s;
@@ -336,7 +324,7 @@ std::vector<applets::StepResult> run_live(const applets::Scenario& scenario,
   const auto system_file = (dir.path() / (system_name + ".yaml")).string();
   std::ofstream(system_file) << yaml;
   SystemSpec::load(system_file);  // what boot checks, before anything starts
-  find_programs();
+  testing::use_programs_beside_this_one();
 
   std::size_t modules = 0;
   for (const auto& s : m.services()) modules += s.provider ? 0 : 1;

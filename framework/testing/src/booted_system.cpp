@@ -475,4 +475,13 @@ void BootedSystem::TearDown() {
   system_.reset();
 }
 
+void use_programs_beside_this_one() {
+  if (const char* dir = std::getenv("OSCAR_BIN_DIR"); dir && *dir) return;
+  std::error_code ec;
+  const auto self = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec && fs::exists(self.parent_path() / "oscar-boot")) {
+    setenv("OSCAR_BIN_DIR", self.parent_path().c_str(), 1);
+  }
+}
+
 }  // namespace oscar::testing

@@ -197,17 +197,6 @@ struct Run {
   std::size_t plans = 0;
 };
 
-// The programs (oscar-boot, oscar-coordinator, oscar-applet, ...) are beside this one.
-void find_programs() {
-  const char* dir = std::getenv("OSCAR_BIN_DIR");
-  if (dir && *dir) return;
-  std::error_code ec;
-  const auto self = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec && fs::exists(self.parent_path() / "oscar-boot")) {
-    setenv("OSCAR_BIN_DIR", self.parent_path().c_str(), 1);
-  }
-}
-
 Run measure(int applets, int grants) {
   const auto dir = fs::temp_directory_path() / fmt::format("oscar-bench-applets-{}", getpid());
   fs::create_directories(dir);
@@ -307,7 +296,7 @@ int run_live_bench(const LiveBenchOptions& options) {
       return 2;
     }
   }
-  find_programs();
+  testing::use_programs_beside_this_one();
   std::vector<Run> runs;
   for (const int n : options.applets) runs.push_back(measure(n, options.grants));
   if (options.json) {

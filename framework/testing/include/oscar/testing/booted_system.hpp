@@ -35,6 +35,11 @@ class RegistryClient;
 
 namespace oscar::testing {
 
+/// Points $OSCAR_BIN_DIR at the folder of the running program if it is unset and that folder
+/// holds oscar-boot: a tool or benchmark built beside the other programs boots systems with
+/// them, not with whatever PATH finds.
+void use_programs_beside_this_one();
+
 /// A DDS domain that no system booted on this machine uses and no other test holds, reserved
 /// for as long as the object lives (a lock file in $OSCAR_TEST_DOMAINS_DIR, default
 /// /tmp/oscar/test-domains, that the kernel releases when the process ends, however it ends).
