@@ -200,6 +200,13 @@ struct Run {
 Run measure(int applets, int grants) {
   const auto dir = fs::temp_directory_path() / fmt::format("oscar-bench-applets-{}", getpid());
   fs::create_directories(dir);
+  struct RemovedAtTheEnd {  // however the run ends; after the system's shutdown
+    fs::path dir;
+    ~RemovedAtTheEnd() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  } removed{dir};
   const auto file = (dir / "system.yaml").string();
   std::ofstream(file) << system_yaml(applets);
   std::fprintf(stderr, "oscar bench applets --live: booting a system with %d applets...\n",
@@ -234,8 +241,10 @@ Run measure(int applets, int grants) {
     if (!r.ok()) throw std::runtime_error(fmt::format("{} {}: {}", applet, what, r.error()));
   };
   std::vector<double> grant, preempt;
-  plans->record();
-  for (int i = 0; i < grants; ++i) {
+  // Round -1 warms up (the first activation and commands after boot are slower) and is not
+  // counted.
+  for (int i = -1; i < grants; ++i) {
+    if (i == 0) plans->record();
     auto t0 = Clock::now();
     event("low", "request");
     grant.push_back(
@@ -258,7 +267,10 @@ Run measure(int applets, int grants) {
     event("low", "release");
     replies->first(
         t0, [](const auto& r) { return runs(r, "deactivated"); }, "deactivate");
-    if ((i + 1) % 100 == 0 || i + 1 == grants) {
+    if (i < 0) {
+      grant.clear();
+      preempt.clear();
+    } else if ((i + 1) % 100 == 0 || i + 1 == grants) {
       std::fprintf(stderr, "oscar bench applets --live: %d applets: %d of %d grants\n", applets,
                    i + 1, grants);
     }
@@ -277,8 +289,6 @@ Run measure(int applets, int grants) {
   plans.reset();
   replies.reset();
   sys.shut_down();
-  std::error_code ec;
-  fs::remove_all(dir, ec);
   return run;
 }
 
@@ -298,7 +308,13 @@ int run_live_bench(const LiveBenchOptions& options) {
   }
   testing::use_programs_beside_this_one();
   std::vector<Run> runs;
-  for (const int n : options.applets) runs.push_back(measure(n, options.grants));
+  try {
+    for (const int n : options.applets) runs.push_back(measure(n, options.grants));
+  } catch (const std::exception& e) {
+    // Caught here, so that the booted system is shut down on the way (nothing left behind).
+    std::cerr << "oscar bench applets --live: " << e.what() << "\n";
+    return 1;
+  }
   if (options.json) {
     nlohmann::ordered_json j;
     j["grant_ms_p50"] = runs.front().grant_p50;
