@@ -59,7 +59,6 @@ class FrameModeSwitcher final : public oscar::coordinator::Applet {
     if (n.kind == oscar::applets::Notification::Kind::kGranted && bundle_name(n) == bundle_) {
       current_.reset();  // granted anew (perhaps given back and granted again since its last step)
       last_.reset();
-      granted_ = true;
       step(ctx);
     }
     return false;  // the rest as by default: a revocation is yielded at once
