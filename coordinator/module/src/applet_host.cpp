@@ -331,7 +331,7 @@ AppletHost::Impl::Impl(const SystemSpec& system, DdsParticipant& participant,
     h->id = config_.model.applet_id(name);
     h->fail_stop = config_.model.applet(h->id).fail_stop;
     h->session = internal::fresh_id();
-    AppletSetup setup(name, config_.applet_params[name], *this);
+    AppletSetup setup(name, config_.applet_params[name], *this, &participant);
     try {
       h->applet = make_applet(spec->type, setup, plugin_path);
     } catch (const std::exception& e) {

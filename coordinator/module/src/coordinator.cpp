@@ -49,7 +49,7 @@ Coordinator::Coordinator(const SystemSpec& system, DdsParticipant& participant,
   if (system.coordinator) {
     for (const auto& a : system.coordinator->applets) {
       if (a.remote()) continue;  // made and run in its own process
-      AppletSetup setup(a.name, config_.applet_params[a.name], *this);
+      AppletSetup setup(a.name, config_.applet_params[a.name], *this, &participant);
       try {
         applets_.at(config_.model.applet_id(a.name)) = make_applet(a.type, setup, plugin_path);
       } catch (const std::exception& e) {

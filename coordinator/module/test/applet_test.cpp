@@ -1,9 +1,15 @@
 // The applet API: registration, making applets by type, the system file's applet system.
 #include "oscar/coordinator/applet.hpp"
 
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <oscar/command_types.hpp>
+#include <oscar/cue_types.hpp>
 
 #include "oscar/coordinator/applet_system.hpp"
 
@@ -97,6 +103,61 @@ TEST(Applet, AnEventAppletsPeriodIsAWholeNumberOfMilliseconds) {
                                                   "number of ms >= 1, not '") +
                                       bad + "'"));
     }
+  }
+}
+
+// Reads the cues of "probe/out" from init() on.
+class Watcher final : public Applet {
+ public:
+  explicit Watcher(AppletSetup& setup) : Applet(setup) {}
+  void init(applets::AppletContext&) override {}
+  void step(applets::AppletContext&) override {}
+  const CueFeed<Bool>& watch() { return cues<Bool>("probe/out"); }
+};
+
+TEST(Applet, ReadsTheNewestCueOfAModulesOutput) {
+  RecordingGateway gateway;
+  DdsParticipant participant(150 + getpid() % 50, "test:applet-cues");
+  AppletSetup setup("w", {}, gateway, &participant);
+  Watcher watcher(setup);
+  const auto& feed = watcher.watch();
+  EXPECT_EQ(feed.address(), "probe/out");
+  EXPECT_FALSE(feed.latest());
+
+  // The producer's side as a kernel's output writes it: reliable, with history.
+  TopicWriter<Bool, BoolPubSubType> producer(
+      participant, topics::cue("probe/out"),
+      qos::cue_writer(OutputOptions{.depth = 4, .reliable = true, .transient_local = true}));
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  for (bool value = false; feed.received() < 3 && std::chrono::steady_clock::now() < deadline;
+       value = !value) {
+    Bool cue;
+    cue.value(value);
+    producer.write(cue);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_GE(feed.received(), 3u) << "the applet's feed got no cues";
+  const auto before = feed.received();
+  Bool last;
+  last.value(true);
+  last.header().seq(4711);
+  producer.write(last);
+  while (feed.received() == before && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_TRUE(feed.latest());
+  EXPECT_EQ(feed.latest()->header().seq(), 4711u);
+}
+
+TEST(Applet, ReadingCuesWhereItDoesNotRunIsAnError) {
+  RecordingGateway gateway;
+  AppletSetup setup("w", {}, gateway);  // as boot makes applets to check them
+  Watcher watcher(setup);
+  try {
+    watcher.watch();
+    FAIL() << "no error";
+  } catch (const std::logic_error& e) {
+    EXPECT_THAT(e.what(), HasSubstr("applet 'w' reads cues of 'probe/out' where it does not run"));
   }
 }
 

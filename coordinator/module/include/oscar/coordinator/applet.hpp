@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -16,6 +17,7 @@
 #include <oscar/config.h>
 
 #include "oscar/applets/applet_context.hpp"
+#include "oscar/coordinator/cue_feed.hpp"
 #include "oscar/idl_type_info.hpp"
 
 namespace oscar::coordinator {
@@ -40,11 +42,16 @@ class AppletGateway {
   virtual std::string bundle_name(applets::BundleId bundle) const = 0;
 };
 
-/// What an applet's constructor gets: its name, its params from the system file, the gateway.
+/// What an applet's constructor gets: its name, its params from the system file, the gateway,
+/// and the participant its cue feeds read from (none where applets are only made to be checked).
 class AppletSetup {
  public:
-  AppletSetup(std::string name, std::map<std::string, std::string> params, AppletGateway& gateway)
-      : name_(std::move(name)), params_(std::move(params)), gateway_(gateway) {}
+  AppletSetup(std::string name, std::map<std::string, std::string> params, AppletGateway& gateway,
+              DdsParticipant* participant = nullptr)
+      : name_(std::move(name)),
+        params_(std::move(params)),
+        gateway_(gateway),
+        participant_(participant) {}
   const std::string& name() const { return name_; }
   /// The `params:` of the applet, as text.
   const std::map<std::string, std::string>& params() const { return params_; }
@@ -54,11 +61,13 @@ class AppletSetup {
     return it == params_.end() ? fallback : it->second;
   }
   AppletGateway& gateway() const { return gateway_; }
+  DdsParticipant* participant() const { return participant_; }
 
  private:
   std::string name_;
   std::map<std::string, std::string> params_;
   AppletGateway& gateway_;
+  DdsParticipant* participant_;
 };
 
 /// The base of every applet (seed 000 §4.1, Abb. 4.12). The constructor only reads its params;
@@ -66,7 +75,8 @@ class AppletSetup {
 /// run between steps. An applet whose code throws loses its bundles and nothing else.
 class Applet {
  public:
-  explicit Applet(AppletSetup& setup) : name_(setup.name()), gateway_(setup.gateway()) {}
+  explicit Applet(AppletSetup& setup)
+      : name_(setup.name()), gateway_(setup.gateway()), participant_(setup.participant()) {}
   virtual ~Applet() = default;
   Applet(const Applet&) = delete;
   Applet& operator=(const Applet&) = delete;
@@ -108,10 +118,28 @@ class Applet {
   std::string bundle_name(const applets::Notification& n) const {
     return gateway_.bundle_name(n.bundle);
   }
+  /// Starts reading the cues of output `address` ("kernel/channel") of any module: the feed
+  /// holds the newest (CueFeed). Call it in init() (the constructor only reads params); the
+  /// applet owns the feed until it is destroyed. Reading needs no service: cues are for anyone.
+  /// @throws std::logic_error where the applet has no participant (made only to be checked).
+  template <CueType T>
+  const CueFeed<T>& cues(const std::string& address) {
+    if (!participant_) {
+      throw std::logic_error(
+          "applet '" + name_ + "' reads cues of '" + address +
+          "' where it does not run (call cues() in init(), not the constructor)");
+    }
+    auto feed = std::make_unique<CueFeed<T>>(*participant_, address);
+    const auto& ref = *feed;
+    feeds_.push_back(std::move(feed));
+    return ref;
+  }
 
  private:
   std::string name_;
   AppletGateway& gateway_;
+  DdsParticipant* participant_;
+  std::vector<std::unique_ptr<CueFeedBase>> feeds_;
 };
 
 namespace internal {
