@@ -127,6 +127,38 @@ int parse_priority(const YAML::Node& node, const std::string& file) {
   return static_cast<int>(p);
 }
 
+namespace {
+// A bundle's `deadline: {early_ms, duration_ms, finish_ms}`, counted from each request; checked
+// with the context switch (eq. 4.9) here, with its line, rather than at the request.
+void set_request_deadline(SystemConfig& c, BundleId bundle, const YAML::Node& node,
+                          const std::string& file, const std::string& who) {
+  if (!node.IsMap()) {
+    fail_at(node, file,
+            who + ": deadline must be a map such as {early_ms: 0, duration_ms: 500, "
+                  "finish_ms: 2000} (counted from each request)");
+  }
+  allow_keys(node, file, "deadline", {"early_ms", "duration_ms", "finish_ms"});
+  if (!node["finish_ms"]) fail_at(node, file, who + ": deadline needs finish_ms");
+  auto ms_of = [&](const char* key) {
+    return node[key] ? milliseconds{number(node[key], file, key)} : milliseconds{0};
+  };
+  Deadline d{ms_of("early_ms"), ms_of("duration_ms"), ms_of("finish_ms")};
+  try {
+    if (d.t_early + d.t_duration + c.options.context_switch > d.t_finish) {
+      throw std::invalid_argument(
+          who + ": deadline needs early_ms + duration_ms + context_switch_ms <= finish_ms (eq. 4.9), "
+                "but " + std::to_string(d.t_early.count()) + " + " +
+          std::to_string(d.t_duration.count()) + " + " +
+          std::to_string(c.options.context_switch.count()) + " > " +
+          std::to_string(d.t_finish.count()));
+    }
+    c.model.set_request_deadline(bundle, d);
+  } catch (const std::invalid_argument& e) {
+    fail_at(node, file, e.what());
+  }
+}
+}  // namespace
+
 SystemConfig load_system(const YAML::Node& root, const std::string& file) {
   SystemConfig c;
   if (!root || !root.IsMap()) fail_at(root, file, "the document must be a mapping");
@@ -222,7 +254,7 @@ SystemConfig load_system(const YAML::Node& root, const std::string& file) {
       }
     }
     for (const auto& b : a["bundles"]) {
-      allow_keys(b, file, "bundle", {"name", "priority", "resources", "requested"});
+      allow_keys(b, file, "bundle", {"name", "priority", "resources", "requested", "deadline"});
       const std::string bname = text(b["name"], file, "bundle name");
       const std::string who = "applet '" + name + "' bundle '" + bname + "'";
       std::vector<std::pair<ServiceId, Access>> resources;
@@ -238,6 +270,7 @@ SystemConfig load_system(const YAML::Node& root, const std::string& file) {
       const bool requested = flag(b["requested"], file, "requested");
       try {
         const BundleId bid = c.model.add_bundle(id, bname, resources, prio);
+        if (const auto d = b["deadline"]) set_request_deadline(c, bid, d, file, who);
         if (requested) {
           c.requested_at_start.push_back(bid);
           requested_at.push_back(b);

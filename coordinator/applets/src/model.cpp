@@ -67,6 +67,21 @@ void Model::provide(AppletId applet, ServiceId service) {
   invalidate();
 }
 
+void Model::set_request_deadline(BundleId bundle, Deadline d) {
+  Bundle& b = bundles_.at(bundle);
+  const std::string who =
+      "applet '" + applets_.at(b.applet).name + "' bundle '" + b.name + "': deadline ";
+  if (d.t_early.count() < 0 || d.t_duration.count() < 0) {
+    fail(who + "times are counted from the request and cannot be negative");
+  }
+  if (d.t_early + d.t_duration > d.t_finish) {
+    fail(who + "needs early + duration <= finish (eq. 4.9), but " +
+         std::to_string(d.t_early.count()) + " ms + " + std::to_string(d.t_duration.count()) +
+         " ms > " + std::to_string(d.t_finish.count()) + " ms");
+  }
+  b.request_deadline = d;
+}
+
 BundleId Model::add_bundle(AppletId applet, std::string name,
                            const std::vector<std::pair<ServiceId, Access>>& resources,
                            int priority) {
@@ -89,7 +104,7 @@ BundleId Model::add_bundle(AppletId applet, std::string name,
     }
   }
   const auto id = static_cast<BundleId>(bundles_.size());
-  Bundle b{applet, std::move(name), {}, priority};
+  Bundle b{applet, std::move(name), {}, priority, std::nullopt};
   for (const auto& [service, access] : resources) {
     const auto rid = static_cast<ResourceId>(resources_.size());
     resources_.push_back(Resource{applet, service, access, id});

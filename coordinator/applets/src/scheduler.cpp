@@ -69,6 +69,11 @@ void Scheduler::request(BundleId bundle) {
          model_.bundle(bundle).name + "' but it crashed; a crashed applet requests nothing");
   }
   check_bundle(bundle);
+  if (const auto& d = model_.bundle(bundle).request_deadline) {
+    const Deadline from_now{now_ + d->t_early, d->t_duration, now_ + d->t_finish};
+    check_deadline(bundle, from_now);
+    state_[bundle].deadline = from_now;
+  }
   state_[bundle].requested = true;
   replan();
 }
@@ -100,22 +105,23 @@ void Scheduler::set_priority(BundleId bundle, int priority) {
   replan();
 }
 
-void Scheduler::set_deadline(BundleId bundle, std::optional<Deadline> deadline) {
-  if (deadline) {
-    const Deadline& d = *deadline;
-    const milliseconds c = options_.context_switch;
-    const std::string who = "applet '" + model_.applet(model_.bundle(bundle).applet).name +
-                            "' bundle '" + model_.bundle(bundle).name + "': deadline ";
-    if (d.t_duration.count() < 0) fail(who + "t_duration " + ms(d.t_duration) + " is negative");
-    if (d.t_early + d.t_duration + c > d.t_finish) {
-      fail(who + "needs t_early + t_duration + c <= t_finish (eq. 4.9), but " + ms(d.t_early) +
-           " + " + ms(d.t_duration) + " + " + ms(c) + " > " + ms(d.t_finish));
-    }
-    if (now_ + d.t_duration + c > d.t_finish) {
-      fail(who + "needs now + t_duration + c <= t_finish (eq. 4.10), but " + ms(now_) + " + " +
-           ms(d.t_duration) + " + " + ms(c) + " > " + ms(d.t_finish));
-    }
+void Scheduler::check_deadline(BundleId bundle, const Deadline& d) const {
+  const milliseconds c = options_.context_switch;
+  const std::string who = "applet '" + model_.applet(model_.bundle(bundle).applet).name +
+                          "' bundle '" + model_.bundle(bundle).name + "': deadline ";
+  if (d.t_duration.count() < 0) fail(who + "t_duration " + ms(d.t_duration) + " is negative");
+  if (d.t_early + d.t_duration + c > d.t_finish) {
+    fail(who + "needs t_early + t_duration + c <= t_finish (eq. 4.9), but " + ms(d.t_early) +
+         " + " + ms(d.t_duration) + " + " + ms(c) + " > " + ms(d.t_finish));
   }
+  if (now_ + d.t_duration + c > d.t_finish) {
+    fail(who + "needs now + t_duration + c <= t_finish (eq. 4.10), but " + ms(now_) + " + " +
+         ms(d.t_duration) + " + " + ms(c) + " > " + ms(d.t_finish));
+  }
+}
+
+void Scheduler::set_deadline(BundleId bundle, std::optional<Deadline> deadline) {
+  if (deadline) check_deadline(bundle, *deadline);
   state_.at(bundle).deadline = deadline;
   replan();
 }

@@ -44,6 +44,35 @@ timeline: []
   EXPECT_EQ(c.requested_at_start, std::vector<BundleId>{0});
 }
 
+TEST(Config, ABundlesDeadlineCountsFromEachRequestAndIsCheckedWithItsLine) {
+  const auto s = Scenario::parse(R"(
+services: [ {name: Pilot} ]
+applets:
+  - name: Cal
+    bundles: [{name: drive, deadline: {early_ms: 5000, duration_ms: 1000, finish_ms: 6000},
+               resources: [{service: Pilot}]}]
+timeline: []
+)",
+                                 "sys.yaml");
+  const auto& d = s.system().model.bundle(0).request_deadline;
+  ASSERT_TRUE(d);
+  EXPECT_EQ(d->t_early, milliseconds{5000});
+  EXPECT_EQ(d->t_duration, milliseconds{1000});
+  EXPECT_EQ(d->t_finish, milliseconds{6000});
+
+  const std::string head =
+      "scheduler: {context_switch_ms: 100}\nservices: [ {name: P} ]\napplets:\n  - name: A\n"
+      "    bundles: [{name: b, resources: [{service: P}], deadline: ";
+  EXPECT_THAT(error_of(head + "{early_ms: 0, duration_ms: 950, finish_ms: 1000}}]\ntimeline: []\n"),
+              HasSubstr("sys.yaml:5: applet 'A' bundle 'b': deadline needs early_ms + duration_ms "
+                        "+ context_switch_ms <= finish_ms (eq. 4.9), but 0 + 950 + 100 > 1000"));
+  EXPECT_THAT(error_of(head + "{early_ms: 0}}]\ntimeline: []\n"),
+              HasSubstr("sys.yaml:5: applet 'A' bundle 'b': deadline needs finish_ms"));
+  EXPECT_THAT(error_of(head + "{finish: 10}}]\ntimeline: []\n"), HasSubstr("finish"));
+  EXPECT_THAT(error_of(head + "5000}]\ntimeline: []\n"),
+              HasSubstr("deadline must be a map such as {early_ms: 0"));
+}
+
 // The long form of a dependency used to throw yaml-cpp's "operator[] call on a scalar": reading
 // its service rewrote the entry it came from.
 TEST(Config, ADependencysLongFormGivesItsServiceAndAccess) {

@@ -43,6 +43,51 @@ TEST(Scheduler, InvalidDeadlinesNameTheInequality) {
       HasSubstr("bundle 's': deadline t_duration -1 ms is negative"));
 }
 
+// A bundle configured with `deadline:` is a reservation for later at every request: early 5 s
+// means 5 s after that request, and the request expires at finish.
+TEST(Scheduler, AConfiguredDeadlineCountsFromEachRequest) {
+  TwoApplets t;
+  t.m.set_request_deadline(t.low,
+                           Deadline{milliseconds{5000}, milliseconds{1000}, milliseconds{6500}});
+  Scheduler s(t.m);
+  s.advance_to(milliseconds{1000});
+  s.request(t.low);
+  EXPECT_FALSE(s.active(t.low)) << "granted before early";
+  s.advance_to(milliseconds{5999});
+  EXPECT_FALSE(s.active(t.low));
+  s.advance_to(milliseconds{6000});
+  EXPECT_TRUE(s.active(t.low));
+  s.take_notifications();
+  s.advance_to(milliseconds{7501});  // finish passed: the request is withdrawn
+  EXPECT_FALSE(s.requested(t.low));
+  bool expired = false;
+  for (const auto& n : s.take_notifications()) {
+    expired = expired || (n.kind == Notification::Kind::kDeadlineExpired && n.bundle == t.low);
+  }
+  EXPECT_TRUE(expired);
+  s.advance_to(milliseconds{8000});
+  s.request(t.low);  // counted from this request
+  s.advance_to(milliseconds{12999});
+  EXPECT_FALSE(s.active(t.low));
+  s.advance_to(milliseconds{13000});
+  EXPECT_TRUE(s.active(t.low));
+}
+
+TEST(Scheduler, AConfiguredDeadlineMustFitItsWindow) {
+  TwoApplets t;
+  EXPECT_THAT(error_of([&] {
+                t.m.set_request_deadline(
+                    t.low, Deadline{milliseconds{500}, milliseconds{600}, milliseconds{1000}});
+              }),
+              HasSubstr("applet 'Low' bundle 's': deadline needs early + duration <= finish "
+                        "(eq. 4.9), but 500 ms + 600 ms > 1000 ms"));
+  EXPECT_THAT(error_of([&] {
+                t.m.set_request_deadline(
+                    t.low, Deadline{milliseconds{-1}, milliseconds{0}, milliseconds{1000}});
+              }),
+              HasSubstr("counted from the request and cannot be negative"));
+}
+
 TEST(Scheduler, SameExclusiveServiceInTwoRequestedBundlesOfOneAppletIsRejected) {
   Model m;
   const ServiceId ui = m.add_service("UI", true);

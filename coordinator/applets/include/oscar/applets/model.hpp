@@ -28,6 +28,16 @@ inline constexpr int kPriorityNormal = 200;
 inline constexpr int kPriorityHigh = 300;
 inline constexpr int kPrioritySystem = 400;
 
+/// A deadline (seed §4.5.1, eq. 4.8–4.10): earliest start, duration and latest end of an access,
+/// in the scheduler's clock.
+struct Deadline {
+  std::chrono::milliseconds t_early{0};
+  std::chrono::milliseconds t_duration{0};
+  std::chrono::milliseconds t_finish{0};
+  /// The relative deadline t_finish - t_duration (eq. 4.8): the latest start.
+  std::chrono::milliseconds relative() const { return t_finish - t_duration; }
+};
+
 /// A service a service depends on, declared in configuration (seed §4.2.3, Abb. 4.10).
 struct Dependency {
   ServiceId service = 0;
@@ -57,6 +67,9 @@ struct Bundle {
   std::string name;
   std::vector<ResourceId> resources;
   int priority = kPriorityNormal;  ///< Initial priority; the Scheduler may change it.
+  /// Configured (`deadline:`): the deadline every request of the bundle gets, with its times
+  /// counted from the request (t_early 5 s: not granted before 5 s after the request).
+  std::optional<Deadline> request_deadline;
 };
 
 /// An applet or service applet (seed §4.1).
@@ -98,6 +111,11 @@ class Model {
   BundleId add_bundle(AppletId applet, std::string name,
                       const std::vector<std::pair<ServiceId, Access>>& resources,
                       int priority = kPriorityNormal);
+
+  /// Gives every request of `bundle` a deadline counted from the request (seed §4.5.1: a
+  /// reservation for later, a window that expires). @throws std::invalid_argument if t_duration
+  /// is negative or t_early + t_duration > t_finish (eq. 4.9).
+  void set_request_deadline(BundleId bundle, Deadline deadline);
 
   /// @throws std::invalid_argument "unknown service 'X'".
   ServiceId service_id(std::string_view name) const;

@@ -12,16 +12,6 @@
 
 namespace oscar::applets {
 
-/// A deadline (seed §4.5.1, eq. 4.8–4.10): earliest start, duration and latest end of an access,
-/// in the scheduler's clock.
-struct Deadline {
-  std::chrono::milliseconds t_early{0};
-  std::chrono::milliseconds t_duration{0};
-  std::chrono::milliseconds t_finish{0};
-  /// The relative deadline t_finish - t_duration (eq. 4.8): the latest start.
-  std::chrono::milliseconds relative() const { return t_finish - t_duration; }
-};
-
 /// Dynamic state of one bundle as the plan sees it.
 struct BundleState {
   bool requested = false;

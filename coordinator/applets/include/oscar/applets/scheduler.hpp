@@ -88,7 +88,9 @@ class Scheduler {
   /// @throws std::invalid_argument if `t` lies before now().
   void advance_to(milliseconds t);
 
-  /// Asks for a bundle (again). @throws std::invalid_argument if another requested bundle of the
+  /// Asks for a bundle (again). A bundle with a configured deadline (Bundle::request_deadline)
+  /// gets it counted from now, replacing one set before.
+  /// @throws std::invalid_argument if another requested bundle of the
   /// same applet uses one of its services and either asks for exclusive access, or if the
   /// applet crashed.
   void request(BundleId bundle);
@@ -161,6 +163,8 @@ class Scheduler {
   std::chrono::nanoseconds last_plan_time() const { return last_plan_time_; }
 
  private:
+  /// Eq. 4.9 and 4.10 for `d` as `bundle`'s deadline now. @throws std::invalid_argument.
+  void check_deadline(BundleId bundle, const Deadline& d) const;
   /// One use of a service that granting a bundle brings along (its own resources and, down the
   /// hierarchy, the services' own uses). Two bundles clash on a service when they use it through
   /// different users and one of those uses is exclusive (the plan's rule, Abb. 4.21).
