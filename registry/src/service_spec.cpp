@@ -53,6 +53,20 @@ ServiceSpec::Provider provider_of(const SystemSpec& s, const YAML::Node& node,
   return p;
 }
 
+// `set: {name: value}`: parameters as text, in file order.
+ServiceSpec::Params parse_params(const std::string& file, const YAML::Node& node,
+                                 const std::string& what) {
+  if (!node.IsMap() || node.size() == 0) {
+    fail(file, node, what + ": expected a map of parameters such as {frame_mode: half}");
+  }
+  ServiceSpec::Params params;
+  for (const auto& kv : node) {
+    params.emplace_back(kv.first.as<std::string>(),
+                        text(file, kv.second, what + "." + kv.first.as<std::string>()));
+  }
+  return params;
+}
+
 void parse_granted(ServiceSpec& svc, const std::string& file, const YAML::Node& node,
                    const std::string& what) {
   if (node.IsScalar() && node.Scalar() == "nothing") return;
@@ -61,10 +75,14 @@ void parse_granted(ServiceSpec& svc, const std::string& file, const YAML::Node& 
     return;
   }
   if (!node.IsMap()) {
-    fail(file, node, what + ": expected {activate: MODE}, activate or nothing");
+    fail(file, node, what + ": expected {activate: MODE, set: {...}}, activate or nothing");
   }
-  check_yaml_keys(node, file, what, {"activate"});
-  if (!node["activate"]) fail(file, node, what + ": expected {activate: MODE}");
+  check_yaml_keys(node, file, what, {"activate", "set"});
+  if (!node["activate"] && !node["set"]) {
+    fail(file, node, what + ": expected {activate: MODE} and/or {set: {param: value}}");
+  }
+  if (node["set"]) svc.granted_params = parse_params(file, node["set"], what + ".set");
+  if (!node["activate"]) return;
   const auto mode = text(file, node["activate"], what + ".activate");
   try {
     if (ModeSpec::parse_text(mode).kind == ModeSpec::Kind::kDeactivated) {
@@ -74,6 +92,39 @@ void parse_granted(ServiceSpec& svc, const std::string& file, const YAML::Node& 
     fail(file, node["activate"], fmt::format("{}.activate: {}", what, e.what()));
   }
   svc.activate = mode;
+}
+
+void parse_idle(ServiceSpec& svc, const std::string& file, const YAML::Node& node,
+                const std::string& what) {
+  if (node.IsMap()) {
+    check_yaml_keys(node, file, what, {"set"});
+    if (!node["set"]) fail(file, node, what + ": expected {set: {param: value}}");
+    svc.idle_params = parse_params(file, node["set"], what + ".set");
+    return;
+  }
+  const auto idle = text(file, node, what);
+  if (idle != "deactivate" && idle != "keep") {
+    fail(
+        file, node,
+        fmt::format("{} '{}': expected deactivate, keep or {{set: {{param: value}}}}", what, idle));
+  }
+  svc.idle_deactivates = idle == "deactivate";
+}
+
+// Parameters belong to a kernel: a provider named by its module alone must have only one.
+void check_param_providers(const SystemSpec& s, const ServiceSpec& svc, const YAML::Node& node,
+                           const std::string& what) {
+  if (svc.granted_params.empty() && svc.idle_params.empty()) return;
+  for (const auto& p : svc.providers) {
+    if (!p.kernel.empty()) continue;
+    const auto& kernels = s.find_module(p.module)->spec.kernels;
+    if (kernels.size() != 1) {
+      fail(s.file, node,
+           fmt::format("{}: set: parameters belong to one kernel, but provider '{}' has {} "
+                       "kernels; name the kernel in provided_by ({}/{})",
+                       what, p.module, kernels.size(), p.module, kernels.front().name));
+    }
+  }
 }
 
 // A cycle of services needing each other can never be granted: no applet can break it.
@@ -172,14 +223,8 @@ void parse_services(SystemSpec& s, const YAML::Node& node) {
       svc.exclusive_only = a == "exclusive";
     }
     if (n["granted"]) parse_granted(svc, s.file, n["granted"], what + ".granted");
-    if (n["idle"]) {
-      const auto idle = text(s.file, n["idle"], what + ".idle");
-      if (idle != "deactivate" && idle != "keep") {
-        fail(s.file, n["idle"],
-             fmt::format("{}.idle '{}': expected deactivate or keep", what, idle));
-      }
-      svc.idle_deactivates = idle == "deactivate";
-    }
+    if (n["idle"]) parse_idle(svc, s.file, n["idle"], what + ".idle");
+    check_param_providers(s, svc, n, what);
     if (s.find_service(svc.name)) fail(s.file, kv.first, "duplicate service '" + svc.name + "'");
     s.services.push_back(std::move(svc));
   }

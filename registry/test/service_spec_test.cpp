@@ -152,8 +152,50 @@ TEST(ServiceSpec, BadAccessGrantedAndIdleValuesAreErrors) {
   EXPECT_THAT(error_of("services: { C: { provided_by: [cam], granted: { activate: often } } }\n"
                        "coordinator: {}\n"),
               HasSubstr("service 'C'.granted.activate: mode 'often'"));
-  EXPECT_THAT(error_of("services: { C: { provided_by: [cam], idle: sleep } }\ncoordinator: {}\n"),
-              HasSubstr("service 'C'.idle 'sleep': expected deactivate or keep"));
+  EXPECT_THAT(
+      error_of("services: { C: { provided_by: [cam], idle: sleep } }\ncoordinator: {}\n"),
+      HasSubstr("service 'C'.idle 'sleep': expected deactivate, keep or {set: {param: value}}"));
+}
+
+TEST(ServiceSpec, GrantingAndIdlingMaySetParametersOfTheProvidersKernels) {
+  const auto s = parse(
+      "services:\n"
+      "  HalfFrames:\n"
+      "    provided_by: [cam]\n"
+      "    granted: { set: { frame_mode: half, exposure: 3 } }\n"
+      "    idle: { set: { frame_mode: quarter } }\n"
+      "coordinator: {}\n");
+  const auto& svc = s.services.at(0);
+  EXPECT_FALSE(svc.activate);
+  EXPECT_EQ(svc.granted_params, (ServiceSpec::Params{{"frame_mode", "half"}, {"exposure", "3"}}));
+  EXPECT_EQ(svc.idle_params, (ServiceSpec::Params{{"frame_mode", "quarter"}}));
+  EXPECT_FALSE(svc.idle_deactivates);
+
+  EXPECT_THAT(error_of("services: { C: { provided_by: [cam], granted: { set: half } } }\n"
+                       "coordinator: {}\n"),
+              HasSubstr("service 'C'.granted.set: expected a map of parameters such as "
+                        "{frame_mode: half}"));
+  EXPECT_THAT(error_of("services: { C: { provided_by: [cam], idle: { set: {}, go: 1 } } }\n"
+                       "coordinator: {}\n"),
+              HasSubstr("go"));
+  EXPECT_THAT(error_of("services: { C: { provided_by: [cam], granted: {} } }\ncoordinator: {}\n"),
+              HasSubstr("service 'C'.granted: expected {activate: MODE} and/or {set: "));
+}
+
+TEST(ServiceSpec, SetParametersNeedOneKernelPerProvider) {
+  try {
+    SystemSpec::parse(
+        YAML::Load("system: t\nmodules: [ { name: cam, kernels: [ { type: relay, name: a },\n"
+                   "                          { type: relay, name: b } ] } ]\n"
+                   "services: { C: { provided_by: [cam], granted: { set: { x: 1 } } } }\n"
+                   "coordinator: {}\n"),
+        "s.yaml");
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("s.yaml:4: service 'C': set: parameters belong to one "
+                                    "kernel, but provider 'cam' has 2 kernels; name the kernel "
+                                    "in provided_by (cam/a)"));
+  }
 }
 
 TEST(ServiceSpec, ServicesNeedACoordinatorAndTheCoordinatorsNameIsReserved) {

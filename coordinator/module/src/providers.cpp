@@ -17,19 +17,65 @@ Providers::Providers(const SystemSpec& system, ConfigClient& client)
   }
 }
 
-std::string Providers::desired(const Target& target, const std::set<std::string>& in_use) const {
+Providers::Desired Providers::desired(const Target& target,
+                                      const std::set<std::string>& in_use) const {
+  Desired d;
   bool idle_deactivates = false;
+  bool granted = false;
   for (const auto* svc : targets_.at(target)) {
-    if (in_use.contains(svc->name)) {
-      if (svc->activate) return "activate:" + *svc->activate;
-      return "";  // in use, but granting it configures nothing: leave the module be
-    }
-    idle_deactivates = idle_deactivates || svc->idle_deactivates;
+    if (!in_use.contains(svc->name)) continue;
+    if (!granted && svc->activate) d.state = "activate:" + *svc->activate;
+    granted = true;
+    for (const auto& [name, value] : svc->granted_params) d.params.emplace(name, value);
   }
-  return idle_deactivates ? "deactivate" : "";
+  for (const auto* svc : targets_.at(target)) {
+    if (in_use.contains(svc->name)) continue;
+    idle_deactivates = idle_deactivates || svc->idle_deactivates;
+    for (const auto& [name, value] : svc->idle_params) d.params.emplace(name, value);
+  }
+  // In use, but granting configures no mode: the module's state is left be.
+  if (!granted && idle_deactivates) d.state = "deactivate";
+  return d;
 }
 
-bool Providers::send(const Target& target, const std::string& state) {
+std::string Providers::param_kernel(const Target& target) const {
+  if (target.second != "*") return target.second;
+  return system_.find_module(target.first)->spec.kernels.front().name;  // checked: only one
+}
+
+bool Providers::send_param(const Target& target, const std::string& name,
+                           const std::string& value) {
+  const auto& module = target.first;
+  const auto kernel = param_kernel(target);
+  try {
+    const auto reply = client_.send(module, CMD_SET_PARAM, {kernel, name, value}, kReplyTimeout);
+    if (!reply.ok()) {
+      spdlog::warn("coordinator: set {}={} on {}/{} refused: {}", name, value, module, kernel,
+                   reply.error());
+      return false;
+    }
+    spdlog::info("coordinator: {}/{}: set {}={}", module, kernel, name, value);
+    return true;
+  } catch (const std::exception& e) {
+    spdlog::warn("coordinator: set {}={} on {}/{}: {}", name, value, module, kernel, e.what());
+    return false;
+  }
+}
+
+bool Providers::send(const Target& target, const Desired& want, const Desired* had) {
+  // Parameters first: a kernel that is activated starts with them.
+  for (const auto& [name, value] : want.params) {
+    if (had) {
+      const auto it = had->params.find(name);
+      if (it != had->params.end() && it->second == value) continue;
+    }
+    if (!send_param(target, name, value)) return false;
+  }
+  if (want.state.empty() || (had && had->state == want.state)) return true;
+  return send_state(target, want.state);
+}
+
+bool Providers::send_state(const Target& target, const std::string& state) {
   const auto& [module, kernel] = target;
   try {
     ConfigReply reply;
@@ -45,7 +91,8 @@ bool Providers::send(const Target& target, const std::string& state) {
       spdlog::warn("coordinator: {} {}/{} refused: {}", state, module, kernel, reply.error());
       return false;
     }
-    spdlog::info("coordinator: {}/{}: {}", module, kernel, state);
+    spdlog::info("coordinator: {}/{}: {}", module, kernel,
+                 state.ends_with(':') ? state.substr(0, state.size() - 1) : state);
     return true;
   } catch (const std::exception& e) {
     spdlog::warn("coordinator: {} {}/{}: {}", state, module, kernel, e.what());
@@ -70,12 +117,14 @@ void Providers::apply(const std::set<std::string>& in_use, const std::set<std::s
       applied_.erase(target);  // configured again when it runs
       continue;
     }
-    const auto want = desired(target, in_use);
+    auto want = desired(target, in_use);
     const auto it = applied_.find(target);
     const bool restarted = it != applied_.end() && it->second.incarnation != status.incarnation;
-    if (want.empty() || (it != applied_.end() && it->second.state == want && !restarted)) continue;
+    const Desired* had = it == applied_.end() || restarted ? nullptr : &it->second.desired;
+    if (want.state.empty() && had) want.state = had->state;  // "leave it be": as it is
+    if (had ? *had == want : want == Desired{}) continue;
     if (const auto r = retry_at_.find(target); r != retry_at_.end() && now < r->second) continue;
-    if (!send(target, want)) {
+    if (!send(target, want, had)) {
       retry_at_[target] = now + kRetry;
       continue;
     }
@@ -108,9 +157,10 @@ bool Providers::ready(const std::string& service) const {
     for (const auto* svc : services) {
       if (svc->name != service) continue;
       const auto want = desired(target, in_use_);
-      if (want.empty()) continue;
+      if (want == Desired{}) continue;
       const auto it = applied_.find(target);
-      if (it == applied_.end() || it->second.state != want) return false;
+      if (it == applied_.end() || it->second.desired.params != want.params) return false;
+      if (!want.state.empty() && it->second.desired.state != want.state) return false;
     }
   }
   return true;

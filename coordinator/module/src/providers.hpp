@@ -25,7 +25,9 @@ class Providers {
 
   Providers(const SystemSpec& system, ConfigClient& client);
 
-  /// Configures every provider as `in_use` (service names) asks: activate for a granted service
+  /// Configures every provider as `in_use` (service names) asks: the parameters of `granted:
+  /// {set: ...}` of its granted services and of `idle: {set: ...}` of its idle ones (a granted
+  /// service's value wins, then the first in the file), then activate for a granted service
   /// with `granted: {activate: MODE}`, deactivate when all services of a provider are idle and
   /// one says `idle: deactivate`. A module the registry reports not running is left until it
   /// runs again; a module that runs with a new incarnation (restarted) is configured again, and
@@ -42,16 +44,26 @@ class Providers {
  private:
   using Clock = std::chrono::steady_clock;
   using Target = std::pair<std::string, std::string>;  // module, kernel ("*": all of them)
+  struct Desired {
+    std::string state;                          // "activate:<mode>", "deactivate", "": leave it
+    std::map<std::string, std::string> params;  // parameter -> value
+    bool operator==(const Desired&) const = default;
+  };
   struct Applied {
-    std::string state;  // "activate:<mode>", "deactivate"
+    Desired desired;
     unsigned long incarnation = 0;
   };
   struct Recorded {
     std::string type;
     std::vector<std::uint8_t> cdr;
   };
-  std::string desired(const Target& target, const std::set<std::string>& in_use) const;
-  bool send(const Target& target, const std::string& state);
+  Desired desired(const Target& target, const std::set<std::string>& in_use) const;
+  // Sends what `want` has and `had` (nullptr: nothing known) has not; true if all was accepted.
+  bool send(const Target& target, const Desired& want, const Desired* had);
+  bool send_state(const Target& target, const std::string& state);
+  bool send_param(const Target& target, const std::string& name, const std::string& value);
+  // The kernel a parameter of `target` goes to: its own, or the module's only one.
+  std::string param_kernel(const Target& target) const;
 
   const SystemSpec& system_;
   ConfigClient& client_;

@@ -76,7 +76,12 @@ struct ServiceSpec {
   /// (mode text such as "continuous:33ms"; empty: the kernel's configured mode).
   std::optional<std::string> activate;
   bool idle_deactivates = false;  ///< `idle: deactivate` (else `idle: keep`)
-  std::string where;              ///< "file:line"
+  using Params = std::vector<std::pair<std::string, std::string>>;  ///< name, value (as text)
+  /// `granted: {set: {name: value}}`: parameters the providers' kernels get while it is granted.
+  Params granted_params;
+  /// `idle: {set: {name: value}}`: parameters they get while nobody holds it.
+  Params idle_params;
+  std::string where;  ///< "file:line"
 };
 
 /// One applet the coordinator runs: its type (a registered applet class) and its configuration
