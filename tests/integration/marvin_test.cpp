@@ -1,0 +1,136 @@
+// Seed 004 §4.2's MARVIN mission as a live system (config/marvin-phases.yaml): the applet
+// `mission` goes from phase explore to identify when the door search sees a sign and back after
+// reading it; the plan runs exactly the modules of the phase, and granting HalfFrames switches
+// the framegrabber to half frames (its idle switches it back to quarter).
+#include <condition_variable>
+#include <fstream>
+#include <mutex>
+#include <optional>
+#include <sstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "booted_system.hpp"
+#include "oscar/coordinator/plan_json.hpp"
+#include "oscar/testing/eventually.hpp"
+#include "oscar/topic_io.hpp"
+#include "oscar/topics.hpp"
+
+namespace oscar {
+namespace {
+
+using ::testing::HasSubstr;
+
+// The shipped system file, ending after `doors` doors, reading each sign for 3 s (long enough
+// for the registry's state to show the phase).
+std::string marvin_system(int doors) {
+  std::ifstream in(std::string(OSCAR_SOURCE_DIR) + "/config/marvin-phases.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  auto yaml = text.str();
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    const auto at = yaml.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) yaml.replace(at, from.size(), to);
+  };
+  replace("doors: 0", "doors: " + std::to_string(doors));
+  replace("read_ms: 1000", "read_ms: 3000");
+  return yaml;
+}
+
+class Mission {
+ public:
+  explicit Mission(int doors)
+      : sys("marvin", marvin_system(doors)),
+        plans_(sys.participant(), topics::applet_plan(), [this](const AppletPlan& p, const auto&) {
+          std::lock_guard lock(mutex_);
+          plan_ = p;
+          changed_.notify_all();
+        }) {}
+
+  // Waits until the plan gives `mission` exactly `held` of the mission's services.
+  ::testing::AssertionResult holds(const std::set<std::string>& held) {
+    static const std::set<std::string> kServices{"WallFollowing", "DoorSearch", "DoorLocalisation",
+                                                 "HalfFrames"};
+    std::unique_lock lock(mutex_);
+    const auto matches = [&] {
+      if (!plan_) return false;
+      for (const auto& s : plan_->services()) {
+        if (!kServices.contains(s.name())) continue;
+        const bool mission = s.holders() == std::vector<std::string>{"mission"};
+        if (mission != held.contains(s.name())) return false;
+      }
+      return true;
+    };
+    if (changed_.wait_for(lock, std::chrono::seconds(30), matches)) {
+      return ::testing::AssertionSuccess();
+    }
+    return ::testing::AssertionFailure()
+           << "the plan never gave the mission what its phase needs; last: "
+           << (plan_ ? coordinator::plan_json(*plan_) : "none") << "\nboot output:\n"
+           << sys.boot_output();
+  }
+
+  // Waits until each module's kernel (named like the module) is in its mode ("deactivated" or
+  // not), and cam's frame mode is `frame_mode`.
+  void modules(const std::map<std::string, bool>& active, const std::string& frame_mode) {
+    sys.wait_for([&](const SystemState& st) {
+      for (const auto& [module, on] : active) {
+        const auto* m = test::entry(st, module);
+        const auto* k = m ? test::kernel_state(*m, module) : nullptr;
+        if (!k || (k->mode() != "deactivated") != on) return false;
+      }
+      const auto* cam = test::entry(st, "cam");
+      const auto* k = cam ? test::kernel_state(*cam, "cam") : nullptr;
+      return k && k->params().find("frame_mode: " + frame_mode) != std::string::npos;
+    });
+  }
+
+  test::BootedSystem sys;
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::optional<AppletPlan> plan_;
+  TopicReader<AppletPlan, AppletPlanPubSubType> plans_;
+};
+
+TEST(MarvinMission, EachPhaseRunsItsModulesAndSwitchesTheFramegrabbersFrameMode) {
+  Mission m(2);
+  m.sys.running();
+  // Phase explore: wall following and door search on quarter frames.
+  ASSERT_TRUE(m.holds({"WallFollowing", "DoorSearch"}));
+  m.modules({{"wall_follow", true}, {"cam", true}, {"door_search", true}, {"door_locate", false}},
+            "quarter");
+  // Phase identify: the door search saw a sign; the door is localised on half frames.
+  ASSERT_TRUE(m.holds({"DoorLocalisation", "HalfFrames"}));
+  m.modules({{"wall_follow", false}, {"cam", true}, {"door_search", false}, {"door_locate", true}},
+            "half");
+  // The next door: explore again, quarter frames again.
+  ASSERT_TRUE(m.holds({"WallFollowing", "DoorSearch"}));
+  m.modules({{"wall_follow", true}, {"door_search", true}, {"door_locate", false}}, "quarter");
+  // After the second door the mission is done: nothing held, every module deactivated. (A
+  // phase change releases one bundle and then requests the next: a plan between the two may show
+  // nothing held, so the end is taken from the mission's word.)
+  ASSERT_TRUE(m.holds({"DoorLocalisation", "HalfFrames"}));
+  ASSERT_TRUE(eventually(
+      [&] {
+        return m.sys.boot_output().find(
+                   "applet mission: phase identify -> done (all doors "
+                   "identified)") != std::string::npos;
+      },
+      std::chrono::seconds(30)))
+      << m.sys.boot_output();
+  ASSERT_TRUE(m.holds({}));
+  m.modules(
+      {{"wall_follow", false}, {"cam", false}, {"door_search", false}, {"door_locate", false}},
+      "quarter");
+  const auto log = m.sys.boot_output();
+  EXPECT_THAT(log, HasSubstr("applet mission: phase explore -> identify (door sign seen)"));
+  EXPECT_THAT(log, HasSubstr("applet mission: door 2 identified"));
+  EXPECT_THAT(log, HasSubstr("coordinator: cam/cam: set frame_mode=half"));
+}
+
+}  // namespace
+}  // namespace oscar
