@@ -42,6 +42,14 @@ KernelHarness::~KernelHarness() {
   }
 }
 
+const Wish& KernelHarness::wish(const std::string& name) const {
+  for (const auto& w : instance_->ports().wishes) {
+    if (w->name() == name) return *w;
+  }
+  throw std::invalid_argument("harness: kernel '" + instance_->name() + "' declares no wish '" +
+                              name + "'");
+}
+
 InputPort& KernelHarness::input_port(const std::string& name) {
   auto* port = instance_->ports().find_input(name);
   if (!port) {

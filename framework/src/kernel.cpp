@@ -76,6 +76,24 @@ void KernelSetup::check_port_name(const std::string& name) const {
   }
 }
 
+Wish& KernelSetup::wish(const std::string& name) {
+  if (!is_identifier(name)) {
+    throw std::invalid_argument(
+        fmt::format("kernel '{}' ({}): wish name '{}' must be an identifier (letters, digits, _)",
+                    name_, type_, name));
+  }
+  for (const auto& w : ports_.wishes) {
+    if (w->name() == name) {
+      throw std::invalid_argument(
+          fmt::format("kernel '{}' ({}): wish '{}' is declared twice; wish names are unique per "
+                      "kernel",
+                      name_, type_, name));
+    }
+  }
+  ports_.wishes.push_back(std::make_unique<Wish>(name_, name));
+  return *ports_.wishes.back();
+}
+
 void KernelSetup::check_command_name(const std::string& name) const {
   if (!is_identifier(name)) {
     throw std::invalid_argument(fmt::format(

@@ -221,6 +221,7 @@ void Module::start(int domain) {
   if (domain >= 0) {
     dds_ = std::make_unique<Dds>(*this, domain);
     dds_->wire_outputs(slots_);
+    dds_->wire_wishes(slots_);
     for (auto& s : slots_) {
       for (const auto& [input, source] : s->sources) {
         if (spec_.find_kernel(source_kernel(source))) continue;  // wired at construction
@@ -272,6 +273,7 @@ void Module::run_slot(Slot& slot, Trigger trigger, bool stub) {
     if (!slot.active) {
       slot.instance->kernel().on_activate();
       slot.active = true;
+      if (dds_) dds_->publish_wishes();  // what it still asks for counts again
     }
     call = stub ? "stub()" : "process()";
     busy_since_ns_.store(Clock::now().time_since_epoch().count(), std::memory_order_relaxed);
@@ -437,7 +439,10 @@ void Module::report(const std::string& transition) {
     last_transition_ = transition;
   }
   log_->info("{}", transition);
-  if (dds_) dds_->publish_state(state());
+  if (dds_) {
+    dds_->publish_state(state());
+    dds_->publish_wishes();  // a kernel activated or deactivated asks or withdraws its wishes
+  }
 }
 
 std::string Module::exit_reason() const {

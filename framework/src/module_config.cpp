@@ -318,6 +318,7 @@ CommandAnswer Module::deliver_command(Slot& slot, const CommandPort& port, const
       if (!slot.active) {
         slot.instance->kernel().on_activate();
         slot.active = true;
+        if (dds_) dds_->publish_wishes();
       }
       busy_since_ns_.store(std::chrono::steady_clock::now().time_since_epoch().count(),
                            std::memory_order_relaxed);

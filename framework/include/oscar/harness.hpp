@@ -67,6 +67,10 @@ class KernelHarness {
   /// How many cues the output published since the last take (and takes them).
   std::size_t take_count(const std::string& output) { return take_erased(output).size(); }
 
+  /// A resource wish the kernel declares: whether it asks for it now (Wish::asked()).
+  /// @throws std::invalid_argument if it declares no wish of that name.
+  const Wish& wish(const std::string& name) const;
+
   Stamp now() const { return now_; }
   void set_now(Stamp t) { now_ = t; }
   void advance(std::chrono::nanoseconds d) { now_ += d.count(); }

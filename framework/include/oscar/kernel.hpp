@@ -20,6 +20,7 @@
 #include "oscar/params.hpp"
 #include "oscar/raw_cue.hpp"
 #include "oscar/time.hpp"
+#include "oscar/wish.hpp"
 
 namespace oscar {
 
@@ -72,6 +73,7 @@ struct KernelPorts {
   std::deque<std::unique_ptr<OutputPort>> outputs;
   ParamSpec params;
   std::deque<std::unique_ptr<CommandPort>> commands;
+  std::deque<std::unique_ptr<Wish>> wishes;
   InputPort* find_input(std::string_view name) const;
   OutputPort* find_output(std::string_view name) const;
   CommandPort* find_command(std::string_view name) const;
@@ -142,6 +144,14 @@ class KernelSetup {
           return CommandAnswer(h(*static_cast<const T*>(request)));
         }));
   }
+
+  /// Declares a resource wish (docs/kernels.md, "Resource wishes"): `name` is a bundle the system
+  /// file declares for this kernel under `coordinator: wishes:`. The kernel asks for it and
+  /// drops it while it runs (Wish::ask, Wish::drop); the coordinator's plan grants it or not.
+  /// A kernel's wishes are dropped when it is deactivated, and asked again on activation if the
+  /// kernel still asks (it may also drop them itself in on_deactivate()).
+  /// @throws std::invalid_argument if the name is taken or not an identifier.
+  Wish& wish(const std::string& name);
 
   /// Binds a Params struct (with `void describe(ParamSpec&)`) and applies the configured values
   /// at once, so the constructor can use them (e.g. to choose an output type).

@@ -78,6 +78,9 @@ TopicSpec<AppletPlan, AppletPlanPubSubType> applet_plan();
 /// starts afresh and announces itself), except the beats (a stream, 16 deep).
 /// An applet's announcement with all it asks for.
 TopicSpec<SchedHello, SchedHelloPubSubType> sched_hello();
+/// What a module's kernels wish from the coordinator (reliable, transient-local, the last per
+/// module process).
+TopicSpec<SchedModuleWishes, SchedModuleWishesPubSubType> sched_wishes();
 /// An applet's heartbeat from its loop (the coordinator's lease).
 TopicSpec<SchedBeat, SchedBeatPubSubType> sched_beat();
 /// An applet's scheduler calls and the coordinator's replies.

@@ -167,6 +167,7 @@ Module::Dds::Dds(Module& module, int domain)
     : module_(module), participant_(domain, "oscar:" + module.spec_.name, module.spec_.network) {}
 
 Module::Dds::~Dds() {
+  wishes_.reset();
   module_.log_sink_->attach(nullptr);
   stop_config();
   {
@@ -180,6 +181,16 @@ Module::Dds::~Dds() {
   pull_servers_.clear();
   for (auto& w : writers_) participant_.publisher().delete_datawriter(w->writer_);
   writers_.clear();
+}
+
+void Module::Dds::wire_wishes(std::vector<std::unique_ptr<Slot>>& slots) {
+  std::vector<internal::ModuleWishes::Entry> entries;
+  for (auto& s : slots) {
+    for (auto& w : s->instance->ports().wishes) entries.push_back({w.get(), &s->active});
+  }
+  if (entries.empty()) return;
+  wishes_ = std::make_unique<internal::ModuleWishes>(participant_, module_.spec_.name,
+                                                     module_.spec_.incarnation, std::move(entries));
 }
 
 void Module::Dds::wire_outputs(std::vector<std::unique_ptr<Slot>>& slots) {

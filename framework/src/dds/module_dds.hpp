@@ -18,6 +18,7 @@
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 
+#include "dds/module_wishes.hpp"
 #include "dds/pull.hpp"
 #include "module_slot.hpp"
 #include "oscar/dds_participant.hpp"
@@ -33,6 +34,13 @@ class Module::Dds {
   ~Dds();
 
   void wire_outputs(std::vector<std::unique_ptr<Slot>>& slots);
+  /// The kernels' resource wishes to the coordinator and its answers (module_wishes.hpp), if
+  /// any kernel declares one.
+  void wire_wishes(std::vector<std::unique_ptr<Slot>>& slots);
+  /// Sends the wishes again if they changed (a kernel was activated or deactivated).
+  void publish_wishes() {
+    if (wishes_) wishes_->publish();
+  }
   /// Connects `input` to the remote `source`: a push input subscribes to its topic, a pull or
   /// prefetch input asks its producer. Waits (at most 2 s) until matched; a rewire
   /// (`switch_wait`) also waits that long for the source's first cue, so that nothing it
@@ -98,6 +106,7 @@ class Module::Dds {
   std::thread config_thread_;
   std::unique_ptr<TopicWriter<ModuleBeat, ModuleBeatPubSubType>> beat_writer_;
   std::thread beat_thread_;
+  std::unique_ptr<internal::ModuleWishes> wishes_;
 };
 
 }  // namespace oscar

@@ -85,6 +85,12 @@ TopicSpec<SchedHello, SchedHelloPubSubType> sched_hello() {
   return {"oscar/sched/hello", qos::command_writer(), qos::command_reader()};
 }
 
+TopicSpec<SchedModuleWishes, SchedModuleWishesPubSubType> sched_wishes() {
+  // The reader keeps more than one: after a restart it gets the last set of every module at
+  // once, and keyless samples share one history.
+  return {"oscar/sched/wishes", qos::state_writer(1), qos::state_reader(256)};
+}
+
 TopicSpec<SchedBeat, SchedBeatPubSubType> sched_beat() {
   return {"oscar/sched/beat", qos::stream_writer(16), qos::stream_reader(16)};
 }
