@@ -194,6 +194,42 @@ void check_service_providers(const SystemSpec& s, const CoordinatorSpec& c) {
   }
 }
 
+// `wishes: [{kernel: module/kernel, bundles: [...]}]`: the bundles are the applet scheduler's
+// (checked when it reads them); `requested:` is the kernel's to decide.
+void parse_wishes(const SystemSpec& s, CoordinatorSpec& c, const YAML::Node& node) {
+  for (const auto& w : list(s.file, node, "coordinator.wishes",
+                            "[{kernel: door_search/door_search, bundles: [...]}]")) {
+    if (!w.IsMap())
+      fail(s.file, w, "coordinator.wishes: each entry is a map with kernel and bundles");
+    check_yaml_keys(w, s.file, "coordinator.wishes entry", {"kernel", "bundles"});
+    const auto who = text(s.file, w["kernel"], "coordinator.wishes entry's kernel");
+    const auto slash = who.find('/');
+    if (slash == std::string::npos) {
+      fail(s.file, w["kernel"],
+           fmt::format("coordinator.wishes: kernel '{}' must be module/kernel", who));
+    }
+    const auto p = provider_of(s, w["kernel"], "coordinator.wishes");
+    const auto what = fmt::format("coordinator.wishes '{}'", who);
+    if (std::any_of(c.wishes.begin(), c.wishes.end(),
+                    [&](const WishSpec& x) { return x.applet() == who; })) {
+      fail(s.file, w["kernel"], what + ": the kernel is listed twice; give all its bundles once");
+    }
+    if (!w["bundles"] || !w["bundles"].IsSequence() || w["bundles"].size() == 0) {
+      fail(s.file, w,
+           what +
+               ": bundles must be a list such as [{name: half_frames, resources: "
+               "[{service: HalfFrames}]}]");
+    }
+    for (const auto& b : w["bundles"]) {
+      if (b.IsMap() && b["requested"]) {
+        fail(s.file, b["requested"],
+             what + ": a wish is asked by its kernel (Wish::ask), not requested at start");
+      }
+    }
+    c.wishes.push_back({p.module, p.kernel, w["bundles"], yaml_where(s.file, w)});
+  }
+}
+
 }  // namespace
 
 void parse_services(SystemSpec& s, const YAML::Node& node) {
@@ -265,7 +301,7 @@ void parse_coordinator(SystemSpec& s, const YAML::Node& node) {
   }
   if (!node.IsMap()) fail(s.file, node, "coordinator: expected a map with host and applets");
   check_yaml_keys(node, s.file, "coordinator",
-                  {"host", "applets", "scheduler", "restart", "applet_lease"});
+                  {"host", "applets", "scheduler", "restart", "applet_lease", "wishes"});
   CoordinatorSpec c;
   c.where = yaml_where(s.file, node);
   auto known_host = [&](const std::string& h) {
@@ -362,6 +398,7 @@ void parse_coordinator(SystemSpec& s, const YAML::Node& node) {
       c.applets.push_back(std::move(spec));
     }
   }
+  if (node["wishes"]) parse_wishes(s, c, node["wishes"]);
   check_service_providers(s, c);
   s.coordinator = std::move(c);
 }

@@ -198,6 +198,40 @@ TEST(ServiceSpec, SetParametersNeedOneKernelPerProvider) {
   }
 }
 
+TEST(ServiceSpec, AKernelsWishesAreBundlesOfAnAppletNamedAfterIt) {
+  const auto s = parse(
+      "services: { Camera: { provided_by: [cam] } }\n"
+      "coordinator:\n"
+      "  wishes:\n"
+      "    - kernel: drive/pilot\n"
+      "      bundles: [ { name: look, priority: low, resources: [ { service: Camera } ] } ]\n");
+  ASSERT_EQ(s.coordinator->wishes.size(), 1u);
+  const auto& w = s.coordinator->wishes[0];
+  EXPECT_EQ(w.applet(), "drive/pilot");
+  EXPECT_EQ(w.module, "drive");
+  EXPECT_EQ(w.where, "s.yaml:8");
+  const std::string head =
+      "services: { Camera: { provided_by: [cam] } }\ncoordinator:\n  wishes:\n";
+  const std::string bundles = ", bundles: [ { name: look, resources: [ { service: Camera } ] } ]";
+  EXPECT_THAT(error_of(head + "    - { kernel: drive" + bundles + " }\n"),
+              HasSubstr("s.yaml:8: coordinator.wishes: kernel 'drive' must be module/kernel"));
+  EXPECT_THAT(error_of(head + "    - { kernel: drive/wheel" + bundles + " }\n"),
+              HasSubstr("s.yaml:8: coordinator.wishes: module 'drive' has no kernel 'wheel'"));
+  EXPECT_THAT(error_of(head + "    - { kernel: lamp/lamp" + bundles + " }\n"),
+              HasSubstr("coordinator.wishes: no module 'lamp' in the system"));
+  EXPECT_THAT(error_of(head + "    - { kernel: drive/pilot }\n"),
+              HasSubstr("coordinator.wishes 'drive/pilot': bundles must be a list"));
+  EXPECT_THAT(error_of(head + "    - { kernel: drive/pilot" + bundles + " }\n" +
+                       "    - { kernel: drive/pilot" + bundles + " }\n"),
+              HasSubstr("s.yaml:9: coordinator.wishes 'drive/pilot': the kernel is listed twice"));
+  EXPECT_THAT(
+      error_of(head + "    - { kernel: drive/pilot, bundles: [ { name: look, requested: true, "
+                      "resources: [ { service: Camera } ] } ] }\n"),
+      HasSubstr("a wish is asked by its kernel (Wish::ask), not requested at start"));
+  EXPECT_THAT(error_of(head + "    - { kernel: drive/pilot" + bundles + ", priority: 3 }\n"),
+              HasSubstr("priority"));
+}
+
 TEST(ServiceSpec, ServicesNeedACoordinatorAndTheCoordinatorsNameIsReserved) {
   EXPECT_THAT(error_of("services: { C: { provided_by: [cam] } }\n"),
               HasSubstr("services: need a coordinator: section"));

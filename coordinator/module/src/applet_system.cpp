@@ -38,6 +38,13 @@ applets::SystemConfig applet_system(const SystemSpec& system) {
     }
     doc["applets"].push_back(applet);
   }
+  // A kernel's wishes are the bundles of an applet named after it (docs/coordinator.md).
+  for (const auto& w : c.wishes) {
+    YAML::Node applet;
+    applet["name"] = w.applet();
+    applet["bundles"] = w.bundles;
+    doc["applets"].push_back(applet);
+  }
   return applets::load_system(doc, system.file);
 }
 

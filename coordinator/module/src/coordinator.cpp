@@ -8,6 +8,7 @@
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
+#include "kernel_wishes.hpp"
 #include "oscar/coordinator/applet_system.hpp"
 #include "oscar/time.hpp"
 #include "providers.hpp"
@@ -82,6 +83,7 @@ Coordinator::Coordinator(const SystemSpec& system, DdsParticipant& participant,
   }
   remote_ =
       std::make_unique<RemoteApplets>(system, *runtime_, *this, participant, [this] { wake(); });
+  wishes_ = std::make_unique<KernelWishes>(system, *runtime_, participant, [this] { wake(); });
   client_ = std::make_unique<ConfigClient>(participant, "coordinator");
   providers_ = std::make_unique<Providers>(system, *client_);
   system_reader_ = std::make_unique<TopicReader<SystemState, SystemStatePubSubType>>(
@@ -93,6 +95,7 @@ Coordinator::~Coordinator() {
   stop();
   system_reader_.reset();  // no callback into a half-destroyed object
   remote_.reset();
+  wishes_.reset();
 }
 
 void Coordinator::wake() {
@@ -167,6 +170,7 @@ Coordinator::Snapshot Coordinator::snapshot() {
   auto& plan = snap.plan;
   plan.system(system_.name);
   std::vector<char> holding(config_.model.applets().size()), waiting(holding.size());
+  std::vector<std::vector<std::string>> granted(holding.size());  // bundles usable now
   runtime_->with_scheduler([&](applets::Scheduler& s) {
     const auto& m = s.model();
     std::vector<char> used(m.services().size());
@@ -181,6 +185,7 @@ Coordinator::Snapshot Coordinator::snapshot() {
       if (!active && !s.requested(b)) continue;
       const auto applet = m.bundle(b).applet;
       (active ? holding : waiting)[applet] = 1;
+      if (active) granted[applet].push_back(m.bundle(b).name);
       for (const auto& u : m.bundle_uses(b)) {
         if (active) mark(u.service);
         (active ? holders : waiters)[u.service].insert(m.applet(applet).name);
@@ -211,8 +216,11 @@ Coordinator::Snapshot Coordinator::snapshot() {
     AppletEntry e;
     e.name(config_.model.applet(static_cast<applets::AppletId>(id)).name);
     e.process(SystemSpec::kCoordinatorModule);
+    e.granted(std::move(granted[id]));
     std::optional<std::string> state;
-    if (remote_->remote(e.name())) {
+    if (const auto module = wishes_->module_of(e.name()); !module.empty()) {
+      e.process(module);  // a kernel's wishes
+    } else if (remote_->remote(e.name())) {
       auto seen = remote_->seen(e.name());
       e.process(seen.process);
       state = seen.state;
@@ -238,6 +246,7 @@ void Coordinator::reconcile() {
   // A service whose provider module is down is unavailable: its holders lose it and keep their
   // request; it is granted again once the module runs. (A module still starting at boot is not
   // down: its service can be granted, and the providers are configured once it runs.)
+  wishes_->apply(modules);
   std::set<std::string> unavailable;
   for (const auto& svc : system_.services) {
     for (const auto& p : svc.providers) {
@@ -272,6 +281,10 @@ std::optional<std::string> Coordinator::apply_event(const AppletEvent& e) {
   // An applet in another process applies the event as its own call (it keeps what it asks for,
   // and announces it again after a restart of either side).
   if (remote_->remote(e.applet())) return remote_->event(e);
+  if (!wishes_->module_of(e.applet()).empty()) {
+    return fmt::format("'{}' is a kernel's wishes: its kernel asks for them and drops them",
+                       e.applet());
+  }
   std::optional<std::string> error;
   runtime_->with_scheduler([&](applets::Scheduler& s) {
     try {

@@ -99,11 +99,23 @@ struct AppletSpec {
   bool remote() const { return !process.empty(); }
 };
 
+/// What one kernel may wish from the coordinator (`coordinator: wishes:`, seed 004 §2.4): its
+/// bundles in the applet scheduler's vocabulary. The scheduler knows the kernel as the applet
+/// "module/kernel", whose bundles are requested and released as the kernel asks and drops them.
+struct WishSpec {
+  std::string module;
+  std::string kernel;
+  YAML::Node bundles;
+  std::string where;
+  std::string applet() const { return module + "/" + kernel; }
+};
+
 /// The `coordinator:` section: where the coordinator runs and what it runs.
 struct CoordinatorSpec {
   std::string host;
   YAML::Node scheduler;  ///< scheduler options, as the applet scheduler reads them
   std::vector<AppletSpec> applets;
+  std::vector<WishSpec> wishes;
   /// How long the coordinator waits for a beat of an applet in another process before it takes
   /// the applet's bundles (`applet_lease:`).
   std::chrono::milliseconds applet_lease{1500};

@@ -30,6 +30,7 @@
 
 namespace oscar::coordinator {
 
+class KernelWishes;
 class Providers;
 class RemoteApplets;
 
@@ -93,6 +94,7 @@ class Coordinator final : public AppletGateway {
   std::unique_ptr<ConfigClient> client_;
   std::unique_ptr<Providers> providers_;
   std::unique_ptr<RemoteApplets> remote_;
+  std::unique_ptr<KernelWishes> wishes_;
   TopicWriter<AppletPlan, AppletPlanPubSubType> plan_writer_;
   std::unique_ptr<TopicReader<SystemState, SystemStatePubSubType>> system_reader_;
 
