@@ -116,10 +116,15 @@ void AprilTagDetect::Params::describe(ParamSpec& spec) {
       .fixed();
   spec.field("refine_edges", refine_edges, "snap quad edges to strong gradients").fixed();
   spec.field("min_margin", min_margin, "drop detections with a lower decision margin").at_least(0);
+  spec.field("closer_look_ms", closer_look_ms,
+             "ask for the wish closer_look while tags are in view and this long after (0 = never)")
+      .at_least(0);
 }
 
 AprilTagDetect::AprilTagDetect(KernelSetup& setup)
-    : image_(setup.input<CameraImage>("image")), tags_(setup.output<TagDetections>("tags")) {
+    : image_(setup.input<CameraImage>("image")),
+      tags_(setup.output<TagDetections>("tags")),
+      closer_look_(setup.wish("closer_look")) {
   setup.params(params_);
   name_ = setup.kernel_name();
   on_params_changed();
@@ -140,7 +145,25 @@ void AprilTagDetect::on_activate() {
   if (!detector_) detector_ = std::make_unique<Detector>(params_);
 }
 
-void AprilTagDetect::on_deactivate() { detector_.reset(); }
+void AprilTagDetect::on_deactivate() {
+  detector_.reset();
+  closer_look_.drop();
+}
+
+// Seed 004 §2.4: a module may tell the coordinator what it would like; here a sign in view would
+// be read better with more pixels. Whether the wish is granted is the plan's decision.
+void AprilTagDetect::wish_closer_look(bool tags_in_view, Stamp now) {
+  if (params_.closer_look_ms <= 0) {
+    closer_look_.drop();
+    return;
+  }
+  if (tags_in_view) {
+    last_tag_seen_ = now;
+    closer_look_.ask();
+  } else if (now - last_tag_seen_ > static_cast<Stamp>(params_.closer_look_ms) * 1'000'000) {
+    closer_look_.drop();
+  }
+}
 
 void AprilTagDetect::process(Cycle& cycle) {
   for (const auto& r : image_.take_new()) detect(*r.cue, cycle);
@@ -221,6 +244,7 @@ void AprilTagDetect::detect(const CameraImage& image, Cycle& cycle) {
     out.detections().push_back(std::move(t));
   }
   apriltag_detections_destroy(found);
+  wish_closer_look(!out.detections().empty(), cycle.now());
   append_stamp(out.header(), cycle.now());
   tags_.publish(std::move(out));
 }

@@ -24,6 +24,9 @@ class AprilTagDetect final : public Kernel {
     double blur_sigma = 0.0;
     bool refine_edges = true;
     double min_margin = 0.0;  ///< drop detections with a lower decision margin
+    /// > 0: ask for the wish `closer_look` while tags are in view and this long after the last
+    /// (e.g. the camera in half frames, as the system file's `coordinator: wishes:` says).
+    int closer_look_ms = 0;
     void describe(ParamSpec& spec);
   };
   /// The tag families this kernel knows (AprilTag 3's).
@@ -40,9 +43,12 @@ class AprilTagDetect final : public Kernel {
  private:
   struct Detector;
   void detect(const CameraImage& image, Cycle& cycle);
+  void wish_closer_look(bool tags_in_view, Stamp now);
 
   Input<CameraImage>& image_;
   Output<TagDetections>& tags_;
+  Wish& closer_look_;
+  Stamp last_tag_seen_ = 0;
   Params params_;
   std::string name_;
   std::vector<int> ids_;

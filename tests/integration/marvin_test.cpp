@@ -1,7 +1,9 @@
 // Seed 004 §4.2's MARVIN mission as a live system (config/marvin-phases.yaml): the applet
 // `mission` goes from phase explore to identify when the door search sees a sign and back after
 // reading it; the plan runs exactly the modules of the phase, and granting HalfFrames switches
-// the framegrabber to half frames (its idle switches it back to quarter).
+// the framegrabber to half frames (its idle switches it back to quarter). While it explores, the
+// door search's resource wish (a closer look at a sign) gets HalfFrames, until the mission's
+// identify phase takes it.
 #include <condition_variable>
 #include <fstream>
 #include <mutex>
@@ -72,6 +74,26 @@ class Mission {
            << sys.boot_output();
   }
 
+  // Waits until the plan gives `service` to `holders`.
+  ::testing::AssertionResult held_by(const std::string& service,
+                                     const std::vector<std::string>& holders) {
+    std::unique_lock lock(mutex_);
+    const auto matches = [&] {
+      if (!plan_) return false;
+      for (const auto& s : plan_->services()) {
+        if (s.name() == service) return s.holders() == holders;
+      }
+      return false;
+    };
+    if (changed_.wait_for(lock, std::chrono::seconds(30), matches)) {
+      return ::testing::AssertionSuccess();
+    }
+    return ::testing::AssertionFailure()
+           << service << " never held by the expected applets; last: "
+           << (plan_ ? coordinator::plan_json(*plan_) : "none") << "\nboot output:\n"
+           << sys.boot_output();
+  }
+
   // Waits until each module's kernel (named like the module) is in its mode ("deactivated" or
   // not), and cam's frame mode is `frame_mode`.
   void modules(const std::map<std::string, bool>& active, const std::string& frame_mode) {
@@ -99,17 +121,20 @@ class Mission {
 TEST(MarvinMission, EachPhaseRunsItsModulesAndSwitchesTheFramegrabbersFrameMode) {
   Mission m(2);
   m.sys.running();
-  // Phase explore: wall following and door search on quarter frames.
+  // Phase explore: wall following and door search; the door search sees a sign and wishes a
+  // closer look, which the plan grants it: half frames.
   ASSERT_TRUE(m.holds({"WallFollowing", "DoorSearch"}));
+  ASSERT_TRUE(m.held_by("HalfFrames", {"door_search/door_search"}));
   m.modules({{"wall_follow", true}, {"cam", true}, {"door_search", true}, {"door_locate", false}},
-            "quarter");
-  // Phase identify: the door search saw a sign; the door is localised on half frames.
+            "half");
+  // Phase identify: the door search saw a sign; the door is localised on half frames, which the
+  // mission now holds itself (its priority is higher than the wish's).
   ASSERT_TRUE(m.holds({"DoorLocalisation", "HalfFrames"}));
   m.modules({{"wall_follow", false}, {"cam", true}, {"door_search", false}, {"door_locate", true}},
             "half");
-  // The next door: explore again, quarter frames again.
+  // The next door: explore again.
   ASSERT_TRUE(m.holds({"WallFollowing", "DoorSearch"}));
-  m.modules({{"wall_follow", true}, {"door_search", true}, {"door_locate", false}}, "quarter");
+  m.modules({{"wall_follow", true}, {"door_search", true}, {"door_locate", false}}, "half");
   // After the second door the mission is done: nothing held, every module deactivated. (A
   // phase change releases one bundle and then requests the next: a plan between the two may show
   // nothing held, so the end is taken from the mission's word.)
@@ -130,6 +155,8 @@ TEST(MarvinMission, EachPhaseRunsItsModulesAndSwitchesTheFramegrabbersFrameMode)
   EXPECT_THAT(log, HasSubstr("applet mission: phase explore -> identify (door sign seen)"));
   EXPECT_THAT(log, HasSubstr("applet mission: door 2 identified"));
   EXPECT_THAT(log, HasSubstr("coordinator: cam/cam: set frame_mode=half"));
+  EXPECT_THAT(log, HasSubstr("coordinator: kernel door_search/door_search asks for its wish "
+                             "closer_look"));
 }
 
 }  // namespace

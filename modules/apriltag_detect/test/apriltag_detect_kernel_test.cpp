@@ -119,6 +119,40 @@ TEST(AprilTagDetect, CopiesTheImageStampsAndAppendsItsOwn) {
   EXPECT_EQ(out->header().stamps()[1], static_cast<unsigned long long>(det.now()));
 }
 
+// Seed 004 §2.4: the detector asks the coordinator for a closer look while a sign is in view and
+// for closer_look_ms after; without closer_look_ms it never asks.
+TEST(AprilTagDetect, AsksForACloserLookWhileTagsAreInView) {
+  KernelHarness grab("framegrabber", YAML::Load("{source: 'synthetic:static'}"), "cam");
+  CameraImage blank;
+  blank.encoding("mono8");
+  blank.width(64);
+  blank.height(48);
+  blank.data().assign(64 * 48, 0);
+  for (const int hold_ms : {0, 200}) {
+    KernelHarness det(
+        "apriltag_detect",
+        YAML::Load("{estimate_pose: false, closer_look_ms: " + std::to_string(hold_ms) + "}"),
+        "door_search");
+    const auto& wish = det.wish("closer_look");
+    grab.step();
+    det.feed("image", *grab.take<CameraImage>("frame").at(0));
+    det.step();
+    ASSERT_FALSE(det.take<TagDetections>("tags").at(0)->detections().empty());
+    EXPECT_EQ(wish.asked(), hold_ms > 0) << "closer_look_ms " << hold_ms;
+    det.advance(std::chrono::milliseconds(150));
+    det.feed("image", blank);
+    det.step();
+    EXPECT_EQ(wish.asked(), hold_ms > 0) << "dropped before closer_look_ms passed";
+    det.advance(std::chrono::milliseconds(100));
+    det.feed("image", blank);
+    det.step();
+    EXPECT_FALSE(wish.asked()) << "still asked after closer_look_ms without a tag";
+    EXPECT_FALSE(wish.granted()) << "granted without a coordinator";
+  }
+  KernelHarness det("apriltag_detect", YAML::Load("{}"), "door_search");
+  EXPECT_THROW(det.wish("far_look"), std::invalid_argument);
+}
+
 TEST(AprilTagDetect, PoseWithoutIntrinsicsIsAClearErrorAndPublishesNothing) {
   KernelHarness det("apriltag_detect", YAML::Load("{}"), "mark_a");
   CameraImage img;
