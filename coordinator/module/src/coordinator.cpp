@@ -243,10 +243,10 @@ void Coordinator::reconcile() {
       if (m.ran && !m.running) down.insert(name);
     }
   }
+  wishes_->apply(modules);  // what kernels ask for now (nothing of a module that is down)
   // A service whose provider module is down is unavailable: its holders lose it and keep their
   // request; it is granted again once the module runs. (A module still starting at boot is not
   // down: its service can be granted, and the providers are configured once it runs.)
-  wishes_->apply(modules);
   std::set<std::string> unavailable;
   for (const auto& svc : system_.services) {
     for (const auto& p : svc.providers) {
