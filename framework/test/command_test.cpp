@@ -62,31 +62,6 @@ TEST(CommandPorts, ADuplicateCommandNameIsRefusedAtDeclaration) {
   EXPECT_EQ(declaration_error({"hold", "release"}), "no error");
 }
 
-TEST(Wishes, AreDeclaredOnceByIdentifierAndAskedOnlyOnceUntilDropped) {
-  KernelPorts ports("k");
-  KernelSetup setup("k", "wishing", ports);
-  auto& half = setup.wish("half_frames");
-  EXPECT_EQ(error_of([&] { setup.wish("half_frames"); }),
-            "kernel 'k' (wishing): wish 'half_frames' is declared twice; wish names are unique "
-            "per kernel");
-  EXPECT_THAT(error_of([&] { setup.wish("half frames"); }),
-              HasSubstr("wish name 'half frames' must be an identifier"));
-  int changes = 0;
-  half.on_change([&] { ++changes; });
-  half.ask();
-  half.ask();
-  EXPECT_TRUE(half.asked());
-  EXPECT_EQ(changes, 1) << "asking again is no change";
-  half.set_granted(true);
-  EXPECT_TRUE(half.granted());
-  half.drop();
-  EXPECT_FALSE(half.granted()) << "a dropped wish is not granted, whatever the plan said last";
-  EXPECT_EQ(changes, 2);
-  half.on_change({});
-  half.ask();
-  EXPECT_EQ(changes, 2) << "called after it was detached";
-}
-
 TEST(CommandPorts, TheHarnessDeliversACommandAndReturnsTheKernelsAnswer) {
   KernelHarness h("test_commanded");
   auto answer = h.command("hold", flag(true));

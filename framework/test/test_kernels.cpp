@@ -3,6 +3,7 @@
 #include "oscar/kernel_registry.hpp"
 
 OSCAR_REGISTER_KERNEL(oscar::test::Counter, "test_counter")
+OSCAR_REGISTER_KERNEL(oscar::test::Wisher, "test_wisher")
 OSCAR_REGISTER_KERNEL(oscar::test::Collect, "test_collect")
 OSCAR_REGISTER_KERNEL(oscar::test::RawCollect, "test_raw_collect")
 OSCAR_REGISTER_KERNEL(oscar::test::Lines, "test_lines")

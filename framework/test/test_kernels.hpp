@@ -215,6 +215,16 @@ class Failing final : public Kernel {
   Params params_;
 };
 
+/// Asks for its wish `look` on every cycle and never drops it (the frame withdraws it while the
+/// kernel is deactivated).
+class Wisher final : public Kernel {
+ public:
+  explicit Wisher(KernelSetup& setup) : look_(setup.wish("look")) {}
+  void process(Cycle&) override { look_.ask(); }
+  void stub(Cycle&) override { look_.ask(); }
+  Wish& look_;
+};
+
 }  // namespace oscar::test
 
 namespace oscar::test {

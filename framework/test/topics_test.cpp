@@ -49,6 +49,7 @@ TEST(Topics, TheWriterAndReaderOfEveryCatalogueTopicMatch) {
   expect_both_sides_match(p, topics::sched_notice());
   expect_both_sides_match(p, topics::sched_command());
   expect_both_sides_match(p, topics::sched_command_reply());
+  expect_both_sides_match(p, topics::sched_wishes());
   expect_both_sides_match(p, topics::pull_request("k/out"));
   expect_both_sides_match(p, topics::pull_reply("k/out"));
 }
@@ -73,10 +74,11 @@ TEST(Topics, EveryCatalogueTopicHasANameOfItsOwn) {
                                     topics::sched_notice().name,
                                     topics::sched_command().name,
                                     topics::sched_command_reply().name,
+                                    topics::sched_wishes().name,
                                     topics::pull_request("k/out").name,
                                     topics::pull_reply("k/out").name,
                                     topics::cue("k/out")};
-  EXPECT_EQ(names.size(), 22u);
+  EXPECT_EQ(names.size(), 23u);
 }
 
 // A module's first log lines are written before boot's reader has discovered it (its process
