@@ -3,12 +3,9 @@
 // must give UI, Pilot and DockingController the holders of Abb. 5.4 — the table the offline
 // scenario coordinator/applets/scenarios/real_world_5_3.yaml expects too. The modules that stand
 // for the hardware run exactly while their service is held.
-#include <condition_variable>
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <mutex>
-#include <optional>
 #include <sstream>
 
 #include <gmock/gmock.h>
@@ -16,9 +13,7 @@
 
 #include "booted_system.hpp"
 #include "oscar/config_client.hpp"
-#include "oscar/coordinator/plan_json.hpp"
-#include "oscar/topic_io.hpp"
-#include "oscar/topics.hpp"
+#include "plan_watch.hpp"
 
 namespace oscar {
 namespace {
@@ -37,12 +32,7 @@ class Scenario {
  public:
   Scenario()
       : sys("applets_5_3", system_5_3()),
-        plans_(sys.participant(), topics::applet_plan(),
-               [this](const AppletPlan& p, const auto&) {
-                 std::lock_guard lock(mutex_);
-                 plan_ = p;
-                 changed_.notify_all();
-               }),
+        plans_(sys.participant()),
         operator_(sys.participant(), "boot") {}
 
   // The world's event for an applet's bundle, through the coordinator's command port.
@@ -60,23 +50,18 @@ class Scenario {
 
   // Waits until the plan gives each service the expected holder.
   ::testing::AssertionResult plan_shows(const Holders& expected) {
-    std::unique_lock lock(mutex_);
-    const auto matches = [&] {
-      if (!plan_) return false;
+    const auto matches = [&](const AppletPlan& p) {
       for (const auto& [service, holder] : expected) {
-        if (planned(*plan_, service) != holder) return false;
+        if (planned(p, service) != holder) return false;
       }
       return true;
     };
-    if (changed_.wait_for(lock, std::chrono::seconds(30), matches)) {
-      return ::testing::AssertionSuccess();
-    }
+    if (plans_.wait(matches)) return ::testing::AssertionSuccess();
     auto failure = ::testing::AssertionFailure();
-    for (const auto& [service, holder] : expected) {
-      failure << service << ": expected " << holder << ", plan says "
-              << (plan_ ? planned(*plan_, service) : "nothing") << "; ";
-    }
-    return failure << "\nboot output:\n" << sys.boot_output();
+    for (const auto& [service, holder] : expected)
+      failure << service << ": expected " << holder << "; ";
+    return failure << "the plan says " << plans_.last_json() << "\nboot output:\n"
+                   << sys.boot_output();
   }
 
   // The module's kernel (named like the module) reaches `mode`.
@@ -98,10 +83,7 @@ class Scenario {
     return "(no such service)";
   }
 
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  std::optional<AppletPlan> plan_;
-  TopicReader<AppletPlan, AppletPlanPubSubType> plans_;
+  test::PlanWatch plans_;
   ConfigClient operator_;
 };
 

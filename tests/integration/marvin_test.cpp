@@ -4,20 +4,18 @@
 // the framegrabber to half frames (its idle switches it back to quarter). While it explores, the
 // door search's resource wish (a closer look at a sign) gets HalfFrames, until the mission's
 // identify phase takes it.
-#include <condition_variable>
 #include <fstream>
-#include <mutex>
-#include <optional>
+#include <functional>
+#include <map>
+#include <set>
 #include <sstream>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "booted_system.hpp"
-#include "oscar/coordinator/plan_json.hpp"
 #include "oscar/testing/eventually.hpp"
-#include "oscar/topic_io.hpp"
-#include "oscar/topics.hpp"
+#include "plan_watch.hpp"
 
 namespace oscar {
 namespace {
@@ -43,55 +41,28 @@ std::string marvin_system(int doors) {
 
 class Mission {
  public:
-  explicit Mission(int doors)
-      : sys("marvin", marvin_system(doors)),
-        plans_(sys.participant(), topics::applet_plan(), [this](const AppletPlan& p, const auto&) {
-          std::lock_guard lock(mutex_);
-          plan_ = p;
-          changed_.notify_all();
-        }) {}
+  explicit Mission(int doors) : sys("marvin", marvin_system(doors)), plans_(sys.participant()) {}
 
   // Waits until the plan gives `mission` exactly `held` of the mission's services.
   ::testing::AssertionResult holds(const std::set<std::string>& held) {
     static const std::set<std::string> kServices{"WallFollowing", "DoorSearch", "DoorLocalisation",
                                                  "HalfFrames"};
-    std::unique_lock lock(mutex_);
-    const auto matches = [&] {
-      if (!plan_) return false;
-      for (const auto& s : plan_->services()) {
+    return shown("the mission's services for its phase", [&](const AppletPlan& p) {
+      for (const auto& s : p.services()) {
         if (!kServices.contains(s.name())) continue;
         const bool mission = s.holders() == std::vector<std::string>{"mission"};
         if (mission != held.contains(s.name())) return false;
       }
       return true;
-    };
-    if (changed_.wait_for(lock, std::chrono::seconds(30), matches)) {
-      return ::testing::AssertionSuccess();
-    }
-    return ::testing::AssertionFailure()
-           << "the plan never gave the mission what its phase needs; last: "
-           << (plan_ ? coordinator::plan_json(*plan_) : "none") << "\nboot output:\n"
-           << sys.boot_output();
+    });
   }
 
   // Waits until the plan gives `service` to `holders`.
   ::testing::AssertionResult held_by(const std::string& service,
                                      const std::vector<std::string>& holders) {
-    std::unique_lock lock(mutex_);
-    const auto matches = [&] {
-      if (!plan_) return false;
-      for (const auto& s : plan_->services()) {
-        if (s.name() == service) return s.holders() == holders;
-      }
-      return false;
-    };
-    if (changed_.wait_for(lock, std::chrono::seconds(30), matches)) {
-      return ::testing::AssertionSuccess();
-    }
-    return ::testing::AssertionFailure()
-           << service << " never held by the expected applets; last: "
-           << (plan_ ? coordinator::plan_json(*plan_) : "none") << "\nboot output:\n"
-           << sys.boot_output();
+    return shown(service + "'s holders", [&](const AppletPlan& p) {
+      return test::PlanWatch::holders(p, service) == holders;
+    });
   }
 
   // Waits until each module's kernel (named like the module) is in its mode ("deactivated" or
@@ -112,10 +83,15 @@ class Mission {
   test::BootedSystem sys;
 
  private:
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  std::optional<AppletPlan> plan_;
-  TopicReader<AppletPlan, AppletPlanPubSubType> plans_;
+  ::testing::AssertionResult shown(const std::string& what,
+                                   const std::function<bool(const AppletPlan&)>& shows) {
+    if (plans_.wait(shows)) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << "the plan never showed " << what
+                                         << "; last: " << plans_.last_json() << "\nboot output:\n"
+                                         << sys.boot_output();
+  }
+
+  test::PlanWatch plans_;
 };
 
 TEST(MarvinMission, EachPhaseRunsItsModulesAndSwitchesTheFramegrabbersFrameMode) {
