@@ -6,9 +6,11 @@
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <charconv>
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -42,6 +44,20 @@ std::string domain_locks() {
   return env && *env ? env : "/tmp/oscar/test-domains";
 }
 const fs::path kShm = "/dev/shm";
+
+// Whether a /dev/shm file is one of `domain`'s Fast DDS ports (fastrtps_port<N>, its lock
+// "_el" and its semaphore "sem.fastrtps_port<N>_mutex", N in 7400 + 250 * domain + [0, 250)).
+bool is_port_of_domain(const std::string& name, int domain) {
+  constexpr std::string_view kPort = "fastrtps_port";
+  const auto at = name.find(kPort);
+  if (at != 0 && !(at == 4 && name.starts_with("sem."))) return false;
+  int port = 0;
+  const auto* first = name.data() + at + kPort.size();
+  const auto [end, error] = std::from_chars(first, name.data() + name.size(), port);
+  if (error != std::errc() || end == first) return false;
+  const int base = 7400 + 250 * domain;
+  return port >= base && port < base + 250;
+}
 
 // `program` from $OSCAR_BIN_DIR, else from PATH.
 std::string find_program(const std::string& program) {
@@ -215,6 +231,11 @@ SystemUnderTest::SystemUnderTest(const std::string& system_file, BootOptions opt
   log_dir_ = options.log_dir.empty() ? work_dir_ + "/logs" : options.log_dir;
   boot_log_ = work_dir_ + "/boot.log";
 
+  // Ports a killed earlier run left in this domain would be opened by this system's processes,
+  // taken for its own and left behind at shutdown (no one else uses the domain: FreeDomain).
+  DeadSharedMemorySweeper(std::chrono::seconds(0), kShm, [&](const std::string& name) {
+    return is_port_of_domain(name, domain_);
+  }).sweep();
   register_standard_cue_types();
   participant_ = std::make_unique<DdsParticipant>(domain_, "oscar-test");
   registry_ = std::make_unique<RegistryClient>(*participant_, "test");

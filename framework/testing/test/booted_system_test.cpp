@@ -9,6 +9,7 @@
 #include <fstream>
 #include <thread>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -99,6 +100,34 @@ TEST(SystemUnderTest, LeavesNothingBehindWhenBootIsKilled) {
   EXPECT_EQ(sys.shut_down(), std::nullopt) << "boot did not exit by itself";
   EXPECT_THAT(sys.leftover_processes(), IsEmpty());
   EXPECT_THAT(sys.leftover_shared_memory(), IsEmpty());
+}
+
+// A killed earlier run in the same domain left a port (with its lock file and semaphore): the
+// system's processes would open it and take it for theirs. The fixture removes dead ports of its
+// domain before it boots, and leaves other domains' files alone.
+TEST(SystemUnderTest, RemovesDeadPortsOfItsDomainBeforeItBoots) {
+  const char* file = std::getenv("OSCAR_TEST_SYSTEM");
+  ASSERT_NE(file, nullptr);
+  FreeDomain domain;
+  const int mine = 7400 + 250 * domain.domain() + 17;
+  const int other = 7400 + 250 * (domain.domain() + 1) + 17;  // the next domain's
+  const std::filesystem::path shm = "/dev/shm";
+  std::vector<std::string> stale, kept;
+  for (const auto* pattern :
+       {"fastrtps_port{}", "fastrtps_port{}_el", "sem.fastrtps_port{}_mutex"}) {
+    stale.push_back(fmt::format(fmt::runtime(pattern), mine));
+    kept.push_back(fmt::format(fmt::runtime(pattern), other));
+  }
+  for (const auto& name : stale) std::ofstream(shm / name) << "left by a killed process";
+  for (const auto& name : kept) std::ofstream(shm / name) << "another domain's";
+  {
+    BootOptions options;
+    options.domain = domain.domain();
+    SystemUnderTest sys(file, options);
+    for (const auto& name : stale) EXPECT_FALSE(std::filesystem::exists(shm / name)) << name;
+    for (const auto& name : kept) EXPECT_TRUE(std::filesystem::exists(shm / name)) << name;
+  }
+  for (const auto& name : kept) std::filesystem::remove(shm / name);
 }
 
 TEST(SystemUnderTest, AFileThatDoesNotExistIsRefusedByName) {
