@@ -83,7 +83,8 @@ TEST_F(Wishes, AKernelsWishIsGrantedByThePlanAndYieldsToAHigherPriority) {
   ASSERT_TRUE(plan_shows({}, {}));
   module_.write(wishes(1, 1, {"closer_look"}));
   ASSERT_TRUE(plan_shows({"det/det"}, {"closer_look"}));
-  for (const auto& a : coordinator_.plan().applets()) {
+  const auto plan = coordinator_.plan();  // kept: a range over a temporary's member dangles
+  for (const auto& a : plan.applets()) {
     if (a.name() == "det/det") {
       EXPECT_EQ(a.process(), "det") << "a kernel's wishes run in its module";
     }
