@@ -40,6 +40,7 @@ struct Service {
   bool exclusive_only = false;
   std::optional<AppletId> provider;  ///< The service applet that provides it, if any.
   std::vector<Dependency> dependencies;
+  bool removed = false;  ///< Removed at run time: its id stays taken, its name is free again.
 };
 
 /// An applet's proxy to one service (seed §4.2.2).
@@ -57,6 +58,7 @@ struct Bundle {
   std::string name;
   std::vector<ResourceId> resources;
   int priority = kPriorityNormal;  ///< Initial priority; the Scheduler may change it.
+  bool removed = false;            ///< Its applet was removed.
 };
 
 /// An applet or service applet (seed §4.1).
@@ -66,6 +68,42 @@ struct Applet {
   std::vector<BundleId> bundles;
   std::vector<ResourceId> resources;
   bool fail_stop = false;  ///< Using a non-granted resource throws instead of blocking (§4.6.2).
+  bool removed = false;    ///< Removed at run time: its id stays taken, its name is free again.
+};
+
+/// A service to add, by names (Model::add): what the configuration says of it.
+struct NewService {
+  std::string name;
+  bool exclusive_only = false;
+  std::vector<std::pair<std::string, Access>> needs;  ///< Services it depends on (§4.2.3).
+};
+
+/// A bundle of an applet to add, by names.
+struct NewBundle {
+  std::string name;
+  int priority = kPriorityNormal;
+  std::vector<std::pair<std::string, Access>> resources;
+};
+
+/// An applet to add, by names (Model::add).
+struct NewApplet {
+  std::string name;
+  bool fail_stop = false;
+  std::vector<std::string> provides;  ///< Services it provides (a service applet, §4.2.3).
+  std::vector<NewBundle> bundles;
+};
+
+/// Services and applets added to a model together: all of them or none (seed 000 §4.1.1: the
+/// scheduler is told of services and applets as they come and go).
+struct ModelAddition {
+  std::vector<NewService> services;  ///< Added first; their needs may name each other.
+  std::vector<NewApplet> applets;    ///< May use and provide the services added with them.
+};
+
+/// The ids an addition got, in the order of its lists.
+struct AddedIds {
+  std::vector<ServiceId> services;
+  std::vector<AppletId> applets;
 };
 
 /// One use of a service while a bundle is granted: by a resource or by a service (a dependency
@@ -98,6 +136,20 @@ class Model {
   BundleId add_bundle(AppletId applet, std::string name,
                       const std::vector<std::pair<ServiceId, Access>>& resources,
                       int priority = kPriorityNormal);
+
+  /// Adds services and applets by name, all or nothing: on any error the model is unchanged.
+  /// New ids follow the ones given so far (a removed thing's id is never given again).
+  /// @throws std::invalid_argument as the single calls do, and naming a removed or unknown
+  ///         service.
+  AddedIds add(const ModelAddition& addition);
+  /// Removes an applet (its bundles with it) and frees its name; the services it provided have
+  /// no provider any more. Its id and its bundles' ids stay taken.
+  /// @throws std::invalid_argument if it was removed already.
+  void remove_applet(AppletId applet);
+  /// Removes a service and frees its name; its id stays taken.
+  /// @throws std::invalid_argument naming the applets whose bundles use it, the services that
+  ///         need it and the applet that provides it, while any does (remove those first).
+  void remove_service(ServiceId service);
 
   /// @throws std::invalid_argument "unknown service 'X'".
   ServiceId service_id(std::string_view name) const;
