@@ -5,6 +5,7 @@
 
 #include <atomic>
 
+#include "oscar/applets/config.hpp"
 #include "oscar/applets/runtime.hpp"
 #include "oscar/applets/scheduler.hpp"
 #include "test_support.hpp"
@@ -285,6 +286,47 @@ TEST(Registrar, BadRunnersAreRefusedBeforeAnythingIsAdded) {
   bool known = true;
   rt.with_scheduler([&](Scheduler& s) { known = s.model().applets().size() > 1; });
   EXPECT_FALSE(known);
+}
+
+TEST(Registrar, AnAdditionIsReadFromYamlWithItsLines) {
+  Base t;
+  const auto loaded = load_addition(t.m,
+                                    parse_yaml(R"(services:
+  - {name: Dock, depends_on: [S]}
+applets:
+  - name: Docker
+    params: {speed: 3}
+    bundles: [{name: d, priority: high, requested: true, resources: [{service: Dock}]}]
+)",
+                                               "spec"),
+                                    "spec");
+  ASSERT_EQ(loaded.addition.services.size(), 1u);
+  EXPECT_EQ(loaded.addition.services[0].needs.at(0).first, "S");
+  ASSERT_EQ(loaded.addition.applets.size(), 1u);
+  EXPECT_EQ(loaded.addition.applets[0].bundles.at(0).priority, kPriorityHigh);
+  EXPECT_EQ(loaded.applet_params.at("Docker").at("speed"), "3");
+  ASSERT_EQ(loaded.requested_at_start.size(), 1u);
+  EXPECT_EQ(loaded.requested_at_start[0], std::make_pair(std::string("Docker"), std::string("d")));
+  EXPECT_EQ(t.m.services().size(), 1u);  // the model it was checked against is unchanged
+  Scheduler s(t.m);
+  s.add(loaded.addition);
+  EXPECT_EQ(s.model().applet_id("Docker"), 1u);
+}
+
+TEST(Registrar, ABadAdditionNamesItsLineAndRule) {
+  Base t;
+  auto error = [&](const std::string& text) {
+    return error_of([&] { load_addition(t.m, parse_yaml(text, "spec"), "spec"); });
+  };
+  EXPECT_EQ(error("applets:\n  - name: Low\n    bundles: []\n"),
+            "spec:2: applet 'Low' is declared twice; names are unique");
+  EXPECT_THAT(error("applets:\n  - name: A\n    bundles:\n      - {name: b, resources: "
+                    "[{service: Nowhere}]}\n"),
+              HasSubstr("spec:4: applet 'A' bundle 'b': unknown service 'Nowhere'"));
+  EXPECT_THAT(error("services:\n  - {name: S}\n"),
+              HasSubstr("spec:2: service 'S' is declared twice"));
+  EXPECT_THAT(error("modules: []\n"), HasSubstr("spec:1: an addition: unknown key 'modules'"));
+  EXPECT_THAT(error("{}\n"), HasSubstr("an addition names services: or applets:"));
 }
 
 }  // namespace
