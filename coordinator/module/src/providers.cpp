@@ -8,23 +8,39 @@ constexpr std::chrono::milliseconds kReplyTimeout{2000};
 constexpr std::chrono::milliseconds kRetry{1000};
 }  // namespace
 
-Providers::Providers(const SystemSpec& system, ConfigClient& client)
-    : system_(system), client_(client) {
-  for (const auto& svc : system.services) {
-    for (const auto& p : svc.providers) {
-      targets_[{p.module, p.kernel.empty() ? "*" : p.kernel}].push_back(&svc);
-    }
+Providers::Providers(const std::vector<ServiceSpec>& services, ConfigClient& client)
+    : client_(client) {
+  for (const auto& svc : services) add(svc);
+}
+
+void Providers::add(const ServiceSpec& service) {
+  for (const auto& p : service.providers) {
+    targets_[{p.module, p.kernel.empty() ? "*" : p.kernel}].push_back(service);
   }
+}
+
+void Providers::remove(const std::string& service) {
+  for (auto it = targets_.begin(); it != targets_.end();) {
+    std::erase_if(it->second, [&](const ServiceSpec& s) { return s.name == service; });
+    if (!it->second.empty()) {
+      ++it;
+      continue;
+    }
+    applied_.erase(it->first);
+    retry_at_.erase(it->first);
+    it = targets_.erase(it);
+  }
+  recorded_.erase(service);
 }
 
 std::string Providers::desired(const Target& target, const std::set<std::string>& in_use) const {
   bool idle_deactivates = false;
-  for (const auto* svc : targets_.at(target)) {
-    if (in_use.contains(svc->name)) {
-      if (svc->activate) return "activate:" + *svc->activate;
+  for (const auto& svc : targets_.at(target)) {
+    if (in_use.contains(svc.name)) {
+      if (svc.activate) return "activate:" + *svc.activate;
       return "";  // in use, but granting it configures nothing: leave the module be
     }
-    idle_deactivates = idle_deactivates || svc->idle_deactivates;
+    idle_deactivates = idle_deactivates || svc.idle_deactivates;
   }
   return idle_deactivates ? "deactivate" : "";
 }
@@ -84,8 +100,8 @@ void Providers::apply(const std::set<std::string>& in_use, const std::set<std::s
     // Commands are recorded only while a service is held, and a held service's providers are
     // configured before its holder's first command goes out: so this is a restarted module (or
     // one that was not running): give it back what the holders of its services commanded.
-    for (const auto* svc : services) {
-      const auto rec = recorded_.find(svc->name);
+    for (const auto& svc : services) {
+      const auto rec = recorded_.find(svc.name);
       if (rec == recorded_.end()) continue;
       for (const auto& [key, r] : rec->second) {
         const auto& [module, kernel, command] = key;
@@ -93,7 +109,7 @@ void Providers::apply(const std::set<std::string>& in_use, const std::set<std::s
         try {
           const auto reply =
               client_.send_command(module, kernel, command, r.type, r.cdr, kReplyTimeout);
-          spdlog::info("coordinator: {}: {}/{} {} re-applied after the restart: {}", svc->name,
+          spdlog::info("coordinator: {}: {}/{} {} re-applied after the restart: {}", svc.name,
                        module, kernel, command, reply.ok() ? "ok" : reply.error());
         } catch (const std::exception& e) {
           spdlog::warn("coordinator: re-applying {}/{} {}: {}", module, kernel, command, e.what());
@@ -105,8 +121,8 @@ void Providers::apply(const std::set<std::string>& in_use, const std::set<std::s
 
 bool Providers::ready(const std::string& service) const {
   for (const auto& [target, services] : targets_) {
-    for (const auto* svc : services) {
-      if (svc->name != service) continue;
+    for (const auto& svc : services) {
+      if (svc.name != service) continue;
       const auto want = desired(target, in_use_);
       if (want.empty()) continue;
       const auto it = applied_.find(target);

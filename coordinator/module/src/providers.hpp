@@ -23,7 +23,14 @@ class Providers {
     unsigned long incarnation = 0;
   };
 
-  Providers(const SystemSpec& system, ConfigClient& client);
+  /// The providers of `services` (the system file's, at first).
+  Providers(const std::vector<ServiceSpec>& services, ConfigClient& client);
+
+  /// A service added at run time: its providers are configured from now on as the file's are.
+  void add(const ServiceSpec& service);
+  /// A service removed at run time (nobody holds it): its providers are not configured for it
+  /// any more.
+  void remove(const std::string& service);
 
   /// Configures every provider as `in_use` (service names) asks: activate for a granted service
   /// with `granted: {activate: MODE}`, deactivate when all services of a provider are idle and
@@ -53,9 +60,8 @@ class Providers {
   std::string desired(const Target& target, const std::set<std::string>& in_use) const;
   bool send(const Target& target, const std::string& state);
 
-  const SystemSpec& system_;
   ConfigClient& client_;
-  std::map<Target, std::vector<const ServiceSpec*>> targets_;
+  std::map<Target, std::vector<ServiceSpec>> targets_;
   std::map<Target, Applied> applied_;
   std::map<Target, Clock::time_point> retry_at_;
   // Per service: the last accepted command per (module, kernel, command).

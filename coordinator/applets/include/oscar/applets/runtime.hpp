@@ -88,6 +88,9 @@ class Runtime {
   /// @throws std::invalid_argument for an unknown service, or naming what uses it.
   void remove_service(const std::string& service);
 
+  /// A bundle's name, read under the runtime's lock (the model changes while applets run).
+  std::string bundle_name(BundleId bundle) const;
+
   /// Calls `f` with the scheduler under the runtime's lock, then delivers notifications.
   void with_scheduler(const std::function<void(Scheduler&)>& f);
   RuntimeStats stats() const;
@@ -130,8 +133,7 @@ class Runtime {
   // The slot of an applet, found under the lock (slots_ grows while applets run); the slot
   // itself lives as long as the runtime. Not with the lock held.
   Slot& slot_of(AppletId id) const;
-  // A bundle's name, read under the lock (the model changes while applets run).
-  std::string bundle_name(BundleId bundle) const;
+
   // Runs one negotiation round for `bundle` and keeps or ends its chain (applet thread).
   std::optional<Notification> run_round(AppletContext& ctx, BundleId bundle,
                                         const NegotiationRound& round);
