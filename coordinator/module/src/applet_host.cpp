@@ -47,7 +47,8 @@ ConfigReply refused(const std::string& module, const std::string& why) {
 class AppletHost::Impl final : public AppletGateway {
  public:
   Impl(const SystemSpec& system, DdsParticipant& participant, const std::vector<std::string>& names,
-       std::string process, const std::vector<std::string>& plugin_path);
+       std::string process, const std::vector<std::string>& plugin_path,
+       const YAML::Node& joining = {}, const std::string& joining_file = {});
   ~Impl() override;
   void start();
   void stop();
@@ -78,6 +79,7 @@ class AppletHost::Impl final : public AppletGateway {
   };
   struct Hosted {
     std::string name;
+    std::string spec;  // a joining applet's entry (its hello carries it); empty: the file's
     AppletId id = 0;
     bool fail_stop = false;
     std::unique_ptr<Applet> applet;
@@ -103,6 +105,12 @@ class AppletHost::Impl final : public AppletGateway {
   };
 
   Hosted& hosted(const std::string& applet);
+  // Makes the applet `name` of type `type` (`where` names its entry in messages) and hosts it.
+  void host(const std::string& name, const std::string& type, const std::string& where,
+            const std::vector<std::string>& plugin_path, std::string spec);
+  // Reads the applets that join the running system (AppletHost's `joining`) into the model.
+  void read_joining(const YAML::Node& joining, const std::string& file,
+                    const std::vector<std::string>& plugin_path);
   void applet_main(Hosted& h);
   // Sends a hello while not welcomed, else a beat when one is due (any thread of the applet).
   void pump(Hosted& h);
@@ -304,7 +312,8 @@ class AppletHost::Impl::Context final : public applets::AppletContext {
 
 AppletHost::Impl::Impl(const SystemSpec& system, DdsParticipant& participant,
                        const std::vector<std::string>& names, std::string process,
-                       const std::vector<std::string>& plugin_path)
+                       const std::vector<std::string>& plugin_path, const YAML::Node& joining,
+                       const std::string& joining_file)
     : system_(system),
       config_(applet_system(system)),
       process_(std::move(process)),
@@ -326,24 +335,9 @@ AppletHost::Impl::Impl(const SystemSpec& system, DdsParticipant& participant,
       throw std::invalid_argument(
           fmt::format("{}: no applet '{}' in the coordinator: section", system.file, name));
     }
-    auto h = std::make_unique<Hosted>();
-    h->name = name;
-    h->id = config_.model.applet_id(name);
-    h->fail_stop = config_.model.applet(h->id).fail_stop;
-    h->session = internal::fresh_id();
-    AppletSetup setup(name, config_.applet_params[name], *this);
-    try {
-      h->applet = make_applet(spec->type, setup, plugin_path);
-    } catch (const std::exception& e) {
-      throw std::invalid_argument(fmt::format("{}: applet '{}': {}", spec->where, name, e.what()));
-    }
-    for (const BundleId b : config_.requested_at_start) {
-      if (config_.model.bundle(b).applet == h->id) {
-        h->requested[config_.model.bundle(b).name] = true;
-      }
-    }
-    hosted_.emplace(name, std::move(h));
+    host(name, spec->type, spec->where, plugin_path, "");
   }
+  if (joining && !joining.IsNull()) read_joining(joining, joining_file, plugin_path);
   notice_reader_ = std::make_unique<TopicReader<SchedNotice, SchedNoticePubSubType>>(
       participant, topics::sched_notice(),
       [this](const SchedNotice& n, const auto&) { on_notice(n); });
@@ -354,6 +348,74 @@ AppletHost::Impl::Impl(const SystemSpec& system, DdsParticipant& participant,
       std::make_unique<TopicReader<SchedCommandReply, SchedCommandReplyPubSubType>>(
           participant, topics::sched_command_reply(),
           [this](const SchedCommandReply& r, const auto&) { on_command_reply(r); });
+}
+
+void AppletHost::Impl::host(const std::string& name, const std::string& type,
+                            const std::string& where, const std::vector<std::string>& plugin_path,
+                            std::string spec) {
+  auto h = std::make_unique<Hosted>();
+  h->name = name;
+  h->spec = std::move(spec);
+  h->id = config_.model.applet_id(name);
+  h->fail_stop = config_.model.applet(h->id).fail_stop;
+  h->session = internal::fresh_id();
+  AppletSetup setup(name, config_.applet_params[name], *this);
+  try {
+    h->applet = make_applet(type, setup, plugin_path);
+  } catch (const std::exception& e) {
+    throw std::invalid_argument(fmt::format("{}: applet '{}': {}", where, name, e.what()));
+  }
+  for (const BundleId b : config_.requested_at_start) {
+    if (config_.model.bundle(b).applet == h->id) {
+      h->requested[config_.model.bundle(b).name] = true;
+    }
+  }
+  hosted_.emplace(name, std::move(h));
+}
+
+void AppletHost::Impl::read_joining(const YAML::Node& joining, const std::string& file,
+                                    const std::vector<std::string>& plugin_path) {
+  const auto addition = system_.parse_addition(joining, file, system_.services);
+  if (!addition.services.empty() || addition.applets.empty()) {
+    throw std::invalid_argument(fmt::format(
+        "{}: joining applets are listed under applets: only (services are added with `oscar "
+        "applets add`)",
+        file));
+  }
+  for (const auto& a : addition.applets) {
+    if (a.remote()) {
+      throw std::invalid_argument(
+          fmt::format("{}: applet '{}': a joining applet runs in this process; leave process: "
+                      "and host: out",
+                      a.where, a.name));
+    }
+    // Its bundles may use services added at run time: the coordinator checks them when it
+    // adds the applet; here only the names count.
+    for (const auto& b : a.node["bundles"]) {
+      for (const auto& r : b["resources"]) {
+        if (!r.IsMap() || !r["service"] || !r["service"].IsScalar()) continue;
+        const auto service = r["service"].as<std::string>();
+        if (!config_.model.find_service(service)) config_.model.add_service(service);
+      }
+    }
+    for (const auto& p : a.node["provides"]) {
+      if (p.IsScalar() && !config_.model.find_service(p.as<std::string>())) {
+        config_.model.add_service(p.as<std::string>());
+      }
+    }
+  }
+  auto loaded = applets::load_addition(config_.model, scheduler_doc(addition), file);
+  config_.model.add(loaded.addition);
+  for (auto& [name, params] : loaded.applet_params) config_.applet_params[name] = params;
+  for (const auto& [applet, bundle] : loaded.requested_at_start) {
+    config_.requested_at_start.push_back(
+        config_.model.bundle_id(config_.model.applet_id(applet), bundle));
+  }
+  for (const auto& a : addition.applets) {
+    YAML::Node entry;
+    entry["applets"].push_back(a.node);
+    host(a.name, a.type, a.where, plugin_path, YAML::Dump(entry));
+  }
 }
 
 AppletHost::Impl::~Impl() {
@@ -405,6 +467,7 @@ void AppletHost::Impl::pump(Hosted& h) {
       hello->applet(h.name);
       hello->process(process_);
       hello->session(h.session);
+      hello->spec(h.spec);
       for (const auto& [bundle, asked] : h.requested) {
         if (!asked) continue;
         SchedWish w;
@@ -768,6 +831,13 @@ AppletHost::AppletHost(const SystemSpec& system, DdsParticipant& participant,
                        const std::vector<std::string>& plugin_path)
     : impl_(std::make_unique<Impl>(system, participant, applets, std::move(process), plugin_path)) {
 }
+
+AppletHost::AppletHost(const SystemSpec& system, DdsParticipant& participant,
+                       const std::vector<std::string>& applets, const YAML::Node& joining,
+                       const std::string& joining_file, std::string process,
+                       const std::vector<std::string>& plugin_path)
+    : impl_(std::make_unique<Impl>(system, participant, applets, std::move(process), plugin_path,
+                                   joining, joining_file)) {}
 
 AppletHost::~AppletHost() = default;
 
