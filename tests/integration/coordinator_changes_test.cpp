@@ -59,11 +59,23 @@ Cli oscar_applets(const CoordinatedSystem& c, std::vector<std::string> args, con
   return {code.value_or(-1), p.output()};
 }
 
-std::string write_file(const char* name, const std::string& text) {
-  const auto path = test::temp_path(name) + ".yaml";
-  std::ofstream(path) << text;
-  return path;
-}
+// A YAML file of this test's own, removed at the end of the test.
+class TempYaml {
+ public:
+  TempYaml(const char* name, const std::string& text) : path_(test::temp_path(name) + ".yaml") {
+    std::ofstream(path_) << text;
+  }
+  ~TempYaml() {
+    std::error_code ec;
+    std::filesystem::remove(path_, ec);
+  }
+  TempYaml(const TempYaml&) = delete;
+  TempYaml& operator=(const TempYaml&) = delete;
+  operator const std::string&() const { return path_; }
+
+ private:
+  std::string path_;
+};
 
 constexpr const char* kCamera2 = R"(services:
   Camera2:
@@ -83,7 +95,8 @@ TEST(CoordinatorChanges, AServiceAndAnAppletAddedAtRunTimeActivateTheProviderWhe
   c.wait_plan([](const AppletPlan& p) { return has_service(p, "Camera"); }, "the first plan");
   EXPECT_FALSE(
       has_service(c.wait_plan([](const AppletPlan&) { return true; }, "a plan"), "Camera2"));
-  const auto spec = write_file("changes_add_spec", kCamera2);
+  const TempYaml file("changes_add_spec", kCamera2);
+  const std::string& spec = file;
   const auto added = oscar_applets(c, {"add", spec}, "changes_add_cli");
   ASSERT_EQ(added.code, 0) << added.output;
   EXPECT_THAT(added.output, HasSubstr(spec + ": added"));
@@ -170,7 +183,7 @@ TEST(CoordinatorChanges, BadSpecsAreRefusedNamingTheLineAndTheRule) {
   CoordinatedSystem c("changes_bad", two_camera_system());
   c.sys.running();
   auto refused = [&](const char* name, const std::string& text) {
-    const auto spec = write_file(name, text);
+    const TempYaml spec(name, text);
     const auto out = oscar_applets(c, {"add", spec}, name);
     EXPECT_EQ(out.code, 1) << out.output;
     return out.output;
@@ -205,7 +218,8 @@ constexpr const char* kVisitor = R"(applets:
 TEST(CoordinatorChanges, AnAppletJoiningFromAnotherProcessIsAddedAndRemovedWhenItIsKilled) {
   CoordinatedSystem c("changes_join", two_camera_system());
   c.sys.running();
-  const auto spec = write_file("changes_join_spec", kVisitor);
+  const TempYaml file("changes_join_spec", kVisitor);
+  const std::string& spec = file;
   // Named like the system's own processes (file and --domain), so that the fixture cleans up
   // after it too.
   test::Process visitor({test::bin("oscar-applet"), c.sys.file(), "--applets", spec, "--module",
@@ -245,7 +259,8 @@ TEST(CoordinatorChanges, AnAppletJoiningFromAnotherProcessIsAddedAndRemovedWhenI
 TEST(CoordinatorChanges, ARestartedCoordinatorAddsAJoinedAppletAgainFromItsHello) {
   CoordinatedSystem c("changes_rejoin", two_camera_system());
   c.sys.running();
-  const auto spec = write_file("changes_rejoin_spec", kVisitor);
+  const TempYaml file("changes_rejoin_spec", kVisitor);
+  const std::string& spec = file;
   test::Process visitor({test::bin("oscar-applet"), c.sys.file(), "--applets", spec, "--module",
                          "visitors", "--domain", std::to_string(c.sys.domain())},
                         test::temp_path("changes_rejoin_visitor") + ".out");
