@@ -37,8 +37,9 @@ ServiceSpec::Provider provider_of(const SystemSpec& s, const YAML::Node& node,
                                   const std::string& what) {
   const auto t = text(s.file, node, what + " entry");
   const auto slash = t.find('/');
-  ServiceSpec::Provider p{t.substr(0, slash),
-                          slash == std::string::npos ? "" : t.substr(slash + 1)};
+  ServiceSpec::Provider p;
+  p.module = t.substr(0, slash);
+  p.kernel = slash == std::string::npos ? "" : t.substr(slash + 1);
   const auto* m = s.find_module(p.module);
   if (!m) {
     std::vector<std::string> names;
@@ -50,6 +51,9 @@ ServiceSpec::Provider provider_of(const SystemSpec& s, const YAML::Node& node,
   if (!p.kernel.empty() && !m->spec.find_kernel(p.kernel)) {
     fail(s.file, node, fmt::format("{}: module '{}' has no kernel '{}'", what, p.module, p.kernel));
   }
+  p.param_kernel = !p.kernel.empty()             ? p.kernel
+                   : m->spec.kernels.size() == 1 ? m->spec.kernels.front().name
+                                                 : "";
   return p;
 }
 
@@ -157,9 +161,10 @@ void check_cycles(const SystemSpec& s) {
 
 // A service is provided by modules (provided_by) or by one applet (its provides:, seed 000
 // §4.2.3: the UI service of §5.3 is the UIService applet's), never by both or by nobody.
-void check_service_providers(const SystemSpec& s, const CoordinatorSpec& c) {
+void check_service_providers(const SystemSpec& s, const std::vector<AppletSpec>& applets,
+                             std::size_t first_service = 0) {
   std::map<std::string, std::string> by_applet;  // service -> applet
-  for (const auto& a : c.applets) {
+  for (const auto& a : applets) {
     const auto provides = a.node["provides"];
     if (!provides) continue;
     for (const auto& p : list(s.file, provides, "applet '" + a.name + "'.provides", "[UI]")) {
@@ -184,7 +189,8 @@ void check_service_providers(const SystemSpec& s, const CoordinatorSpec& c) {
       }
     }
   }
-  for (const auto& svc : s.services) {
+  for (std::size_t i = first_service; i < s.services.size(); ++i) {
+    const auto& svc = s.services[i];
     if (svc.providers.empty() && !by_applet.contains(svc.name)) {
       throw std::invalid_argument(fmt::format(
           "{}: service '{}': nobody provides it: name its modules in provided_by, or list it "
@@ -232,8 +238,12 @@ void parse_wishes(const SystemSpec& s, CoordinatorSpec& c, const YAML::Node& nod
 
 }  // namespace
 
-void parse_services(SystemSpec& s, const YAML::Node& node) {
-  if (!node) return;
+namespace {
+
+// Reads `services:` and appends them to s.services; the services there before are known to
+// their needs (and their names are taken).
+void append_services(SystemSpec& s, const YAML::Node& node) {
+  const std::size_t first = s.services.size();
   if (!node.IsMap()) fail(s.file, node, "services: a map of service names to services");
   for (const auto& kv : node) {
     ServiceSpec svc;
@@ -265,7 +275,8 @@ void parse_services(SystemSpec& s, const YAML::Node& node) {
     s.services.push_back(std::move(svc));
   }
   // Needs in a second pass: their order in the file does not matter.
-  for (auto& svc : s.services) {
+  for (std::size_t i = first; i < s.services.size(); ++i) {
+    auto& svc = s.services[i];
     const auto what = "service '" + svc.name + "'";
     const auto needs = node[svc.name]["needs"];
     if (!needs) continue;
@@ -290,6 +301,89 @@ void parse_services(SystemSpec& s, const YAML::Node& node) {
     }
   }
   check_cycles(s);
+}
+
+bool identifier(const std::string& name) {
+  return !name.empty() && !std::isdigit(static_cast<unsigned char>(name[0])) &&
+         std::all_of(name.begin(), name.end(), [](char ch) {
+           return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
+         });
+}
+
+// One entry of `applets:`; `coordinator_host` is where a process without a host runs, and
+// `process_hosts` (process -> host) keeps a process on one host.
+AppletSpec parse_applet(const SystemSpec& s, const YAML::Node& a,
+                        const std::string& coordinator_host,
+                        std::map<std::string, std::string>& process_hosts) {
+  auto known_host = [&](const std::string& h) {
+    return std::any_of(s.hosts.begin(), s.hosts.end(),
+                       [&](const HostSpec& x) { return x.name == h; });
+  };
+  if (!a.IsMap()) fail(s.file, a, "coordinator.applets: each applet is a map with type and name");
+  check_yaml_keys(
+      a, s.file, "applet",
+      {"type", "name", "params", "bundles", "fail_stop", "process", "host", "provides"});
+  AppletSpec spec{text(s.file, a["type"], "applet type"),
+                  text(s.file, a["name"], "applet name"),
+                  a,
+                  yaml_where(s.file, a),
+                  "",
+                  ""};
+  const auto what = fmt::format("applet '{}'", spec.name);
+  if (a["host"]) {
+    spec.host = text(s.file, a["host"], what + ".host");
+    if (!known_host(spec.host)) {
+      std::vector<std::string> names;
+      for (const auto& h : s.hosts) names.push_back(h.name);
+      fail(s.file, a["host"],
+           fmt::format("{}: unknown host '{}' (hosts: {})", what, spec.host,
+                       fmt::join(names, ", ")));
+    }
+  }
+  if (a["process"]) {
+    spec.process = text(s.file, a["process"], what + ".process");
+    if (!identifier(spec.process)) {
+      fail(s.file, a["process"],
+           fmt::format("{}.process '{}': a process name is a module name, an identifier "
+                       "(letters, digits, _)",
+                       what, spec.process));
+    }
+    if (spec.process == SystemSpec::kCoordinatorModule) {
+      fail(s.file, a["process"],
+           fmt::format("{}.process: '{}' is the coordinator's own process; leave process: "
+                       "out to run the applet there",
+                       what, spec.process));
+    }
+    if (s.find_module(spec.process)) {
+      fail(s.file, a["process"],
+           fmt::format("{}.process: '{}' is a module of the system; an applet process is a "
+                       "module of its own, name it differently",
+                       what, spec.process));
+    }
+  } else if (!spec.host.empty()) {
+    spec.process = "applets_" + spec.host;
+    for (char& ch : spec.process) {
+      if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+    }
+  }
+  if (spec.remote()) {
+    if (spec.host.empty()) spec.host = coordinator_host;
+    const auto [it, added] = process_hosts.emplace(spec.process, spec.host);
+    if (!added && it->second != spec.host) {
+      fail(s.file, a["host"] ? a["host"] : a["process"],
+           fmt::format("{}: process '{}' runs on host '{}' (an applet before says so); a "
+                       "process has one host",
+                       what, spec.process, it->second));
+    }
+  }
+  return spec;
+}
+
+}  // namespace
+
+void parse_services(SystemSpec& s, const YAML::Node& node) {
+  if (!node) return;
+  append_services(s, node);
 }
 
 void parse_coordinator(SystemSpec& s, const YAML::Node& node) {
@@ -332,75 +426,50 @@ void parse_coordinator(SystemSpec& s, const YAML::Node& node) {
   if (node["applets"]) {
     for (const auto& a :
          list(s.file, node["applets"], "coordinator.applets", "[{type: T, name: N}]")) {
-      if (!a.IsMap())
-        fail(s.file, a, "coordinator.applets: each applet is a map with type and name");
-      check_yaml_keys(
-          a, s.file, "applet",
-          {"type", "name", "params", "bundles", "fail_stop", "process", "host", "provides"});
-      AppletSpec spec{text(s.file, a["type"], "applet type"),
-                      text(s.file, a["name"], "applet name"),
-                      a,
-                      yaml_where(s.file, a),
-                      "",
-                      ""};
-      const auto what = fmt::format("applet '{}'", spec.name);
-      if (a["host"]) {
-        spec.host = text(s.file, a["host"], what + ".host");
-        if (!known_host(spec.host)) {
-          std::vector<std::string> names;
-          for (const auto& h : s.hosts) names.push_back(h.name);
-          fail(s.file, a["host"],
-               fmt::format("{}: unknown host '{}' (hosts: {})", what, spec.host,
-                           fmt::join(names, ", ")));
-        }
-      }
-      if (a["process"]) {
-        spec.process = text(s.file, a["process"], what + ".process");
-        const bool identifier = !spec.process.empty() &&
-                                !std::isdigit(static_cast<unsigned char>(spec.process[0])) &&
-                                std::all_of(spec.process.begin(), spec.process.end(), [](char ch) {
-                                  return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
-                                });
-        if (!identifier) {
-          fail(s.file, a["process"],
-               fmt::format("{}.process '{}': a process name is a module name, an identifier "
-                           "(letters, digits, _)",
-                           what, spec.process));
-        }
-        if (spec.process == SystemSpec::kCoordinatorModule) {
-          fail(s.file, a["process"],
-               fmt::format("{}.process: '{}' is the coordinator's own process; leave process: "
-                           "out to run the applet there",
-                           what, spec.process));
-        }
-        if (s.find_module(spec.process)) {
-          fail(s.file, a["process"],
-               fmt::format("{}.process: '{}' is a module of the system; an applet process is a "
-                           "module of its own, name it differently",
-                           what, spec.process));
-        }
-      } else if (!spec.host.empty()) {
-        spec.process = "applets_" + spec.host;
-        for (char& ch : spec.process) {
-          if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
-        }
-      }
-      if (spec.remote()) {
-        if (spec.host.empty()) spec.host = c.host;
-        const auto [it, added] = process_hosts.emplace(spec.process, spec.host);
-        if (!added && it->second != spec.host) {
-          fail(s.file, a["host"] ? a["host"] : a["process"],
-               fmt::format("{}: process '{}' runs on host '{}' (an applet before says so); a "
-                           "process has one host",
-                           what, spec.process, it->second));
-        }
-      }
-      c.applets.push_back(std::move(spec));
+      c.applets.push_back(parse_applet(s, a, c.host, process_hosts));
     }
   }
   if (node["wishes"]) parse_wishes(s, c, node["wishes"]);
-  check_service_providers(s, c);
+  check_service_providers(s, c.applets);
   s.coordinator = std::move(c);
 }
 
 }  // namespace oscar::internal
+
+namespace oscar {
+
+SystemAddition SystemSpec::parse_addition(const YAML::Node& addition,
+                                          const std::string& addition_file,
+                                          const std::vector<ServiceSpec>& services_now) const {
+  using internal::fail;
+  // The running system as it is now, read from `addition_file`: messages point into the addition.
+  SystemSpec now = *this;
+  now.file = addition_file;
+  now.services = services_now;
+  now.root = addition;
+  if (!addition || !addition.IsMap()) {
+    fail(addition_file, addition, "an addition is a map with services: and/or applets:");
+  }
+  check_yaml_keys(addition, addition_file, "an addition", {"services", "applets"});
+  if (!addition["services"] && !addition["applets"]) {
+    fail(addition_file, addition, "an addition names services: or applets: (or both)");
+  }
+  if (!coordinator)
+    fail(addition_file, addition, "the system has no coordinator: section (who grants them)");
+  const std::size_t first = now.services.size();
+  if (addition["services"]) internal::append_services(now, addition["services"]);
+  SystemAddition out;
+  std::map<std::string, std::string> process_hosts;
+  if (addition["applets"]) {
+    for (const auto& a :
+         internal::list(addition_file, addition["applets"], "applets", "[{type: T, name: N}]")) {
+      out.applets.push_back(internal::parse_applet(now, a, coordinator->host, process_hosts));
+    }
+  }
+  internal::check_service_providers(now, out.applets, first);
+  out.services.assign(now.services.begin() + static_cast<std::ptrdiff_t>(first),
+                      now.services.end());
+  return out;
+}
+
+}  // namespace oscar

@@ -387,3 +387,58 @@ coordinator:
 
 }  // namespace
 }  // namespace oscar
+
+namespace oscar {
+namespace {
+
+std::string addition_error(const SystemSpec& s, const std::string& text) {
+  try {
+    s.parse_addition(YAML::Load(text), "add.yaml", s.services);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(SystemAddition, ServicesAndAppletsAreReadAsInTheSystemFile) {
+  const auto s = parse(kGood);
+  const auto add = s.parse_addition(YAML::Load(R"(services:
+  Nav: { provided_by: [drive/pilot], needs: [Pilot], granted: { activate: "continuous:20ms" } }
+  Plan: {}
+applets:
+  - { type: event_applet, name: navigator, provides: [Plan],
+      bundles: [ { name: go, resources: [ { service: Nav } ] } ] }
+)"),
+                                    "add.yaml", s.services);
+  ASSERT_EQ(add.services.size(), 2u);
+  EXPECT_EQ(add.services[0].name, "Nav");
+  EXPECT_EQ(add.services[0].providers.at(0).text(), "drive/pilot");
+  EXPECT_EQ(add.services[0].needs.at(0).service, "Pilot");
+  EXPECT_EQ(add.services[0].activate, std::optional<std::string>("continuous:20ms"));
+  EXPECT_EQ(add.services[0].where, "add.yaml:2");
+  ASSERT_EQ(add.applets.size(), 1u);
+  EXPECT_EQ(add.applets[0].type, "event_applet");
+  EXPECT_EQ(add.applets[0].where, "add.yaml:5");
+  EXPECT_FALSE(add.applets[0].remote());
+}
+
+TEST(SystemAddition, BadAdditionsAreErrorsWithTheirLineInTheAddition) {
+  const auto s = parse(kGood);
+  EXPECT_EQ(addition_error(s, "services:\n  Camera: { provided_by: [cam] }\n"),
+            "add.yaml:2: duplicate service 'Camera'");
+  EXPECT_THAT(addition_error(s, "services:\n  X:\n    provided_by: [nowhere]\n"),
+              HasSubstr("add.yaml:3: service 'X'.provided_by: no module 'nowhere' in the system"));
+  EXPECT_THAT(addition_error(s, "services:\n  X: { provided_by: [cam], needs: [Y] }\n"),
+              HasSubstr("add.yaml:2: service 'X' needs service 'Y', which is not declared"));
+  EXPECT_THAT(addition_error(s, "services:\n  X: {}\n"),
+              HasSubstr("add.yaml:2: service 'X': nobody provides it"));
+  EXPECT_THAT(addition_error(s, "applets:\n  - { type: t, name: a, provides: [Camera] }\n"),
+              HasSubstr("add.yaml:2: applet 'a' provides service 'Camera', which modules provide"));
+  EXPECT_THAT(addition_error(s, "applets:\n  - { type: t, name: a, colour: red }\n"),
+              HasSubstr("add.yaml:2: applet: unknown key 'colour'"));
+  EXPECT_THAT(addition_error(s, "modules: []\n"), HasSubstr("unknown key 'modules'"));
+  EXPECT_THAT(addition_error(s, "{}\n"), HasSubstr("names services: or applets:"));
+}
+
+}  // namespace
+}  // namespace oscar

@@ -3,6 +3,7 @@
 // on a booted system with every applet in a process of its own.
 // oscar-applets ps [--json] — the plan of the running system's coordinator.
 // oscar-applets graph [-o FILE.svg] — the same plan as a picture.
+// oscar-applets add FILE.yaml / remove --applet NAME | --service NAME — change the running system.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
@@ -13,6 +14,7 @@
 #include "oscar/applets/dot.hpp"
 #include "oscar/applets/scenario.hpp"
 #ifdef OSCAR_APPLETS_LIVE
+#include "change.hpp"
 #include "live.hpp"
 #include "ps.hpp"
 #endif
@@ -49,9 +51,20 @@ int main(int argc, char** argv) {
   oscar::tools::add_ps(app, ps);
   oscar::tools::GraphOptions graph;
   oscar::tools::add_graph(app, graph);
+  oscar::tools::ChangeOptions change;
+  oscar::tools::add_change(app, change);
 #endif
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 #ifdef OSCAR_APPLETS_LIVE
+  if (change.add->parsed() || change.remove->parsed()) {
+    try {
+      return oscar::tools::run_change(change);
+    } catch (const std::exception& e) {
+      std::cerr << "oscar applets " << (change.add->parsed() ? "add" : "remove") << ": " << e.what()
+                << "\n";
+      return 2;
+    }
+  }
   if (ps.command->parsed() || graph.command->parsed()) {
     try {
       return ps.command->parsed() ? oscar::tools::run_ps(ps) : oscar::tools::run_graph(graph);

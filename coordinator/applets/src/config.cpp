@@ -88,6 +88,166 @@ std::map<std::string, std::string> params_of(const YAML::Node& node, const std::
 
 }  // namespace
 
+namespace {
+
+// Reads `services:` (a list) into `model`; returns the ids it added.
+std::vector<ServiceId> read_services(Model& model, const YAML::Node& services,
+                                     const std::string& file, SystemConfig& c) {
+  std::vector<ServiceId> added;
+  for (const auto& s : services) {
+    allow_keys(s, file, "service", {"name", "exclusive_only", "depends_on", "params"});
+    const std::string name = text(s["name"], file, "service name");
+    const bool exclusive_only = flag(s["exclusive_only"], file, "exclusive_only");
+    try {
+      added.push_back(model.add_service(name, exclusive_only));
+    } catch (const std::invalid_argument& e) {
+      fail_at(s["name"], file, e.what());
+    }
+    c.service_params[name] = params_of(s["params"], file);
+  }
+  // Dependencies in a second pass so that their order in the file does not matter.
+  for (const auto& s : services) {
+    const YAML::Node deps = s["depends_on"];
+    if (!deps) continue;
+    const std::string name = s["name"].as<std::string>();
+    if (!deps.IsSequence())
+      fail_at(deps, file, "service '" + name + "': depends_on must be a list");
+    for (const auto& d : deps) {
+      // Not `YAML::Node svc = d; svc = d["service"];`: assigning to a node that refers to `d`
+      // rewrites `d` itself (yaml-cpp nodes are references), and d["access"] then fails.
+      if (d.IsMap()) allow_keys(d, file, "dependency", {"service", "access"});
+      const YAML::Node svc = d.IsMap() ? d["service"] : d;
+      const Access access =
+          d.IsMap() && d["access"] ? access_of(d["access"], file) : Access::kExclusive;
+      const std::string dep = text(svc, file, "dependency");
+      const auto id = model.find_service(dep);
+      if (!id) {
+        fail_at(svc, file, "service '" + name + "' depends on unknown service '" + dep + "'");
+      }
+      try {
+        model.add_dependency(model.service_id(name), *id, access);
+      } catch (const std::invalid_argument& e) {
+        fail_at(svc, file, e.what());
+      }
+    }
+  }
+  return added;
+}
+
+// A bundle's `deadline: {early_ms, duration_ms, finish_ms}`, counted from each request; checked
+// with the context switch (eq. 4.9) here, with its line, rather than at the request.
+void set_request_deadline(Model& model, const SchedulerOptions& options, BundleId bundle,
+                          const YAML::Node& node, const std::string& file, const std::string& who) {
+  if (!node.IsMap()) {
+    fail_at(node, file,
+            who +
+                ": deadline must be a map such as {early_ms: 0, duration_ms: 500, "
+                "finish_ms: 2000} (counted from each request)");
+  }
+  allow_keys(node, file, "deadline", {"early_ms", "duration_ms", "finish_ms"});
+  if (!node["finish_ms"]) fail_at(node, file, who + ": deadline needs finish_ms");
+  auto ms_of = [&](const char* key) {
+    return node[key] ? milliseconds{number(node[key], file, key)} : milliseconds{0};
+  };
+  Deadline d{ms_of("early_ms"), ms_of("duration_ms"), ms_of("finish_ms")};
+  try {
+    if (d.t_early + d.t_duration + options.context_switch > d.t_finish) {
+      throw std::invalid_argument(
+          who +
+          ": deadline needs early_ms + duration_ms + context_switch_ms <= finish_ms (eq. 4.9), "
+          "but " +
+          std::to_string(d.t_early.count()) + " + " + std::to_string(d.t_duration.count()) + " + " +
+          std::to_string(options.context_switch.count()) + " > " +
+          std::to_string(d.t_finish.count()));
+    }
+    model.set_request_deadline(bundle, d);
+  } catch (const std::invalid_argument& e) {
+    fail_at(node, file, e.what());
+  }
+}
+
+// Reads `applets:` (a list) into `model`; returns the ids it added. Bundles with
+// `requested: true` go to c.requested_at_start, their nodes to `requested_at`.
+std::vector<AppletId> read_applets(Model& model, const YAML::Node& applets, const std::string& file,
+                                   SystemConfig& c, std::vector<YAML::Node>& requested_at) {
+  std::vector<AppletId> added;
+  if (applets && !applets.IsSequence()) fail_at(applets, file, "'applets' must be a list");
+  for (const auto& a : applets) {
+    allow_keys(a, file, "applet", {"name", "provides", "bundles", "params", "fail_stop"});
+    const std::string name = text(a["name"], file, "applet name");
+    AppletId id = 0;
+    const bool fail_stop = flag(a["fail_stop"], file, "fail_stop");
+    try {
+      id = model.add_applet(name, fail_stop);
+    } catch (const std::invalid_argument& e) {
+      fail_at(a["name"], file, e.what());
+    }
+    added.push_back(id);
+    c.applet_params[name] = params_of(a["params"], file);
+    // A scalar or a mapping where a list belongs would be read as an empty list: say so.
+    for (const char* key : {"provides", "bundles"}) {
+      if (a[key] && !a[key].IsSequence()) {
+        fail_at(a[key], file,
+                "applet '" + name + "': " + key + " must be a list" +
+                    (std::string(key) == "provides" ? " of services, such as [UI]"
+                                                    : " of bundles, such as [{name: b, ...}]"));
+      }
+    }
+    for (const auto& p : a["provides"]) {
+      try {
+        model.provide(id, service_at(model, p, file, "applet '" + name + "' provides"));
+      } catch (const std::invalid_argument& e) {
+        if (std::string(e.what()).rfind(file, 0) == 0) throw;
+        fail_at(p, file, e.what());
+      }
+    }
+    for (const auto& b : a["bundles"]) {
+      allow_keys(b, file, "bundle", {"name", "priority", "resources", "requested", "deadline"});
+      const std::string bname = text(b["name"], file, "bundle name");
+      const std::string who = "applet '" + name + "' bundle '" + bname + "'";
+      std::vector<std::pair<ServiceId, Access>> resources;
+      if (!b["resources"] || !b["resources"].IsSequence()) {
+        fail_at(b, file, who + ": 'resources' must be a list");
+      }
+      for (const auto& r : b["resources"]) {
+        allow_keys(r, file, "resource", {"service", "access"});
+        const Access access = r["access"] ? access_of(r["access"], file) : Access::kExclusive;
+        resources.emplace_back(service_at(model, r["service"], file, who), access);
+      }
+      const int prio = b["priority"] ? parse_priority(b["priority"], file) : kPriorityNormal;
+      const bool requested = flag(b["requested"], file, "requested");
+      try {
+        const BundleId bid = model.add_bundle(id, bname, resources, prio);
+        if (const auto d = b["deadline"]) set_request_deadline(model, c.options, bid, d, file, who);
+        if (requested) {
+          c.requested_at_start.push_back(bid);
+          requested_at.push_back(b);
+        }
+      } catch (const std::invalid_argument& e) {
+        fail_at(b, file, e.what());
+      }
+    }
+  }
+  return added;
+}
+
+// Requests at start are checked now, with their line, not when a run makes them (e.g. two
+// bundles of one applet that both want an exclusive-only service).
+void check_requests(const Model& model, const SchedulerOptions& options,
+                    const std::vector<BundleId>& requested,
+                    const std::vector<YAML::Node>& requested_at, const std::string& file) {
+  Scheduler probe(model, options);
+  for (std::size_t i = 0; i < requested.size(); ++i) {
+    try {
+      probe.request(requested[i]);
+    } catch (const std::invalid_argument& e) {
+      fail_at(requested_at[i], file, e.what());
+    }
+  }
+}
+
+}  // namespace
+
 std::string where(const YAML::Node& node, const std::string& file) {
   if (!node || node.Mark().line < 0) return file;
   return file + ":" + std::to_string(node.Mark().line + 1);
@@ -127,38 +287,6 @@ int parse_priority(const YAML::Node& node, const std::string& file) {
   return static_cast<int>(p);
 }
 
-namespace {
-// A bundle's `deadline: {early_ms, duration_ms, finish_ms}`, counted from each request; checked
-// with the context switch (eq. 4.9) here, with its line, rather than at the request.
-void set_request_deadline(SystemConfig& c, BundleId bundle, const YAML::Node& node,
-                          const std::string& file, const std::string& who) {
-  if (!node.IsMap()) {
-    fail_at(node, file,
-            who + ": deadline must be a map such as {early_ms: 0, duration_ms: 500, "
-                  "finish_ms: 2000} (counted from each request)");
-  }
-  allow_keys(node, file, "deadline", {"early_ms", "duration_ms", "finish_ms"});
-  if (!node["finish_ms"]) fail_at(node, file, who + ": deadline needs finish_ms");
-  auto ms_of = [&](const char* key) {
-    return node[key] ? milliseconds{number(node[key], file, key)} : milliseconds{0};
-  };
-  Deadline d{ms_of("early_ms"), ms_of("duration_ms"), ms_of("finish_ms")};
-  try {
-    if (d.t_early + d.t_duration + c.options.context_switch > d.t_finish) {
-      throw std::invalid_argument(
-          who + ": deadline needs early_ms + duration_ms + context_switch_ms <= finish_ms (eq. 4.9), "
-                "but " + std::to_string(d.t_early.count()) + " + " +
-          std::to_string(d.t_duration.count()) + " + " +
-          std::to_string(c.options.context_switch.count()) + " > " +
-          std::to_string(d.t_finish.count()));
-    }
-    c.model.set_request_deadline(bundle, d);
-  } catch (const std::invalid_argument& e) {
-    fail_at(node, file, e.what());
-  }
-}
-}  // namespace
-
 SystemConfig load_system(const YAML::Node& root, const std::string& file) {
   SystemConfig c;
   if (!root || !root.IsMap()) fail_at(root, file, "the document must be a mapping");
@@ -185,112 +313,64 @@ SystemConfig load_system(const YAML::Node& root, const std::string& file) {
   if (!services || !services.IsSequence()) {
     fail_at(services ? services : root, file, "'services' must be a list of services");
   }
-  for (const auto& s : services) {
-    allow_keys(s, file, "service", {"name", "exclusive_only", "depends_on", "params"});
-    const std::string name = text(s["name"], file, "service name");
-    const bool exclusive_only = flag(s["exclusive_only"], file, "exclusive_only");
-    try {
-      c.model.add_service(name, exclusive_only);
-    } catch (const std::invalid_argument& e) {
-      fail_at(s["name"], file, e.what());
-    }
-    c.service_params[name] = params_of(s["params"], file);
-  }
-  // Dependencies in a second pass so that their order in the file does not matter.
-  for (const auto& s : services) {
-    const YAML::Node deps = s["depends_on"];
-    if (!deps) continue;
-    const std::string name = s["name"].as<std::string>();
-    if (!deps.IsSequence())
-      fail_at(deps, file, "service '" + name + "': depends_on must be a list");
-    for (const auto& d : deps) {
-      // Not `YAML::Node svc = d; svc = d["service"];`: assigning to a node that refers to `d`
-      // rewrites `d` itself (yaml-cpp nodes are references), and d["access"] then fails.
-      if (d.IsMap()) allow_keys(d, file, "dependency", {"service", "access"});
-      const YAML::Node svc = d.IsMap() ? d["service"] : d;
-      const Access access =
-          d.IsMap() && d["access"] ? access_of(d["access"], file) : Access::kExclusive;
-      const std::string dep = text(svc, file, "dependency");
-      const auto id = c.model.find_service(dep);
-      if (!id) {
-        fail_at(svc, file, "service '" + name + "' depends on unknown service '" + dep + "'");
-      }
-      try {
-        c.model.add_dependency(c.model.service_id(name), *id, access);
-      } catch (const std::invalid_argument& e) {
-        fail_at(svc, file, e.what());
-      }
-    }
-  }
-  const YAML::Node applets = root["applets"];
-  if (applets && !applets.IsSequence()) fail_at(applets, file, "'applets' must be a list");
+  read_services(c.model, services, file, c);
   std::vector<YAML::Node> requested_at;  // per requested_at_start entry, for messages
-  for (const auto& a : applets) {
-    allow_keys(a, file, "applet", {"name", "provides", "bundles", "params", "fail_stop"});
-    const std::string name = text(a["name"], file, "applet name");
-    AppletId id = 0;
-    const bool fail_stop = flag(a["fail_stop"], file, "fail_stop");
-    try {
-      id = c.model.add_applet(name, fail_stop);
-    } catch (const std::invalid_argument& e) {
-      fail_at(a["name"], file, e.what());
-    }
-    c.applet_params[name] = params_of(a["params"], file);
-    // A scalar or a mapping where a list belongs would be read as an empty list: say so.
-    for (const char* key : {"provides", "bundles"}) {
-      if (a[key] && !a[key].IsSequence()) {
-        fail_at(a[key], file,
-                "applet '" + name + "': " + key + " must be a list" +
-                    (std::string(key) == "provides" ? " of services, such as [UI]"
-                                                    : " of bundles, such as [{name: b, ...}]"));
-      }
-    }
-    for (const auto& p : a["provides"]) {
-      try {
-        c.model.provide(id, service_at(c.model, p, file, "applet '" + name + "' provides"));
-      } catch (const std::invalid_argument& e) {
-        if (std::string(e.what()).rfind(file, 0) == 0) throw;
-        fail_at(p, file, e.what());
-      }
-    }
-    for (const auto& b : a["bundles"]) {
-      allow_keys(b, file, "bundle", {"name", "priority", "resources", "requested", "deadline"});
-      const std::string bname = text(b["name"], file, "bundle name");
-      const std::string who = "applet '" + name + "' bundle '" + bname + "'";
-      std::vector<std::pair<ServiceId, Access>> resources;
-      if (!b["resources"] || !b["resources"].IsSequence()) {
-        fail_at(b, file, who + ": 'resources' must be a list");
-      }
-      for (const auto& r : b["resources"]) {
-        allow_keys(r, file, "resource", {"service", "access"});
-        const Access access = r["access"] ? access_of(r["access"], file) : Access::kExclusive;
-        resources.emplace_back(service_at(c.model, r["service"], file, who), access);
-      }
-      const int prio = b["priority"] ? parse_priority(b["priority"], file) : kPriorityNormal;
-      const bool requested = flag(b["requested"], file, "requested");
-      try {
-        const BundleId bid = c.model.add_bundle(id, bname, resources, prio);
-        if (const auto d = b["deadline"]) set_request_deadline(c, bid, d, file, who);
-        if (requested) {
-          c.requested_at_start.push_back(bid);
-          requested_at.push_back(b);
-        }
-      } catch (const std::invalid_argument& e) {
-        fail_at(b, file, e.what());
-      }
-    }
-  }
-  // Requests at start are checked now, with their line, not when a run makes them (e.g. two
-  // bundles of one applet that both want an exclusive-only service).
-  Scheduler probe(c.model, c.options);
-  for (std::size_t i = 0; i < c.requested_at_start.size(); ++i) {
-    try {
-      probe.request(c.requested_at_start[i]);
-    } catch (const std::invalid_argument& e) {
-      fail_at(requested_at[i], file, e.what());
-    }
-  }
+  read_applets(c.model, root["applets"], file, c, requested_at);
+  check_requests(c.model, c.options, c.requested_at_start, requested_at, file);
   return c;
+}
+
+LoadedAddition load_addition(const Model& current, const YAML::Node& root,
+                             const std::string& file) {
+  if (!root || !root.IsMap()) fail_at(root, file, "the document must be a mapping");
+  allow_keys(root, file, "an addition", {"services", "applets"});
+  const YAML::Node services = root["services"];
+  if (services && !services.IsSequence()) {
+    fail_at(services, file, "'services' must be a list of services");
+  }
+  if (!services && !root["applets"]) {
+    fail_at(root, file, "an addition names services: or applets: (or both)");
+  }
+  // Read into a copy of the running model, so that every message has its line; then what the
+  // copy gained is the addition, by names.
+  SystemConfig c;
+  Model probe = current;
+  const auto service_ids =
+      services ? read_services(probe, services, file, c) : std::vector<ServiceId>{};
+  std::vector<YAML::Node> requested_at;
+  const auto applet_ids = read_applets(probe, root["applets"], file, c, requested_at);
+  check_requests(probe, {}, c.requested_at_start, requested_at, file);
+  LoadedAddition out;
+  for (const ServiceId id : service_ids) {
+    const Service& svc = probe.service(id);
+    NewService n{svc.name, svc.exclusive_only, {}};
+    for (const Dependency& d : svc.dependencies) {
+      n.needs.emplace_back(probe.service(d.service).name, d.access);
+    }
+    out.addition.services.push_back(std::move(n));
+  }
+  for (const AppletId id : applet_ids) {
+    const Applet& a = probe.applet(id);
+    NewApplet n{a.name, a.fail_stop, {}, {}};
+    for (const ServiceId p : a.provides) n.provides.push_back(probe.service(p).name);
+    for (const BundleId b : a.bundles) {
+      NewBundle nb{
+          probe.bundle(b).name, probe.bundle(b).priority, {}, probe.bundle(b).request_deadline};
+      for (const ResourceId r : probe.bundle(b).resources) {
+        nb.resources.emplace_back(probe.service(probe.resource(r).service).name,
+                                  probe.resource(r).access);
+      }
+      n.bundles.push_back(std::move(nb));
+    }
+    out.addition.applets.push_back(std::move(n));
+  }
+  for (const BundleId b : c.requested_at_start) {
+    out.requested_at_start.emplace_back(probe.applet(probe.bundle(b).applet).name,
+                                        probe.bundle(b).name);
+  }
+  out.applet_params = std::move(c.applet_params);
+  out.service_params = std::move(c.service_params);
+  return out;
 }
 
 }  // namespace oscar::applets

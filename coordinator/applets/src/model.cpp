@@ -28,6 +28,10 @@ ServiceId Model::add_service(std::string name, bool exclusive_only) {
 void Model::add_dependency(ServiceId service, ServiceId dependency, Access access) {
   Service& s = services_.at(service);
   const std::string& dep_name = services_.at(dependency).name;
+  if (s.removed) fail("service '" + s.name + "' was removed; it needs nothing any more");
+  if (services_[dependency].removed) {
+    fail("service '" + s.name + "' cannot need service '" + dep_name + "': it was removed");
+  }
   if (service == dependency) fail("service '" + s.name + "' cannot depend on itself");
   for (const Dependency& d : s.dependencies) {
     if (d.service == dependency) {
@@ -58,6 +62,10 @@ AppletId Model::add_applet(std::string name, bool fail_stop) {
 void Model::provide(AppletId applet, ServiceId service) {
   Service& s = services_.at(service);
   Applet& a = applets_.at(applet);
+  if (a.removed) fail("applet '" + a.name + "' was removed; it provides nothing any more");
+  if (s.removed) {
+    fail("applet '" + a.name + "' cannot provide service '" + s.name + "': it was removed");
+  }
   if (s.provider && *s.provider != applet) {
     fail("service '" + s.name + "' is already provided by applet '" + applets_[*s.provider].name +
          "'; applet '" + a.name + "' cannot provide it too");
@@ -87,6 +95,7 @@ BundleId Model::add_bundle(AppletId applet, std::string name,
                            int priority) {
   Applet& a = applets_.at(applet);
   const std::string where = "applet '" + a.name + "' bundle '" + name + "'";
+  if (a.removed) fail("applet '" + a.name + "' was removed; it takes no bundles any more");
   if (name.empty()) fail("applet '" + a.name + "': a bundle needs a name");
   for (BundleId b : a.bundles) {
     if (bundles_[b].name == name) fail(where + " is declared twice; bundle names are unique");
@@ -94,6 +103,7 @@ BundleId Model::add_bundle(AppletId applet, std::string name,
   if (resources.empty()) fail(where + " has no resources; a bundle needs at least one");
   for (std::size_t i = 0; i < resources.size(); ++i) {
     const Service& s = services_.at(resources[i].first);
+    if (s.removed) fail(where + " uses service '" + s.name + "', which was removed");
     for (std::size_t j = 0; j < i; ++j) {
       if (resources[j].first == resources[i].first) {
         fail(where + " lists service '" + s.name + "' twice");
@@ -115,6 +125,86 @@ BundleId Model::add_bundle(AppletId applet, std::string name,
   a.bundles.push_back(id);
   invalidate();
   return id;
+}
+
+AddedIds Model::add(const ModelAddition& addition) {
+  // All or nothing: the calls validate one by one, so they run on a copy that replaces this
+  // model only once all of them succeeded.
+  Model next = *this;
+  AddedIds ids;
+  for (const NewService& s : addition.services) {
+    ids.services.push_back(next.add_service(s.name, s.exclusive_only));
+  }
+  for (std::size_t i = 0; i < addition.services.size(); ++i) {
+    for (const auto& [need, access] : addition.services[i].needs) {
+      next.add_dependency(ids.services[i], next.service_id(need), access);
+    }
+  }
+  for (const NewApplet& a : addition.applets) {
+    const AppletId id = next.add_applet(a.name, a.fail_stop);
+    ids.applets.push_back(id);
+    for (const std::string& p : a.provides) next.provide(id, next.service_id(p));
+    for (const NewBundle& b : a.bundles) {
+      std::vector<std::pair<ServiceId, Access>> resources;
+      for (const auto& [service, access] : b.resources) {
+        resources.emplace_back(next.service_id(service), access);
+      }
+      const BundleId bundle = next.add_bundle(id, b.name, resources, b.priority);
+      if (b.request_deadline) next.set_request_deadline(bundle, *b.request_deadline);
+    }
+  }
+  *this = std::move(next);
+  return ids;
+}
+
+void Model::remove_applet(AppletId applet) {
+  Applet& a = applets_.at(applet);
+  if (a.removed) fail("applet '" + a.name + "' was removed already");
+  a.removed = true;
+  applet_ids_.erase(a.name);
+  for (ServiceId s : a.provides) services_[s].provider.reset();
+  a.provides.clear();
+  for (BundleId b : a.bundles) bundles_[b].removed = true;
+  invalidate();
+}
+
+void Model::remove_service(ServiceId service) {
+  Service& s = services_.at(service);
+  if (s.removed) fail("service '" + s.name + "' was removed already");
+  std::vector<std::string> users, needers;
+  for (const Applet& a : applets_) {
+    if (a.removed) continue;
+    const bool uses = std::any_of(a.resources.begin(), a.resources.end(),
+                                  [&](ResourceId r) { return resources_[r].service == service; });
+    if (uses) users.push_back("'" + a.name + "'");
+  }
+  for (const Service& other : services_) {
+    if (other.removed) continue;
+    const bool needs = std::any_of(other.dependencies.begin(), other.dependencies.end(),
+                                   [&](const Dependency& d) { return d.service == service; });
+    if (needs) needers.push_back("'" + other.name + "'");
+  }
+  auto joined = [](const std::vector<std::string>& names) {
+    std::string out;
+    for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+    return out;
+  };
+  std::string why;
+  if (!users.empty()) why += "the bundles of applet(s) " + joined(users) + " use it";
+  if (!needers.empty()) {
+    why += (why.empty() ? "" : "; ") + std::string("service(s) ") + joined(needers) + " need it";
+  }
+  if (s.provider) {
+    why += (why.empty() ? "" : "; ") + std::string("applet '") + applets_[*s.provider].name +
+           "' provides it";
+  }
+  if (!why.empty()) {
+    fail("service '" + s.name + "' cannot be removed while " + why + " (remove them first)");
+  }
+  s.removed = true;
+  s.dependencies.clear();
+  service_ids_.erase(s.name);
+  invalidate();
 }
 
 std::optional<ServiceId> Model::find_service(std::string_view name) const {

@@ -63,7 +63,10 @@ void Runtime::start() {
   running_ = true;
   stopping_ = false;
   for (AppletId a = 0; a < slots_.size(); ++a) {
-    if (slots_[a]->has_code) slots_[a]->thread = std::thread([this, a] { applet_main(a); });
+    Slot* slot = slots_[a].get();
+    if (slot->has_code && !slot->removed) {
+      slot->thread = std::thread([this, a, slot] { applet_main(a, *slot); });
+    }
   }
   reassigner_ = std::thread([this] { reassigner_main(); });
 }
@@ -75,11 +78,15 @@ void Runtime::stop() {
     stopping_ = true;
   }
   changed_.notify_all();
-  for (auto& s : slots_) {
-    {
-      std::lock_guard lock(mutex_);  // no lost wake-up between a check and a wait
+  std::vector<Slot*> slots;
+  {
+    std::lock_guard lock(mutex_);  // no lost wake-up between a check and a wait
+    for (auto& s : slots_) {
       s->cv.notify_all();
+      slots.push_back(s.get());
     }
+  }
+  for (Slot* s : slots) {
     if (s->thread.joinable()) s->thread.join();
   }
   if (reassigner_.joinable()) reassigner_.join();
@@ -128,6 +135,7 @@ void Runtime::deliver() {
     }
     if (n.kind == Notification::Kind::kRevokedByForce) waiting_since_[n.bundle] = Clock::now();
     Slot& slot = *slots_[n.applet];
+    if (slot.removed) continue;
     if (slot.forward) {  // its code runs elsewhere
       slot.forward(n);
       continue;
@@ -139,6 +147,82 @@ void Runtime::deliver() {
   }
 }
 
+Runtime::Slot& Runtime::slot_of(AppletId id) const {
+  std::lock_guard lock(mutex_);
+  return *slots_.at(id);
+}
+
+std::string Runtime::bundle_name(BundleId bundle) const {
+  std::lock_guard lock(mutex_);
+  return scheduler_.model().bundle(bundle).name;
+}
+
+AddedIds Runtime::add(const ModelAddition& addition, std::map<std::string, AppletRunner> runners) {
+  for (const auto& [name, runner] : runners) {
+    const bool added = std::any_of(addition.applets.begin(), addition.applets.end(),
+                                   [&](const NewApplet& a) { return a.name == name; });
+    if (!added) {
+      throw std::invalid_argument("a runner for applet '" + name + "', which is not added");
+    }
+    if (runner.code.has_value() == static_cast<bool>(runner.forward)) {
+      throw std::invalid_argument("applet '" + name +
+                                  "': a runner has either code or a forward, not both or none");
+    }
+    if (runner.code && !runner.code->step) {
+      throw std::invalid_argument("applet '" + name + "': code needs a step");
+    }
+  }
+  std::unique_lock lock(mutex_);
+  AddedIds ids;
+  locked_call([&](Scheduler& s) { ids = s.add(addition); });
+  while (slots_.size() < scheduler_.model().applets().size()) {
+    slots_.push_back(std::make_unique<Slot>());
+  }
+  waiting_since_.resize(scheduler_.model().bundles().size());
+  granted_at_.resize(scheduler_.model().bundles().size());
+  for (const AppletId id : ids.applets) {
+    const auto it = runners.find(scheduler_.model().applet(id).name);
+    if (it == runners.end()) continue;
+    Slot* slot = slots_[id].get();
+    if (it->second.forward) {
+      slot->forward = std::move(it->second.forward);
+      continue;
+    }
+    slot->code = std::move(*it->second.code);
+    slot->has_code = true;
+    if (running_ && !stopping_) {
+      slot->thread = std::thread([this, id, slot] { applet_main(id, *slot); });
+    }
+  }
+  wake(lock);
+  return ids;
+}
+
+void Runtime::remove_applet(const std::string& applet) {
+  std::thread ending;
+  {
+    std::unique_lock lock(mutex_);
+    const AppletId id = scheduler_.model().applet_id(applet);
+    Slot& slot = *slots_[id];
+    if (slot.thread.joinable() && slot.thread.get_id() == std::this_thread::get_id()) {
+      throw std::invalid_argument("applet '" + applet +
+                                  "' cannot remove itself (its thread would wait for itself)");
+    }
+    locked_call([&](Scheduler& s) { s.remove_applet(id); });
+    slot.removed = true;
+    slot.forward = nullptr;
+    slot.interrupts.clear();
+    slot.cv.notify_all();  // a step waiting in use() or between steps ends
+    ending = std::move(slot.thread);
+    wake(lock);
+  }
+  if (ending.joinable()) ending.join();
+}
+
+void Runtime::remove_service(const std::string& service) {
+  with_scheduler([&](Scheduler& s) { s.remove_service(s.model().service_id(service)); });
+}
+
 RuntimeStats Runtime::stats() const {
   std::lock_guard lock(mutex_);
   return stats_;
@@ -147,8 +231,7 @@ RuntimeStats Runtime::stats() const {
 // The applet wrapper (seed §4.6.2 "Fail-Stop"): whatever the code throws — a std::exception or
 // anything else (`throw 42`) — ends this applet only; its bundles are released and everything
 // else goes on.
-void Runtime::applet_main(AppletId id) {
-  Slot& slot = *slots_[id];
+void Runtime::applet_main(AppletId id, Slot& slot) {
   RuntimeContext ctx(*this, id);
   try {
     if (slot.code.init) slot.code.init(ctx);  // Abb. 4.12 lines 1–3
@@ -157,7 +240,7 @@ void Runtime::applet_main(AppletId id) {
       std::deque<Notification> queue;
       {
         std::unique_lock lock(mutex_);
-        if (stopping_) return;
+        if (stopping_ || slot.removed) return;
         queue.swap(slot.interrupts);
       }
       for (const Notification& n : queue) {  // Abb. 4.12 line 4: interrupt handlers first
@@ -165,7 +248,7 @@ void Runtime::applet_main(AppletId id) {
         if (slot.code.on_interrupt) {
           slot.code.on_interrupt(ctx, n);
         } else if (n.kind == Notification::Kind::kRevokeRequested) {
-          ctx.yield(scheduler_.model().bundle(n.bundle).name);
+          ctx.yield(bundle_name(n.bundle));
         }
         slot.reacting_to_revocation.reset();
       }
@@ -183,11 +266,13 @@ void Runtime::applet_main(AppletId id) {
       // An interrupt wakes the applet at once: its handler runs now, between two steps, and the
       // steps keep their period (a holder asked to give a service back need not wait a period).
       std::unique_lock lock(mutex_);
-      slot.cv.wait_until(lock, next, [&] { return stopping_ || !slot.interrupts.empty(); });
-      if (stopping_) return;
+      slot.cv.wait_until(lock, next,
+                         [&] { return stopping_ || slot.removed || !slot.interrupts.empty(); });
+      if (stopping_ || slot.removed) return;
     }
   } catch (...) {  // the boundary of the applet: nothing may escape into the process
     std::unique_lock lock(mutex_);
+    if (slot.removed) return;  // its calls were refused because it was removed: not a crash
     slot.crashed = true;
     stats_.crashed.push_back(scheduler_.model().applet(id).name);
     locked_call([id](Scheduler& s) { s.crash(id); });
@@ -197,8 +282,8 @@ void Runtime::applet_main(AppletId id) {
 
 std::optional<Notification> Runtime::run_round(AppletContext& ctx, BundleId bundle,
                                                const NegotiationRound& round) {
-  Slot& slot = *slots_[ctx.id()];
-  const std::string& name = scheduler_.model().bundle(bundle).name;  // the model never changes
+  Slot& slot = slot_of(ctx.id());
+  const std::string name = bundle_name(bundle);
   const SchedulerOptions& options = scheduler_.options();
   const auto started = Clock::now();
   if (round.first) round.first();
@@ -227,14 +312,14 @@ std::optional<Notification> Runtime::run_round(AppletContext& ctx, BundleId bund
 }
 
 void Runtime::run_negotiations(AppletContext& ctx) {
-  Slot& slot = *slots_[ctx.id()];
+  Slot& slot = slot_of(ctx.id());
   const auto round_max = scheduler_.options().negotiation_round_max;
   for (auto it = slot.negotiations.begin(); it != slot.negotiations.end();) {
     const auto current = it++;  // run_round may erase `current`, never another entry
     const BundleId bundle = current->first;
     Slot::Chain& chain = current->second;
     if (chain.step >= slot.steps) continue;  // one round per main-loop step
-    const std::string& name = scheduler_.model().bundle(bundle).name;
+    const std::string name = bundle_name(bundle);
     if (!ctx.being_revoked(name)) {  // forced meanwhile, or the plan gave the bundle back
       slot.negotiations.erase(current);
       continue;

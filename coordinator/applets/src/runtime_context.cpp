@@ -13,6 +13,7 @@ double ms_between(std::chrono::steady_clock::time_point a,
 }  // namespace
 
 BundleId RuntimeContext::bundle_id(const std::string& bundle) const {
+  std::lock_guard lock(runtime_.mutex_);  // the model grows while applets run
   return runtime_.scheduler_.model().bundle_id(applet_, bundle);
 }
 
@@ -35,8 +36,9 @@ void RuntimeContext::yield(const std::string& bundle) {
   });
 }
 void RuntimeContext::refuse_reprioritising(const std::string& bundle, const char* what) const {
-  const auto& revoked = runtime_.slots_[applet_]->reacting_to_revocation;
+  const auto& revoked = runtime_.slot_of(applet_).reacting_to_revocation;
   if (!revoked) return;
+  std::lock_guard lock(runtime_.mutex_);
   const Model& m = runtime_.scheduler_.model();
   throw std::invalid_argument(
       "applet '" + m.applet(applet_).name + "' " + what + " bundle '" + bundle +
@@ -68,12 +70,13 @@ Notification RuntimeContext::negotiate(const std::string& bundle, const Negotiat
 std::optional<Notification> RuntimeContext::negotiate(const std::string& bundle,
                                                       const NegotiationRound& round) {
   const BundleId b = bundle_id(bundle);
-  if (runtime_.slots_[applet_]->negotiations.count(b) != 0) return std::nullopt;
+  if (runtime_.slot_of(applet_).negotiations.count(b) != 0) return std::nullopt;
   return runtime_.run_round(*this, b, round);
 }
 
 bool RuntimeContext::negotiating(const std::string& bundle) const {
-  return runtime_.slots_[applet_]->negotiations.count(bundle_id(bundle)) != 0;
+  const BundleId b = bundle_id(bundle);
+  return runtime_.slot_of(applet_).negotiations.count(b) != 0;
 }
 
 bool RuntimeContext::being_revoked(const std::string& bundle) const {
@@ -98,9 +101,11 @@ bool RuntimeContext::use(const std::string& bundle, const std::function<void()>&
                               "' used bundle '" + bundle + "' which is not granted (fail-stop)");
       }
       const auto asked = Runtime::Clock::now();
-      runtime_.slots_[applet_]->cv.wait(
-          lock, [&] { return runtime_.stopping_ || runtime_.scheduler_.active(b); });
-      if (runtime_.stopping_) return false;
+      auto& slot = *runtime_.slots_[applet_];
+      slot.cv.wait(lock, [&] {
+        return runtime_.stopping_ || slot.removed || runtime_.scheduler_.active(b);
+      });
+      if (runtime_.stopping_ || slot.removed) return false;
       const auto now = Runtime::Clock::now();
       // Scheduling overhead: from the grant (or the ask, if later) to running again.
       runtime_.stats_.overhead_ms.push_back(

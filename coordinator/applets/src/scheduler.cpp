@@ -28,6 +28,7 @@ Scheduler::Scheduler(Model model, SchedulerOptions options)
   revoking_.assign(n, 0);
   reassigners_.resize(model_.services().size());
   crashed_.assign(model_.applets().size(), 0);
+  provider_gone_.assign(model_.services().size(), 0);
   plan_context_.unavailable.assign(model_.services().size(), 0);
   footprint_cache_.assign(n, std::nullopt);
   services_cache_.assign(n, std::nullopt);
@@ -61,7 +62,15 @@ void Scheduler::check_bundle(BundleId bundle) const {
   }
 }
 
+void Scheduler::check_live(BundleId bundle, const char* what) const {
+  const Bundle& b = model_.bundle(bundle);
+  if (!b.removed) return;
+  fail("applet '" + model_.applet(b.applet).name + "' " + what + " bundle '" + b.name +
+       "' but the applet was removed");
+}
+
 void Scheduler::request(BundleId bundle) {
+  check_live(bundle, "requests");
   if (state_.at(bundle).requested) return;
   const AppletId applet = model_.bundle(bundle).applet;
   if (crashed_[applet]) {
@@ -96,6 +105,7 @@ void Scheduler::yield(BundleId bundle) {
 }
 
 void Scheduler::set_priority(BundleId bundle, int priority) {
+  check_live(bundle, "sets the priority of");
   if (priority < 0) {
     fail("applet '" + model_.applet(model_.bundle(bundle).applet).name + "' bundle '" +
          model_.bundle(bundle).name + "': priority " + std::to_string(priority) +
@@ -121,6 +131,7 @@ void Scheduler::check_deadline(BundleId bundle, const Deadline& d) const {
 }
 
 void Scheduler::set_deadline(BundleId bundle, std::optional<Deadline> deadline) {
+  check_live(bundle, "sets a deadline on");
   if (deadline) check_deadline(bundle, *deadline);
   state_.at(bundle).deadline = deadline;
   replan();
@@ -140,6 +151,7 @@ void Scheduler::trigger(BundleId bundle) {
 
 void Scheduler::crash(AppletId applet) {
   crashed_.at(applet) = 1;
+  for (ServiceId s : model_.applet(applet).provides) provider_gone_[s] = 1;
   for (BundleId b : model_.applet(applet).bundles) {
     state_[b].requested = false;
     state_[b].boosted = false;
@@ -153,8 +165,7 @@ void Scheduler::crash(AppletId applet) {
 
 void Scheduler::set_available(ServiceId service, bool available) {
   auto& gone = plan_context_.unavailable.at(service);
-  const auto provider = model_.service(service).provider;
-  if (available && provider && crashed_.at(*provider)) return;  // gone for good
+  if (available && provider_gone_[service]) return;  // until an applet provides it again
   if ((gone == 0) == available) return;
   gone = available ? 0 : 1;
   if (available) {

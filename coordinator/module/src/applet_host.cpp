@@ -1,38 +1,7 @@
-#include "oscar/coordinator/applet_host.hpp"
-
-#include <algorithm>
-#include <chrono>
-#include <condition_variable>
-#include <deque>
-#include <map>
-#include <mutex>
-#include <optional>
-#include <stdexcept>
-#include <thread>
-
-#include <fmt/format.h>
-#include <spdlog/spdlog.h>
-
-#include "oscar/applets/config.hpp"
-#include "oscar/coordinator/applet_system.hpp"
-#include "oscar/topic_io.hpp"
-#include "oscar/topics.hpp"
-#include "sched_wire.hpp"
+#include "applet_host_impl.hpp"
 
 namespace oscar::coordinator {
 namespace {
-
-using applets::AppletId;
-using applets::BundleId;
-using applets::Notification;
-using Clock = std::chrono::steady_clock;
-using std::chrono::milliseconds;
-
-constexpr milliseconds kSlice{20};              // waits are cut into slices that keep beating
-constexpr milliseconds kHelloAgain{300};        // a hello not welcomed yet is sent again
-constexpr milliseconds kCallTimeout{3000};      // a scheduler call's reply
-constexpr milliseconds kCommandTimeout{10000};  // a command's reply (the coordinator may first
-                                                // configure the providers, then the module answers)
 
 ConfigReply refused(const std::string& module, const std::string& why) {
   ConfigReply r;
@@ -43,105 +12,6 @@ ConfigReply refused(const std::string& module, const std::string& why) {
 }
 
 }  // namespace
-
-class AppletHost::Impl final : public AppletGateway {
- public:
-  Impl(const SystemSpec& system, DdsParticipant& participant, const std::vector<std::string>& names,
-       std::string process, const std::vector<std::string>& plugin_path);
-  ~Impl() override;
-  void start();
-  void stop();
-
-  ConfigReply command(const std::string& applet, const std::string& service,
-                      const std::string& module, const std::string& kernel,
-                      const std::string& command, const std::string& type,
-                      std::vector<std::uint8_t> cdr) override;
-  ConfigReply trigger(const std::string& applet, const std::string& service,
-                      const std::string& module, const std::string& kernel) override;
-  std::string bundle_name(BundleId bundle) const override {
-    return config_.model.bundle(bundle).name;
-  }
-
- private:
-  class Context;
-  // Sends an applet's command or trigger to the coordinator and waits for its reply.
-  ConfigReply send(SchedCommand command);
-  struct Chain {  // a chain of negotiation rounds under way (applet thread only)
-    std::shared_ptr<const applets::NegotiationRound> next;
-    Clock::time_point round_started;
-    std::uint64_t step = 0;
-    int rounds = 0;
-  };
-  struct Settings {  // what the applet set on a bundle: announced again with its request
-    std::optional<int> priority;
-    std::optional<applets::Deadline> deadline;
-  };
-  struct Hosted {
-    std::string name;
-    AppletId id = 0;
-    bool fail_stop = false;
-    std::unique_ptr<Applet> applet;
-    std::uint64_t session = 0;
-    // Under the host's mutex:
-    bool welcomed = false;
-    bool crashed = false;  // its code threw: it says nothing more
-    Clock::time_point last_hello{}, last_beat{};
-    std::uint64_t coordinator = 0, state_seq = 0;
-    std::map<std::string, SchedBundleState> bundles;  // the coordinator's view, latest
-    std::map<std::string, bool> requested;            // what it asks for (true) and has set
-    std::map<std::string, Settings> settings;
-    std::deque<SchedNotice> notices;  // for the applet's thread
-    std::uint64_t next_seq = 1;
-    std::map<std::uint64_t, SchedReply> replies;
-    std::map<std::uint64_t, SchedCommandReply> command_replies;
-    std::condition_variable cv;
-    // The applet's thread only:
-    std::optional<BundleId> reacting_to_revocation;
-    std::map<BundleId, Chain> negotiations;
-    std::uint64_t steps = 0;
-    std::thread thread;
-  };
-
-  Hosted& hosted(const std::string& applet);
-  void applet_main(Hosted& h);
-  // Sends a hello while not welcomed, else a beat when one is due (any thread of the applet).
-  void pump(Hosted& h);
-  // Waits until `ready` (under the lock) or `timeout`, beating meanwhile. False on timeout or stop.
-  bool wait(Hosted& h, std::unique_lock<std::mutex>& lock, Clock::duration timeout,
-            const std::function<bool()>& ready);
-  void apply_state(Hosted& h, std::uint64_t coordinator, std::uint64_t seq,
-                   const std::vector<SchedBundleState>& bundles);
-  // A scheduler call; nullopt when the coordinator is not reachable now (the applet's wishes
-  // are announced again when it is).
-  std::optional<SchedReply> call(Hosted& h, SchedCall c);
-  void on_notice(const SchedNotice& n);
-  void on_reply(const SchedReply& r);
-  void on_command_reply(const SchedCommandReply& r);
-  Notification notification_of(const Hosted& h, const SchedNotice& n) const;
-  std::optional<Notification> run_round(Context& ctx, Hosted& h, BundleId bundle,
-                                        const applets::NegotiationRound& round);
-  void run_negotiations(Context& ctx, Hosted& h);
-  // Applies an operator's event (a notice of kind event) as the applet's own call and tells the
-  // coordinator (event_done, with the refusal if any). False for "crash": the caller throws.
-  bool apply_event(Context& ctx, Hosted& h, const SchedNotice& n);
-
-  const SystemSpec& system_;
-  applets::SystemConfig config_;
-  std::string process_;
-  milliseconds beat_every_;
-  std::map<std::string, std::unique_ptr<Hosted>> hosted_;
-  mutable std::mutex mutex_;
-  bool stopping_ = false;
-  bool started_ = false;
-  TopicWriter<SchedHello, SchedHelloPubSubType> hello_writer_;
-  TopicWriter<SchedBeat, SchedBeatPubSubType> beat_writer_;
-  TopicWriter<SchedCall, SchedCallPubSubType> call_writer_;
-  TopicWriter<SchedCommand, SchedCommandPubSubType> command_writer_;
-  std::unique_ptr<TopicReader<SchedNotice, SchedNoticePubSubType>> notice_reader_;
-  std::unique_ptr<TopicReader<SchedReply, SchedReplyPubSubType>> reply_reader_;
-  std::unique_ptr<TopicReader<SchedCommandReply, SchedCommandReplyPubSubType>>
-      command_reply_reader_;
-};
 
 // The applet's calls, over DDS to the coordinator.
 class AppletHost::Impl::Context final : public applets::AppletContext {
@@ -302,96 +172,6 @@ class AppletHost::Impl::Context final : public applets::AppletContext {
   Hosted& h_;
 };
 
-AppletHost::Impl::Impl(const SystemSpec& system, DdsParticipant& participant,
-                       const std::vector<std::string>& names, std::string process,
-                       const std::vector<std::string>& plugin_path)
-    : system_(system),
-      config_(applet_system(system)),
-      process_(std::move(process)),
-      beat_every_(std::max(
-          milliseconds(10),
-          (system.coordinator ? system.coordinator->applet_lease : milliseconds(1500)) / 6)),
-      hello_writer_(participant, topics::sched_hello()),
-      beat_writer_(participant, topics::sched_beat()),
-      call_writer_(participant, topics::sched_call()),
-      command_writer_(participant, topics::sched_command()) {
-  for (const auto& name : names) {
-    const AppletSpec* spec = nullptr;
-    if (system.coordinator) {
-      for (const auto& a : system.coordinator->applets) {
-        if (a.name == name) spec = &a;
-      }
-    }
-    if (!spec) {
-      throw std::invalid_argument(
-          fmt::format("{}: no applet '{}' in the coordinator: section", system.file, name));
-    }
-    auto h = std::make_unique<Hosted>();
-    h->name = name;
-    h->id = config_.model.applet_id(name);
-    h->fail_stop = config_.model.applet(h->id).fail_stop;
-    h->session = internal::fresh_id();
-    AppletSetup setup(name, config_.applet_params[name], *this, &participant);
-    try {
-      h->applet = make_applet(spec->type, setup, plugin_path);
-    } catch (const std::exception& e) {
-      throw std::invalid_argument(fmt::format("{}: applet '{}': {}", spec->where, name, e.what()));
-    }
-    for (const BundleId b : config_.requested_at_start) {
-      if (config_.model.bundle(b).applet == h->id) {
-        h->requested[config_.model.bundle(b).name] = true;
-      }
-    }
-    hosted_.emplace(name, std::move(h));
-  }
-  notice_reader_ = std::make_unique<TopicReader<SchedNotice, SchedNoticePubSubType>>(
-      participant, topics::sched_notice(),
-      [this](const SchedNotice& n, const auto&) { on_notice(n); });
-  reply_reader_ = std::make_unique<TopicReader<SchedReply, SchedReplyPubSubType>>(
-      participant, topics::sched_reply(),
-      [this](const SchedReply& r, const auto&) { on_reply(r); });
-  command_reply_reader_ =
-      std::make_unique<TopicReader<SchedCommandReply, SchedCommandReplyPubSubType>>(
-          participant, topics::sched_command_reply(),
-          [this](const SchedCommandReply& r, const auto&) { on_command_reply(r); });
-}
-
-AppletHost::Impl::~Impl() {
-  stop();
-  notice_reader_.reset();
-  reply_reader_.reset();
-  command_reply_reader_.reset();
-}
-
-void AppletHost::Impl::start() {
-  std::lock_guard lock(mutex_);
-  if (started_) return;
-  started_ = true;
-  for (auto& [name, h] : hosted_) {
-    Hosted* p = h.get();
-    p->thread = std::thread([this, p] { applet_main(*p); });
-  }
-}
-
-void AppletHost::Impl::stop() {
-  {
-    std::lock_guard lock(mutex_);
-    stopping_ = true;
-    for (auto& [name, h] : hosted_) h->cv.notify_all();
-  }
-  for (auto& [name, h] : hosted_) {
-    if (h->thread.joinable()) h->thread.join();
-  }
-}
-
-AppletHost::Impl::Hosted& AppletHost::Impl::hosted(const std::string& applet) {
-  const auto it = hosted_.find(applet);
-  if (it == hosted_.end()) {
-    throw std::invalid_argument(fmt::format("applet '{}' is not hosted here", applet));
-  }
-  return *it->second;
-}
-
 void AppletHost::Impl::pump(Hosted& h) {
   std::optional<SchedHello> hello;
   std::optional<SchedBeat> beat;
@@ -405,6 +185,7 @@ void AppletHost::Impl::pump(Hosted& h) {
       hello->applet(h.name);
       hello->process(process_);
       hello->session(h.session);
+      hello->spec(h.spec);
       for (const auto& [bundle, asked] : h.requested) {
         if (!asked) continue;
         SchedWish w;
@@ -761,27 +542,6 @@ ConfigReply AppletHost::Impl::send(SchedCommand c) {
   auto reply = h.command_replies.at(seq).reply();
   h.command_replies.erase(seq);
   return reply;
-}
-
-AppletHost::AppletHost(const SystemSpec& system, DdsParticipant& participant,
-                       const std::vector<std::string>& applets, std::string process,
-                       const std::vector<std::string>& plugin_path)
-    : impl_(std::make_unique<Impl>(system, participant, applets, std::move(process), plugin_path)) {
-}
-
-AppletHost::~AppletHost() = default;
-
-void AppletHost::start() { impl_->start(); }
-void AppletHost::stop() { impl_->stop(); }
-
-std::vector<std::string> AppletHost::applets_of(const SystemSpec& system,
-                                                const std::string& process) {
-  std::vector<std::string> names;
-  if (!system.coordinator) return names;
-  for (const auto& a : system.coordinator->applets) {
-    if (a.process == process) names.push_back(a.name);
-  }
-  return names;
 }
 
 }  // namespace oscar::coordinator

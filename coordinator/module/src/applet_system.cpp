@@ -48,6 +48,37 @@ applets::SystemConfig applet_system(const SystemSpec& system) {
   return applets::load_system(doc, system.file);
 }
 
+YAML::Node scheduler_doc(const SystemAddition& addition) {
+  YAML::Node doc;
+  if (!addition.services.empty()) {
+    doc["services"] = YAML::Node(YAML::NodeType::Sequence);
+    for (const auto& svc : addition.services) {
+      YAML::Node s;
+      s["name"] = svc.name;
+      s["exclusive_only"] = svc.exclusive_only;
+      for (const auto& n : svc.needs) {
+        YAML::Node d;
+        d["service"] = n.service;
+        d["access"] = n.exclusive ? "exclusive" : "shared";
+        s["depends_on"].push_back(d);
+      }
+      doc["services"].push_back(s);
+    }
+  }
+  if (!addition.applets.empty()) {
+    doc["applets"] = YAML::Node(YAML::NodeType::Sequence);
+    for (const auto& a : addition.applets) {
+      YAML::Node applet;
+      for (const auto& kv : a.node) {
+        const auto key = kv.first.as<std::string>();
+        if (key != "type" && key != "process" && key != "host") applet[kv.first] = kv.second;
+      }
+      doc["applets"].push_back(applet);
+    }
+  }
+  return doc;
+}
+
 namespace {
 // Applets made only to check them: nothing runs, so nothing calls the gateway.
 class NoGateway final : public AppletGateway {

@@ -43,7 +43,10 @@ struct Coordinator::Snapshot {
 Coordinator::Coordinator(const SystemSpec& system, DdsParticipant& participant,
                          const std::vector<std::string>& plugin_path)
     : system_(system),
+      participant_(participant),
+      plugin_path_(plugin_path),
       config_(applet_system(system)),
+      services_(system.services),
       plan_writer_(participant, topics::applet_plan()) {
   runtime_ = std::make_unique<applets::Runtime>(config_.model, config_.options);
   applets_.resize(config_.model.applets().size());
@@ -61,16 +64,7 @@ Coordinator::Coordinator(const SystemSpec& system, DdsParticipant& participant,
   for (std::size_t id = 0; id < applets_.size(); ++id) {
     Applet* a = applets_[id].get();
     if (!a) continue;  // runs in another process (or a service applet without code of its own)
-    applets::AppletCode code;
-    code.init = [a](applets::AppletContext& ctx) { a->init(ctx); };
-    code.step = [a](applets::AppletContext& ctx) { a->step(ctx); };
-    code.on_interrupt = [a, this](applets::AppletContext& ctx, const applets::Notification& n) {
-      if (!a->on_interrupt(ctx, n) && n.kind == applets::Notification::Kind::kRevokeRequested) {
-        ctx.yield(bundle_name(n.bundle));
-      }
-    };
-    code.period = a->period();
-    runtime_->set_code(a->name(), std::move(code));
+    runtime_->set_code(a->name(), code_of(a));
   }
   // Who provides each service, as the plan shows it.
   providers_of_.resize(config_.model.services().size());
@@ -81,14 +75,35 @@ Coordinator::Coordinator(const SystemSpec& system, DdsParticipant& participant,
   for (const auto& a : config_.model.applets()) {
     for (const ServiceId s : a.provides) providers_of_.at(s).push_back("applet:" + a.name);
   }
-  remote_ =
-      std::make_unique<RemoteApplets>(system, *runtime_, *this, participant, [this] { wake(); });
+  RemoteApplets::Membership membership;
+  membership.join = [this](const std::string& applet, const std::string& process,
+                           const std::string& spec) { return join(applet, process, spec); };
+  membership.leave = [this](const std::string& applet) {
+    if (const auto error = remove_applet(applet, false)) {
+      spdlog::warn("coordinator: removing applet '{}': {}", applet, *error);
+    }
+  };
+  remote_ = std::make_unique<RemoteApplets>(
+      system, *runtime_, *this, participant, [this] { wake(); }, std::move(membership));
   wishes_ = std::make_unique<KernelWishes>(system, *runtime_, participant, [this] { wake(); });
   client_ = std::make_unique<ConfigClient>(participant, "coordinator");
-  providers_ = std::make_unique<Providers>(system, *client_);
+  providers_ = std::make_unique<Providers>(system.services, *client_);
   system_reader_ = std::make_unique<TopicReader<SystemState, SystemStatePubSubType>>(
       participant, topics::system_state(),
       [this](const SystemState& s, const auto&) { on_system_state(s); });
+}
+
+applets::AppletCode Coordinator::code_of(Applet* a) {
+  applets::AppletCode code;
+  code.init = [a](applets::AppletContext& ctx) { a->init(ctx); };
+  code.step = [a](applets::AppletContext& ctx) { a->step(ctx); };
+  code.on_interrupt = [a, this](applets::AppletContext& ctx, const applets::Notification& n) {
+    if (!a->on_interrupt(ctx, n) && n.kind == applets::Notification::Kind::kRevokeRequested) {
+      ctx.yield(bundle_name(n.bundle));
+    }
+  };
+  code.period = a->period();
+  return code;
 }
 
 Coordinator::~Coordinator() {
@@ -169,10 +184,14 @@ Coordinator::Snapshot Coordinator::snapshot() {
   Snapshot snap;
   auto& plan = snap.plan;
   plan.system(system_.name);
-  std::vector<char> holding(config_.model.applets().size()), waiting(holding.size());
-  std::vector<std::vector<std::string>> granted(holding.size());  // bundles usable now
+  std::vector<std::string> applet_names;  // the applets there are now, by id
+  std::vector<char> holding, waiting;
+  std::vector<std::vector<std::string>> granted;  // per applet: its bundles usable now
   runtime_->with_scheduler([&](applets::Scheduler& s) {
     const auto& m = s.model();
+    holding.assign(m.applets().size(), 0);
+    waiting.assign(m.applets().size(), 0);
+    granted.assign(m.applets().size(), {});
     std::vector<char> used(m.services().size());
     std::function<void(ServiceId)> mark = [&](ServiceId id) {
       if (used[id]) return;
@@ -191,8 +210,10 @@ Coordinator::Snapshot Coordinator::snapshot() {
         (active ? holders : waiters)[u.service].insert(m.applet(applet).name);
       }
     }
+    std::lock_guard lock(services_mutex_);
     for (ServiceId id = 0; id < used.size(); ++id) {
       const auto& svc = m.service(id);
+      if (svc.removed) continue;
       if (used[id]) snap.in_use.insert(svc.name);
       ServicePlan p;
       p.name(svc.name);
@@ -206,26 +227,32 @@ Coordinator::Snapshot Coordinator::snapshot() {
       p.plan(s.holder(id));
       p.active(s.active_holder(id));
       for (const auto& u : m.needs(id)) p.needs().push_back(m.service(u.service).name);
-      p.providers(providers_of_[id]);
+      if (id < providers_of_.size()) p.providers(providers_of_[id]);
       plan.services().push_back(std::move(p));
     }
+    for (const auto& a : m.applets()) applet_names.push_back(a.removed ? "" : a.name);
     plan.plans(s.plans_computed());
     plan.plan_us(std::chrono::duration<double, std::micro>(s.last_plan_time()).count());
   });
-  for (std::size_t id = 0; id < holding.size(); ++id) {
+  for (std::size_t id = 0; id < applet_names.size(); ++id) {
+    if (applet_names[id].empty()) continue;  // removed
     AppletEntry e;
-    e.name(config_.model.applet(static_cast<applets::AppletId>(id)).name);
+    e.name(applet_names[id]);
     e.process(SystemSpec::kCoordinatorModule);
     e.granted(std::move(granted[id]));
     std::optional<std::string> state;
-    if (const auto module = wishes_->module_of(e.name()); !module.empty()) {
-      e.process(module);  // a kernel's wishes
-    } else if (remote_->remote(e.name())) {
-      auto seen = remote_->seen(e.name());
-      e.process(seen.process);
-      state = seen.state;
-    } else if (runtime_->crashed(e.name())) {
-      state = "crashed";
+    try {
+      if (const auto module = wishes_->module_of(e.name()); !module.empty()) {
+        e.process(module);  // a kernel's wishes
+      } else if (remote_->remote(e.name())) {
+        auto seen = remote_->seen(e.name());
+        e.process(seen.process);
+        state = seen.state;
+      } else if (runtime_->crashed(e.name())) {
+        state = "crashed";
+      }
+    } catch (const std::exception&) {
+      continue;  // removed since the plan above was taken
     }
     e.state(state ? *state : holding[id] ? "holding" : waiting[id] ? "waiting" : "idle");
     plan.applets().push_back(std::move(e));
@@ -248,14 +275,22 @@ void Coordinator::reconcile() {
   // request; it is granted again once the module runs. (A module still starting at boot is not
   // down: its service can be granted, and the providers are configured once it runs.)
   std::set<std::string> unavailable;
-  for (const auto& svc : system_.services) {
+  std::vector<ServiceSpec> services;
+  {
+    std::lock_guard lock(services_mutex_);
+    services = services_;
+  }
+  for (const auto& svc : services) {
     for (const auto& p : svc.providers) {
       if (down.contains(p.module)) unavailable.insert(svc.name);
     }
   }
   runtime_->with_scheduler([&](applets::Scheduler& s) {
-    for (const auto& svc : system_.services) {
-      const auto id = s.model().service_id(svc.name);
+    for (const auto& svc : services) {
+      if (svc.providers.empty()) continue;  // an applet provides it: no module can go down
+      const auto found = s.model().find_service(svc.name);
+      if (!found) continue;  // removed meanwhile
+      const auto id = *found;
       const bool available = !unavailable.contains(svc.name);
       if (s.available(id) == available) continue;
       spdlog::warn("coordinator: service {} is {}", svc.name,
@@ -278,6 +313,18 @@ void Coordinator::reconcile() {
 AppletPlan Coordinator::plan() { return snapshot().plan; }
 
 std::optional<std::string> Coordinator::apply_event(const AppletEvent& e) {
+  if (e.event() == "add") {
+    return add_spec(e.spec(), e.spec_name().empty() ? std::string("spec") : e.spec_name());
+  }
+  if (e.event() == "remove") {
+    if (!e.service().empty() && !e.applet().empty()) {
+      return "event 'remove' names an applet or a service, not both";
+    }
+    if (!e.service().empty()) return remove_service(e.service());
+    if (!e.applet().empty()) return remove_applet(e.applet());
+    return std::string(
+        "event 'remove' needs the applet (applet) or the service (service) to remove");
+  }
   // An applet in another process applies the event as its own call (it keeps what it asks for,
   // and announces it again after a restart of either side).
   if (remote_->remote(e.applet())) return remote_->event(e);
@@ -336,14 +383,20 @@ std::optional<std::string> Coordinator::apply_event(const AppletEvent& e) {
 }
 
 std::string Coordinator::bundle_name(applets::BundleId bundle) const {
-  return config_.model.bundle(bundle).name;
+  return runtime_->bundle_name(bundle);
 }
 
 std::optional<ConfigReply> Coordinator::refuse_unless_held(const std::string& applet,
                                                            const std::string& service,
                                                            const std::string& module,
                                                            const std::string& kernel) {
-  const auto* svc = system_.find_service(service);
+  std::optional<ServiceSpec> svc;
+  {
+    std::lock_guard lock(services_mutex_);
+    for (const auto& x : services_) {
+      if (x.name == service) svc = x;
+    }
+  }
   if (!svc) return refused(module, fmt::format("no service '{}' in the system", service));
   const bool provides = std::any_of(svc->providers.begin(), svc->providers.end(), [&](auto& p) {
     return p.module == module && (p.kernel.empty() || p.kernel == kernel);
@@ -356,15 +409,19 @@ std::optional<ConfigReply> Coordinator::refuse_unless_held(const std::string& ap
   }
   bool holds = false;
   std::string holder;
-  runtime_->with_scheduler([&](applets::Scheduler& s) {
-    const auto& m = s.model();
-    const auto id = m.service_id(service);
-    for (const BundleId b : m.applet(m.applet_id(applet)).bundles) {
-      if (!s.active(b)) continue;
-      for (const auto& u : m.bundle_uses(b)) holds = holds || u.service == id;
-    }
-    holder = s.active_holder(id);
-  });
+  try {
+    runtime_->with_scheduler([&](applets::Scheduler& s) {
+      const auto& m = s.model();
+      const auto id = m.service_id(service);
+      for (const BundleId b : m.applet(m.applet_id(applet)).bundles) {
+        if (!s.active(b)) continue;
+        for (const auto& u : m.bundle_uses(b)) holds = holds || u.service == id;
+      }
+      holder = s.active_holder(id);
+    });
+  } catch (const std::invalid_argument& e) {  // removed meanwhile
+    return refused(module, e.what());
+  }
   if (holds) return std::nullopt;
   return refused(module, fmt::format("applet '{}' does not hold service '{}': {}", applet, service,
                                      holder == "none" ? std::string("nobody holds it now")

@@ -41,6 +41,11 @@ class CoordinatorKernel final : public Kernel {
       if (const auto error = c->apply_event(e)) {
         return CommandAnswer::refuse(*error);
       }
+      if (e.event() == "add") return CommandAnswer::accept("added");
+      if (e.event() == "remove") {
+        return CommandAnswer::accept(e.service().empty() ? "removed applet " + e.applet()
+                                                         : "removed service " + e.service());
+      }
       return CommandAnswer::accept(e.applet() + "/" + e.bundle() + ": " + e.event());
     });
   }

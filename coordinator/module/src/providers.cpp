@@ -8,13 +8,29 @@ constexpr std::chrono::milliseconds kReplyTimeout{2000};
 constexpr std::chrono::milliseconds kRetry{1000};
 }  // namespace
 
-Providers::Providers(const SystemSpec& system, ConfigClient& client)
-    : system_(system), client_(client) {
-  for (const auto& svc : system.services) {
-    for (const auto& p : svc.providers) {
-      targets_[{p.module, p.kernel.empty() ? "*" : p.kernel}].push_back(&svc);
-    }
+Providers::Providers(const std::vector<ServiceSpec>& services, ConfigClient& client)
+    : client_(client) {
+  for (const auto& svc : services) add(svc);
+}
+
+void Providers::add(const ServiceSpec& service) {
+  for (const auto& p : service.providers) {
+    targets_[{p.module, p.kernel.empty() ? "*" : p.kernel}].push_back(service);
   }
+}
+
+void Providers::remove(const std::string& service) {
+  for (auto it = targets_.begin(); it != targets_.end();) {
+    std::erase_if(it->second, [&](const ServiceSpec& s) { return s.name == service; });
+    if (!it->second.empty()) {
+      ++it;
+      continue;
+    }
+    applied_.erase(it->first);
+    retry_at_.erase(it->first);
+    it = targets_.erase(it);
+  }
+  recorded_.erase(service);
 }
 
 Providers::Desired Providers::desired(const Target& target,
@@ -22,16 +38,16 @@ Providers::Desired Providers::desired(const Target& target,
   Desired d;
   bool idle_deactivates = false;
   bool granted = false;
-  for (const auto* svc : targets_.at(target)) {
-    if (!in_use.contains(svc->name)) continue;
-    if (!granted && svc->activate) d.state = "activate:" + *svc->activate;
+  for (const auto& svc : targets_.at(target)) {
+    if (!in_use.contains(svc.name)) continue;
+    if (!granted && svc.activate) d.state = "activate:" + *svc.activate;
     granted = true;
-    for (const auto& [name, value] : svc->granted_params) d.params.emplace(name, value);
+    for (const auto& [name, value] : svc.granted_params) d.params.emplace(name, value);
   }
-  for (const auto* svc : targets_.at(target)) {
-    if (in_use.contains(svc->name)) continue;
-    idle_deactivates = idle_deactivates || svc->idle_deactivates;
-    for (const auto& [name, value] : svc->idle_params) d.params.emplace(name, value);
+  for (const auto& svc : targets_.at(target)) {
+    if (in_use.contains(svc.name)) continue;
+    idle_deactivates = idle_deactivates || svc.idle_deactivates;
+    for (const auto& [name, value] : svc.idle_params) d.params.emplace(name, value);
   }
   // In use, but granting configures no mode: the module's state is left be.
   if (!granted && idle_deactivates) d.state = "deactivate";
@@ -40,7 +56,12 @@ Providers::Desired Providers::desired(const Target& target,
 
 std::string Providers::param_kernel(const Target& target) const {
   if (target.second != "*") return target.second;
-  return system_.find_module(target.first)->spec.kernels.front().name;  // checked: only one
+  for (const auto& svc : targets_.at(target)) {
+    for (const auto& p : svc.providers) {
+      if (p.module == target.first && p.kernel.empty()) return p.param_kernel;  // its only one
+    }
+  }
+  return {};
 }
 
 bool Providers::send_param(const Target& target, const std::string& name,
@@ -133,8 +154,8 @@ void Providers::apply(const std::set<std::string>& in_use, const std::set<std::s
     // Commands are recorded only while a service is held, and a held service's providers are
     // configured before its holder's first command goes out: so this is a restarted module (or
     // one that was not running): give it back what the holders of its services commanded.
-    for (const auto* svc : services) {
-      const auto rec = recorded_.find(svc->name);
+    for (const auto& svc : services) {
+      const auto rec = recorded_.find(svc.name);
       if (rec == recorded_.end()) continue;
       for (const auto& [key, r] : rec->second) {
         const auto& [module, kernel, command] = key;
@@ -142,7 +163,7 @@ void Providers::apply(const std::set<std::string>& in_use, const std::set<std::s
         try {
           const auto reply =
               client_.send_command(module, kernel, command, r.type, r.cdr, kReplyTimeout);
-          spdlog::info("coordinator: {}: {}/{} {} re-applied after the restart: {}", svc->name,
+          spdlog::info("coordinator: {}: {}/{} {} re-applied after the restart: {}", svc.name,
                        module, kernel, command, reply.ok() ? "ok" : reply.error());
         } catch (const std::exception& e) {
           spdlog::warn("coordinator: re-applying {}/{} {}: {}", module, kernel, command, e.what());
@@ -154,8 +175,8 @@ void Providers::apply(const std::set<std::string>& in_use, const std::set<std::s
 
 bool Providers::ready(const std::string& service) const {
   for (const auto& [target, services] : targets_) {
-    for (const auto* svc : services) {
-      if (svc->name != service) continue;
+    for (const auto& svc : services) {
+      if (svc.name != service) continue;
       const auto want = desired(target, in_use_);
       if (want == Desired{}) continue;
       const auto it = applied_.find(target);

@@ -23,7 +23,14 @@ class Providers {
     unsigned long incarnation = 0;
   };
 
-  Providers(const SystemSpec& system, ConfigClient& client);
+  /// The providers of `services` (the system file's, at first).
+  Providers(const std::vector<ServiceSpec>& services, ConfigClient& client);
+
+  /// A service added at run time: its providers are configured from now on as the file's are.
+  void add(const ServiceSpec& service);
+  /// A service removed at run time (nobody holds it): its providers are not configured for it
+  /// any more.
+  void remove(const std::string& service);
 
   /// Configures every provider as `in_use` (service names) asks: the parameters of `granted:
   /// {set: ...}` of its granted services and of `idle: {set: ...}` of its idle ones (a granted
@@ -65,9 +72,8 @@ class Providers {
   // The kernel a parameter of `target` goes to: its own, or the module's only one.
   std::string param_kernel(const Target& target) const;
 
-  const SystemSpec& system_;
   ConfigClient& client_;
-  std::map<Target, std::vector<const ServiceSpec*>> targets_;
+  std::map<Target, std::vector<ServiceSpec>> targets_;
   std::map<Target, Applied> applied_;
   std::map<Target, Clock::time_point> retry_at_;
   // Per service: the last accepted command per (module, kernel, command).

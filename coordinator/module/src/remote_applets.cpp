@@ -37,11 +37,12 @@ SchedNotice notice_of(const applets::Model& m, const Notification& n) {
 
 RemoteApplets::RemoteApplets(const SystemSpec& system, applets::Runtime& runtime,
                              AppletGateway& gateway, DdsParticipant& participant,
-                             std::function<void()> changed)
+                             std::function<void()> changed, Membership membership)
     : system_(system),
       runtime_(runtime),
       gateway_(gateway),
       changed_(std::move(changed)),
+      membership_(std::move(membership)),
       lease_(system.coordinator ? system.coordinator->applet_lease
                                 : std::chrono::milliseconds(1500)),
       coordinator_id_(internal::fresh_id()),
@@ -56,15 +57,10 @@ RemoteApplets::RemoteApplets(const SystemSpec& system, applets::Runtime& runtime
           [&](applets::Scheduler& s) { entry.id = s.model().applet_id(a.name); });
       entry.process = a.process;
       applets_.emplace(a.name, entry);
-      runtime_.set_remote(a.name, [this, name = a.name](const Notification& n) {
-        // Under the runtime's lock: only queue.
-        std::lock_guard lock(mutex_);
-        outgoing_.push_back({name, n, {}});
-        wake_.notify_all();
-      });
+      runtime_.set_remote(a.name, forwarder(a.name));
     }
   }
-  if (applets_.empty()) return;  // no endpoints to listen on
+  // Listening also without applets of the file's: applets may join from other processes.
   hello_reader_ = std::make_unique<TopicReader<SchedHello, SchedHelloPubSubType>>(
       participant, topics::sched_hello(), [this](const SchedHello& h, const auto&) {
         std::lock_guard lock(mutex_);
@@ -96,9 +92,41 @@ RemoteApplets::~RemoteApplets() {
   beat_reader_.reset();
 }
 
+std::function<void(const Notification&)> RemoteApplets::forwarder(const std::string& applet) {
+  return [this, applet](const Notification& n) {
+    // Under the runtime's lock: only queue.
+    std::lock_guard lock(mutex_);
+    outgoing_.push_back({applet, n, {}});
+    wake_.notify_all();
+  };
+}
+
+void RemoteApplets::adopt(const std::string& applet, AppletId id, const std::string& process) {
+  std::lock_guard lock(mutex_);
+  Applet entry;
+  entry.id = id;
+  entry.process = process;
+  entry.joined = true;
+  applets_[applet] = entry;
+}
+
+void RemoteApplets::forget(const std::string& applet, bool refuse_session) {
+  std::lock_guard lock(mutex_);
+  const auto it = applets_.find(applet);
+  if (it == applets_.end()) return;
+  if (refuse_session && it->second.joined) refused_[applet] = it->second.session;
+  applets_.erase(it);
+}
+
+bool RemoteApplets::joined(const std::string& applet) const {
+  std::lock_guard lock(mutex_);
+  const auto it = applets_.find(applet);
+  return it != applets_.end() && it->second.joined;
+}
+
 void RemoteApplets::start() {
   std::lock_guard lock(mutex_);
-  if (started_ || applets_.empty()) return;
+  if (started_) return;
   started_ = true;
   worker_ = std::thread([this] { worker(); });
   commands_thread_ = std::thread([this] { commands(); });
@@ -133,7 +161,9 @@ std::optional<std::string> RemoteApplets::event(const AppletEvent& e) {
   std::uint64_t session = 0;
   {
     std::lock_guard lock(mutex_);
-    const auto& a = applets_.at(applet);
+    const auto it = applets_.find(applet);
+    if (it == applets_.end()) return fmt::format("unknown applet '{}'", applet);
+    const auto& a = it->second;
     if (!a.present) {
       return fmt::format(
           "applet '{}' runs in process '{}', which the coordinator does not hear "
@@ -192,10 +222,23 @@ bool RemoteApplets::current(const std::string& applet, std::uint64_t session) {
 
 void RemoteApplets::on_beat(const SchedBeat& beat) {
   std::lock_guard lock(mutex_);
-  const auto it = applets_.find(beat.applet());
-  if (it == applets_.end()) return;  // not ours (another system, or not remote)
-  auto& a = it->second;
   const auto now = Clock::now();
+  const auto it = applets_.find(beat.applet());
+  if (it == applets_.end()) {
+    // An applet that joined by its hello before this coordinator started (or before its lease
+    // ran out), or one of the file's that runs here: its hello says which.
+    auto& asked = unknown_asked_[beat.applet()];
+    if (now - asked < kAskAgain) return;
+    asked = now;
+    SchedNotice n;
+    n.applet(beat.applet());
+    n.session(beat.session());
+    n.kind("announce");
+    outgoing_.push_back({beat.applet(), std::nullopt, std::move(n)});
+    wake_.notify_all();
+    return;
+  }
+  auto& a = it->second;
   if (a.present && a.session == beat.session()) {
     a.last_beat = now;
     return;
@@ -223,6 +266,25 @@ void RemoteApplets::take_bundles(AppletId id) {
 void RemoteApplets::on_hello(const SchedHello& hello) {
   AppletId id = 0;
   bool replaced = false;
+  bool is_known = false;
+  {
+    std::lock_guard lock(mutex_);
+    is_known = applets_.contains(hello.applet());
+    const auto refused = refused_.find(hello.applet());
+    if (!is_known && refused != refused_.end() && refused->second == hello.session()) return;
+  }
+  if (!is_known && !hello.spec().empty() && membership_.join) {
+    // An applet the file does not configure joins: the coordinator adds it (seed 000 §4.1.1).
+    if (const auto error = membership_.join(hello.applet(), hello.process(), hello.spec())) {
+      spdlog::warn("coordinator: applet '{}' in process '{}' cannot join: {}", hello.applet(),
+                   hello.process(), *error);
+      std::lock_guard lock(mutex_);
+      refused_[hello.applet()] = hello.session();  // told once; a new start may try again
+      return;
+    }
+    spdlog::info("coordinator: applet '{}' in process '{}' joined", hello.applet(),
+                 hello.process());
+  }
   {
     std::lock_guard lock(mutex_);
     const auto it = applets_.find(hello.applet());
@@ -420,21 +482,30 @@ void RemoteApplets::send(Outgoing out) {
 
 void RemoteApplets::check_leases() {
   std::vector<std::pair<std::string, AppletId>> lost;
+  std::vector<std::string> gone;  // joined by their hello: removed, not just released
   {
     std::lock_guard lock(mutex_);
     const auto now = Clock::now();
     for (auto& [name, a] : applets_) {
       if (a.present && now - a.last_beat > lease_) {
         a.present = false;
-        lost.emplace_back(name, a.id);
+        if (a.joined) {
+          gone.push_back(name);
+        } else {
+          lost.emplace_back(name, a.id);
+        }
         spdlog::warn(
-            "coordinator: applet '{}' in process '{}' missed its lease ({} ms): its "
-            "bundles are taken",
-            name, a.process, lease_.count());
+            "coordinator: applet '{}' in process '{}' missed its lease ({} ms): {}", name,
+            a.process, lease_.count(),
+            a.joined ? "it joined by its hello, so it is removed" : "its bundles are taken");
       }
     }
   }
   for (const auto& [name, id] : lost) take_bundles(id);
+  for (const auto& name : gone) {
+    if (membership_.leave) membership_.leave(name);
+  }
+  if (!gone.empty()) changed_();
   if (!lost.empty()) changed_();
 }
 
@@ -464,14 +535,25 @@ void RemoteApplets::worker() {
       n.applet(out.applet);
       n.coordinator(coordinator_id_);
       AppletId id = 0;
+      bool known = true;
       {
         std::lock_guard l(mutex_);
-        const auto& a = applets_.at(out.applet);
-        id = a.id;
-        if (out.notification) {
-          if (!a.present) continue;  // it hears everything again when it announces itself
-          n.session(a.session);
+        const auto it = applets_.find(out.applet);
+        known = it != applets_.end();
+        if (known) {
+          const auto& a = it->second;
+          id = a.id;
+          if (out.notification) {
+            if (!a.present) continue;  // it hears everything again when it announces itself
+            n.session(a.session);
+          }
         }
+      }
+      if (!known) {
+        // Removed meanwhile (nothing to tell it), or an applet that beats unknown: asked to
+        // announce itself (it may join by its hello).
+        if (n.kind() == "announce") notice_writer_.write(n);
+        continue;
       }
       runtime_.with_scheduler([&](applets::Scheduler& s) {
         if (out.notification) {

@@ -32,11 +32,23 @@ namespace oscar::coordinator {
 
 class RemoteApplets {
  public:
+  /// Applets the system file does not configure, which join from other processes: `join` adds
+  /// one (its hello's spec, seed 000 §4.1.1) and returns why not; it calls adopt(). `leave`
+  /// removes one whose lease ran out (it calls forget()). Both are called from the worker
+  /// thread, with no lock of this class held.
+  struct Membership {
+    std::function<std::optional<std::string>(const std::string& applet, const std::string& process,
+                                             const std::string& spec)>
+        join;
+    std::function<void(const std::string& applet)> leave;
+  };
+
   /// Makes every applet of `system` with a `process:` remote in `runtime` (before it starts).
   /// `gateway` forwards their commands; `changed` is called after every change of the plan that
   /// a remote applet made (the coordinator publishes the plan).
   RemoteApplets(const SystemSpec& system, applets::Runtime& runtime, AppletGateway& gateway,
-                DdsParticipant& participant, std::function<void()> changed);
+                DdsParticipant& participant, std::function<void()> changed,
+                Membership membership = {});
   ~RemoteApplets();
   RemoteApplets(const RemoteApplets&) = delete;
   RemoteApplets& operator=(const RemoteApplets&) = delete;
@@ -46,6 +58,17 @@ class RemoteApplets {
 
   /// Whether the applet runs in another process.
   bool remote(const std::string& applet) const;
+  /// What the runtime hands an applet's notifications to (Runtime::add's runner): they are
+  /// queued for its process.
+  std::function<void(const applets::Notification&)> forwarder(const std::string& applet);
+  /// A joining applet was added to the runtime as `id`: it is remote from now on, announced
+  /// by the hello that is being handled.
+  void adopt(const std::string& applet, applets::AppletId id, const std::string& process);
+  /// The applet was removed. With `refuse_session`, its process's present session may not join
+  /// again (an operator removed it; a new start of the process may).
+  void forget(const std::string& applet, bool refuse_session);
+  /// Whether the applet joined by its hello (not configured in the system file).
+  bool joined(const std::string& applet) const;
   /// What the plan shows of a remote applet: its process, and "absent" (not announced, or its
   /// lease ran out) or "crashed" when it is not taking part; nullopt when it is.
   struct Seen {
@@ -66,6 +89,7 @@ class RemoteApplets {
     std::uint64_t session = 0;
     bool present = false;
     bool crashed = false;
+    bool joined = false;  // added by its hello's spec: removed when its lease runs out
     std::chrono::steady_clock::time_point last_beat;
     std::chrono::steady_clock::time_point last_announce_asked;
   };
@@ -93,6 +117,7 @@ class RemoteApplets {
   applets::Runtime& runtime_;
   AppletGateway& gateway_;
   std::function<void()> changed_;
+  Membership membership_;
   const std::chrono::milliseconds lease_;
   const std::uint64_t coordinator_id_;
   std::uint64_t state_seq_ = 0;  // under the runtime's lock
@@ -100,6 +125,8 @@ class RemoteApplets {
   mutable std::mutex mutex_;  // what follows
   std::condition_variable wake_;
   std::map<std::string, Applet> applets_;
+  std::map<std::string, std::uint64_t> refused_;  // applet -> a session that may not join
+  std::map<std::string, std::chrono::steady_clock::time_point> unknown_asked_;  // by applet
   std::deque<std::function<void()>> inbound_;  // hellos and calls, in arrival order
   std::deque<SchedCommand> commands_;
   std::deque<Outgoing> outgoing_;

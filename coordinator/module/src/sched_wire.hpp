@@ -18,7 +18,7 @@ std::optional<applets::Notification::Kind> notice_kind(const std::string& text);
 bool is_revocation(applets::Notification::Kind kind);
 /// The operator's events an applet takes (AppletEvent.event), for messages: "request, ...".
 inline constexpr const char* kAppletEvents =
-    "request, release, trigger, yield, set_priority, set_deadline, negotiate, crash";
+    "request, release, trigger, yield, set_priority, set_deadline, negotiate, crash, add, remove";
 /// Whether `event` is one of kAppletEvents.
 bool known_applet_event(const std::string& event);
 /// A random number, never 0 (a session, a start of the coordinator).

@@ -62,6 +62,8 @@ struct ServiceSpec {
   struct Provider {
     std::string module;
     std::string kernel;  ///< empty: every kernel of the module
+    /// The kernel parameters go to (`set:`): `kernel`, or the module's only one.
+    std::string param_kernel;
     std::string text() const { return kernel.empty() ? module : module + "/" + kernel; }
   };
   struct Need {
@@ -122,6 +124,13 @@ struct CoordinatorSpec {
   std::string where;
 };
 
+/// Services and applets added to a running system (docs/coordinator.md, "Adding and removing at
+/// run time"), as SystemSpec::parse_addition reads them.
+struct SystemAddition {
+  std::vector<ServiceSpec> services;
+  std::vector<AppletSpec> applets;
+};
+
 struct SystemSpec {
   std::string file;
   std::string name;
@@ -141,6 +150,14 @@ struct SystemSpec {
   /// @throws std::invalid_argument "file:line: ..." naming the thing and the rule.
   static SystemSpec load(const std::string& path);
   static SystemSpec parse(const YAML::Node& root, const std::string& file);
+
+  /// Reads services and applets to add to this running system: `services:` as in the system
+  /// file (provided_by names its modules) and `applets:` as entries of `coordinator: applets:`.
+  /// `services_now` are the services the system has now (its own and those added since): the
+  /// new ones may need them, their names are taken. `addition_file` names the text in messages.
+  /// @throws std::invalid_argument "file:line: ..." naming the thing and the rule.
+  SystemAddition parse_addition(const YAML::Node& addition, const std::string& addition_file,
+                                const std::vector<ServiceSpec>& services_now) const;
 
   /// Builds every module without DDS (loads the plugins, checks the multi-core rules and the
   /// types of wires between modules, and that no reliable input reads a best-effort output).

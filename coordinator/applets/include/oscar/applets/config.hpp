@@ -5,6 +5,8 @@
 
 #include <map>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
@@ -27,6 +29,21 @@ struct SystemConfig {
 /// Reads the system from a parsed YAML document; `file` names it in messages.
 /// @throws std::invalid_argument "file:line: what: rule" on any bad input.
 SystemConfig load_system(const YAML::Node& root, const std::string& file);
+
+/// Services and applets to add to a running system (Scheduler::add), as read.
+struct LoadedAddition {
+  ModelAddition addition;
+  std::map<std::string, std::map<std::string, std::string>> applet_params;
+  std::map<std::string, std::map<std::string, std::string>> service_params;
+  /// Bundles with `requested: true` (applet, bundle), in file order.
+  std::vector<std::pair<std::string, std::string>> requested_at_start;
+};
+
+/// Reads services and applets to add to `current` (`services:` and/or `applets:`, in the
+/// vocabulary of load_system), checked against it as the scheduler will: names in use, unknown
+/// services, bad bundles. `file` names the text in messages.
+/// @throws std::invalid_argument "file:line: what: rule" on any bad input.
+LoadedAddition load_addition(const Model& current, const YAML::Node& root, const std::string& file);
 
 /// Parses YAML text. @throws std::invalid_argument "file:line:column: malformed YAML: ...".
 YAML::Node parse_yaml(const std::string& text, const std::string& file);

@@ -50,6 +50,7 @@ struct Service {
   bool exclusive_only = false;
   std::optional<AppletId> provider;  ///< The service applet that provides it, if any.
   std::vector<Dependency> dependencies;
+  bool removed = false;  ///< Removed at run time: its id stays taken, its name is free again.
 };
 
 /// An applet's proxy to one service (seed §4.2.2).
@@ -70,6 +71,7 @@ struct Bundle {
   /// Configured (`deadline:`): the deadline every request of the bundle gets, with its times
   /// counted from the request (t_early 5 s: not granted before 5 s after the request).
   std::optional<Deadline> request_deadline;
+  bool removed = false;  ///< Its applet was removed.
 };
 
 /// An applet or service applet (seed §4.1).
@@ -79,6 +81,43 @@ struct Applet {
   std::vector<BundleId> bundles;
   std::vector<ResourceId> resources;
   bool fail_stop = false;  ///< Using a non-granted resource throws instead of blocking (§4.6.2).
+  bool removed = false;    ///< Removed at run time: its id stays taken, its name is free again.
+};
+
+/// A service to add, by names (Model::add): what the configuration says of it.
+struct NewService {
+  std::string name;
+  bool exclusive_only = false;
+  std::vector<std::pair<std::string, Access>> needs;  ///< Services it depends on (§4.2.3).
+};
+
+/// A bundle of an applet to add, by names.
+struct NewBundle {
+  std::string name;
+  int priority = kPriorityNormal;
+  std::vector<std::pair<std::string, Access>> resources;
+  std::optional<Deadline> request_deadline;  ///< Bundle::request_deadline
+};
+
+/// An applet to add, by names (Model::add).
+struct NewApplet {
+  std::string name;
+  bool fail_stop = false;
+  std::vector<std::string> provides;  ///< Services it provides (a service applet, §4.2.3).
+  std::vector<NewBundle> bundles;
+};
+
+/// Services and applets added to a model together: all of them or none (seed 000 §4.1.1: the
+/// scheduler is told of services and applets as they come and go).
+struct ModelAddition {
+  std::vector<NewService> services;  ///< Added first; their needs may name each other.
+  std::vector<NewApplet> applets;    ///< May use and provide the services added with them.
+};
+
+/// The ids an addition got, in the order of its lists.
+struct AddedIds {
+  std::vector<ServiceId> services;
+  std::vector<AppletId> applets;
 };
 
 /// One use of a service while a bundle is granted: by a resource or by a service (a dependency
@@ -116,6 +155,19 @@ class Model {
   /// reservation for later, a window that expires). @throws std::invalid_argument if t_duration
   /// is negative or t_early + t_duration > t_finish (eq. 4.9).
   void set_request_deadline(BundleId bundle, Deadline deadline);
+  /// Adds services and applets by name, all or nothing: on any error the model is unchanged.
+  /// New ids follow the ones given so far (a removed thing's id is never given again).
+  /// @throws std::invalid_argument as the single calls do, and naming a removed or unknown
+  ///         service.
+  AddedIds add(const ModelAddition& addition);
+  /// Removes an applet (its bundles with it) and frees its name; the services it provided have
+  /// no provider any more. Its id and its bundles' ids stay taken.
+  /// @throws std::invalid_argument if it was removed already.
+  void remove_applet(AppletId applet);
+  /// Removes a service and frees its name; its id stays taken.
+  /// @throws std::invalid_argument naming the applets whose bundles use it, the services that
+  ///         need it and the applet that provides it, while any does (remove those first).
+  void remove_service(ServiceId service);
 
   /// @throws std::invalid_argument "unknown service 'X'".
   ServiceId service_id(std::string_view name) const;

@@ -41,7 +41,16 @@ struct RuntimeStats {
   std::vector<std::string> crashed;  ///< Applets whose code threw.
 };
 
-/// Runs applets in threads around one Scheduler. Construct, add code, start, stop.
+/// How an applet added at run time runs (Runtime::add): its code in a thread of its own here,
+/// or elsewhere with its notifications handed to `forward` (as Runtime::set_remote), or neither
+/// (it is driven through with_scheduler only).
+struct AppletRunner {
+  std::optional<AppletCode> code;
+  std::function<void(const Notification&)> forward;
+};
+
+/// Runs applets in threads around one Scheduler. Construct, add code, start, stop; services and
+/// applets may be added and removed while it runs.
 class Runtime {
  public:
   explicit Runtime(Model model, SchedulerOptions options = {});
@@ -65,6 +74,23 @@ class Runtime {
   /// Whether an applet's thread ended by an exception (its bundles were released).
   bool crashed(const std::string& applet) const;
 
+  /// Adds services and applets (Scheduler::add), all or nothing; `runners` says how each added
+  /// applet runs (by name; an applet without one runs nowhere). Applets with code start at once
+  /// if the runtime runs.
+  /// @throws std::invalid_argument as Scheduler::add, or for a runner naming no added applet,
+  ///         without code and forward, or with both; nothing is changed then.
+  AddedIds add(const ModelAddition& addition, std::map<std::string, AppletRunner> runners = {});
+  /// Removes an applet (Scheduler::remove_applet) and ends its thread: it is told nothing more,
+  /// a use() it waits in returns false, and this returns once its step ended.
+  /// @throws std::invalid_argument for an unknown applet, or when called from its own thread.
+  void remove_applet(const std::string& applet);
+  /// Removes a service (Scheduler::remove_service).
+  /// @throws std::invalid_argument for an unknown service, or naming what uses it.
+  void remove_service(const std::string& service);
+
+  /// A bundle's name, read under the runtime's lock (the model changes while applets run).
+  std::string bundle_name(BundleId bundle) const;
+
   /// Calls `f` with the scheduler under the runtime's lock, then delivers notifications.
   void with_scheduler(const std::function<void(Scheduler&)>& f);
   RuntimeStats stats() const;
@@ -77,6 +103,7 @@ class Runtime {
     bool paused = false;
     bool crashed = false;
     bool has_code = false;
+    bool removed = false;                              // removed at run time: its thread ends
     std::function<void(const Notification&)> forward;  // set: the applet runs elsewhere
     /// A chain of negotiation rounds under way (seed §4.5.3). Applet thread only.
     struct Chain {
@@ -102,7 +129,11 @@ class Runtime {
   // Unlocks, then wakes the applets deliver() queued notifications for: a woken applet does
   // not block on the mutex its waker still holds.
   void wake(std::unique_lock<std::mutex>& lock);
-  void applet_main(AppletId id);
+  void applet_main(AppletId id, Slot& slot);
+  // The slot of an applet, found under the lock (slots_ grows while applets run); the slot
+  // itself lives as long as the runtime. Not with the lock held.
+  Slot& slot_of(AppletId id) const;
+
   // Runs one negotiation round for `bundle` and keeps or ends its chain (applet thread).
   std::optional<Notification> run_round(AppletContext& ctx, BundleId bundle,
                                         const NegotiationRound& round);

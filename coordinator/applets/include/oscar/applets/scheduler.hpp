@@ -117,6 +117,24 @@ class Scheduler {
   /// once (kRevokedByForce naming the service) and keep their request; they are granted again
   /// when it is back. A service whose service applet crashed stays unavailable.
   void set_available(ServiceId service, bool available);
+  /// Adds services and applets while the scheduler runs (seed 000 §4.1.1: the scheduler is the
+  /// registrar of services and applets), all or nothing. Their bundles start unrequested with
+  /// their configured priority; the plan is made again. An added applet may provide a service
+  /// added with it, or one whose providing applet was removed (it becomes available again), or
+  /// any other that no granted bundle uses now.
+  /// @throws std::invalid_argument as Model::add, for a negative priority, and for a provided
+  ///         service that a granted bundle uses now; nothing is changed then.
+  AddedIds add(const ModelAddition& addition);
+  /// Removes an applet: its bundles are released as when it ends, the services it provides
+  /// become unavailable (as when it crashes) until another applet provides them, and it is
+  /// gone from the model (its name may be added again; its ids are never reused).
+  /// @throws std::invalid_argument if it was removed already.
+  void remove_applet(AppletId applet);
+  /// Removes a service nobody uses. @throws std::invalid_argument naming the applets whose
+  /// bundles use it, the services that need it, or the applet that provides it.
+  void remove_service(ServiceId service);
+  /// Whether the applet was removed.
+  bool removed(AppletId applet) const { return model_.applet(applet).removed; }
   /// Whether the applet crashed.
   bool crashed(AppletId applet) const { return crashed_.at(applet) != 0; }
   /// Whether the service can be used: false once its service applet crashed.
@@ -192,6 +210,11 @@ class Scheduler {
   bool uses_itself(BundleId bundle, ServiceId service) const;
   bool conflicts(BundleId a, BundleId b) const;
   void check_bundle(BundleId bundle) const;
+  // Throws if the bundle's applet was removed (`what` names the call).
+  void check_live(BundleId bundle, const char* what) const;
+  // Sizes the per-bundle, per-service and per-applet state to the model, and forgets the
+  // cached footprints (what a service needs may have changed).
+  void fit_to_model();
   void start_giving(BundleId bundle);
   void stop_giving(BundleId bundle);
   Notification negotiate_with(ServiceId service, Reassignment::Giving& giving,
@@ -206,6 +229,7 @@ class Scheduler {
   std::vector<char> revoking_;             // per bundle: in some reassigner's `giving`
   std::vector<Reassignment> reassigners_;  // per service
   std::vector<char> crashed_;              // per applet
+  std::vector<char> provider_gone_;        // per service: its service applet crashed or left
   PlanContext plan_context_;               // unavailable: per service
   std::vector<Notification> notifications_;
   std::uint64_t plans_ = 0;

@@ -27,6 +27,16 @@ class AppletHost {
   AppletHost(const SystemSpec& system, DdsParticipant& participant,
              const std::vector<std::string>& applets, std::string process,
              const std::vector<std::string>& plugin_path);
+  /// Also hosts applets the system file does not configure, which join the running system
+  /// (seed 000 §4.1.1): `joining` is YAML with `applets:` (entries as in `coordinator:
+  /// applets:`, without process: and host:), `joining_file` names it in messages. Each one's
+  /// hello carries its entry: the coordinator adds the applet at its first hello (and again
+  /// after the coordinator restarts) and removes it when its lease runs out.
+  /// @throws std::invalid_argument as above, and "file:line: ..." for a bad entry.
+  AppletHost(const SystemSpec& system, DdsParticipant& participant,
+             const std::vector<std::string>& applets, const YAML::Node& joining,
+             const std::string& joining_file, std::string process,
+             const std::vector<std::string>& plugin_path);
   ~AppletHost();
   AppletHost(const AppletHost&) = delete;
   AppletHost& operator=(const AppletHost&) = delete;

@@ -14,6 +14,11 @@ namespace oscar::coordinator {
 /// @throws std::invalid_argument "file:line: ..." on a bad applet or bundle.
 applets::SystemConfig applet_system(const SystemSpec& system);
 
+/// The applet scheduler's vocabulary for services and applets added to a running system (what
+/// applets::load_addition reads), from the addition's own nodes, so that messages keep their
+/// lines; what only the coordinator reads (type, process, host) is left out.
+YAML::Node scheduler_doc(const SystemAddition& addition);
+
 /// Checks the system's applets without running them: the model (as applet_system()), and that
 /// every applet's type can be made with its params (from a registered type or its plugin on
 /// `plugin_path`). What boot does before it starts anything.

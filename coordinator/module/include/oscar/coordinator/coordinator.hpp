@@ -65,8 +65,22 @@ class Coordinator final : public AppletGateway {
   /// An operator's event for an applet's bundle (what the coordinator kernel's command port
   /// `applet` takes): request, release, trigger, yield, set_priority, set_deadline, negotiate,
   /// and crash for an applet in another process. An applet in another process applies it as
-  /// its own call; this returns once it did. Returns why it was refused, if it was.
+  /// its own call; this returns once it did. Also `add` (add_spec) and `remove` (remove_applet
+  /// or, with `service` set, remove_service). Returns why it was refused, if it was.
   std::optional<std::string> apply_event(const AppletEvent& event);
+
+  /// Adds services and applets while the system runs (docs/coordinator.md, "Adding and removing
+  /// at run time"): `spec` is YAML with `services:` (as in the system file) and/or `applets:`
+  /// (as `coordinator: applets:` entries, in this process); `name` names it in messages. Added
+  /// services configure their providers as the file's do; added applets start at once. All or
+  /// nothing. Returns why it was refused ("name:line: ..."), if it was.
+  std::optional<std::string> add_spec(const std::string& spec, const std::string& name);
+  /// Removes an applet: its bundles are released, the services it provides become unavailable,
+  /// its thread ends. Returns why it was refused, if it was.
+  std::optional<std::string> remove_applet(const std::string& applet);
+  /// Removes a service nobody uses. Returns why it was refused (the applets whose bundles use
+  /// it, the services that need it), if it was.
+  std::optional<std::string> remove_service(const std::string& service);
 
  private:
   struct Snapshot;
@@ -85,11 +99,27 @@ class Coordinator final : public AppletGateway {
   // Refused unless the providers of `service` are (or become) configured for its holder; with
   // reconcile_mutex_ held.
   std::optional<ConfigReply> await_providers(const std::string& service, const std::string& module);
+  // What the runtime runs for an applet made here.
+  applets::AppletCode code_of(Applet* applet);
+  // Adds what `addition` (read from `root`, named `name`) says; `remote` names the process of
+  // an applet joining from another process (its hello), else empty. With change_mutex_ held.
+  void add_locked(const SystemAddition& addition, const YAML::Node& root, const std::string& name,
+                  const std::string& remote);
+  // Removes an applet; `by_operator` keeps its joined process's session from joining again.
+  std::optional<std::string> remove_applet(const std::string& applet, bool by_operator);
+  // A hello with a spec from an applet the coordinator does not know.
+  std::optional<std::string> join(const std::string& applet, const std::string& process,
+                                  const std::string& spec);
 
   const SystemSpec& system_;
+  DdsParticipant& participant_;  // applets added at run time read cues through it
+  std::vector<std::string> plugin_path_;
   applets::SystemConfig config_;
   std::unique_ptr<applets::Runtime> runtime_;
-  std::vector<std::unique_ptr<Applet>> applets_;        // by AppletId
+  std::vector<std::unique_ptr<Applet>> applets_;        // by AppletId; with change_mutex_ held
+  std::mutex change_mutex_;                             // one addition or removal at a time
+  mutable std::mutex services_mutex_;                   // guards the next two
+  std::vector<ServiceSpec> services_;                   // the file's and those added since
   std::vector<std::vector<std::string>> providers_of_;  // by ServiceId, as the plan shows them
   std::unique_ptr<ConfigClient> client_;
   std::unique_ptr<Providers> providers_;
