@@ -54,9 +54,16 @@ Cli oscar_applets(const CoordinatedSystem& c, std::vector<std::string> args, con
   std::vector<std::string> argv{test::bin("oscar-applets")};
   argv.insert(argv.end(), args.begin(), args.end());
   argv.insert(argv.end(), {"-d", std::to_string(c.sys.domain())});
-  test::Process p(argv, test::temp_path(log) + ".out");
-  const auto code = p.wait(std::chrono::seconds(30));
-  return {code.value_or(-1), p.output()};
+  const auto out = test::temp_path(log) + ".out";
+  Cli result;
+  {
+    test::Process p(argv, out);
+    result.code = p.wait(std::chrono::seconds(30)).value_or(-1);
+    result.output = p.output();
+  }
+  std::error_code ec;
+  std::filesystem::remove(out, ec);  // what it printed is in `result`, and in any failure
+  return result;
 }
 
 // A YAML file of this test's own, removed at the end of the test.
@@ -224,7 +231,7 @@ TEST(CoordinatorChanges, AnAppletJoiningFromAnotherProcessIsAddedAndRemovedWhenI
   // after it too.
   test::Process visitor({test::bin("oscar-applet"), c.sys.file(), "--applets", spec, "--module",
                          "visitors", "--domain", std::to_string(c.sys.domain())},
-                        test::temp_path("changes_join_visitor") + ".out");
+                        c.sys.log_dir() + "/visitors.out");
   c.wait_plan(
       [](const AppletPlan& p) {
         return CoordinatedSystem::applet(p, "visitor") == "visitors holding" &&
@@ -247,7 +254,7 @@ TEST(CoordinatorChanges, AnAppletJoiningFromAnotherProcessIsAddedAndRemovedWhenI
   // Its name is free again: a new start of the process joins again.
   test::Process again({test::bin("oscar-applet"), c.sys.file(), "--applets", spec, "--module",
                        "visitors", "--domain", std::to_string(c.sys.domain())},
-                      test::temp_path("changes_join_again") + ".out");
+                      c.sys.log_dir() + "/visitors-again.out");
   c.wait_plan(
       [](const AppletPlan& p) {
         return CoordinatedSystem::holders(p, "Camera") == Strings{"visitor"};
@@ -263,7 +270,7 @@ TEST(CoordinatorChanges, ARestartedCoordinatorAddsAJoinedAppletAgainFromItsHello
   const std::string& spec = file;
   test::Process visitor({test::bin("oscar-applet"), c.sys.file(), "--applets", spec, "--module",
                          "visitors", "--domain", std::to_string(c.sys.domain())},
-                        test::temp_path("changes_rejoin_visitor") + ".out");
+                        c.sys.log_dir() + "/visitors.out");
   c.wait_plan(
       [](const AppletPlan& p) {
         return CoordinatedSystem::holders(p, "Camera") == Strings{"visitor"};
