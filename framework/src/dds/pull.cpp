@@ -172,16 +172,30 @@ DdsPullSource::~DdsPullSource() {
   }
 }
 
-bool DdsPullSource::wait_matched(std::chrono::milliseconds timeout) const {
+bool DdsPullSource::wait_matched(std::chrono::milliseconds timeout) {
   const auto until = std::chrono::steady_clock::now() + timeout;
   for (;;) {
     dds::PublicationMatchedStatus pub;
     dds::SubscriptionMatchedStatus sub;
     requests_->get_publication_matched_status(pub);
     replies_->get_subscription_matched_status(sub);
-    if (pub.current_count > 0 && sub.current_count > 0) return true;
+    if (pub.current_count > 0 && sub.current_count > 0) break;
     if (std::chrono::steady_clock::now() > until) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  // Our reader knowing the producer's reply writer does not mean that writer knows our reader
+  // (discovery is not symmetric in time): a reply it sends before would be lost, and the input's
+  // first pull with it. A pull of no cues, answered, shows the way back is open.
+  for (;;) {
+    const auto probe = request(PullBlock::latest(0));
+    const auto left = until - std::chrono::steady_clock::now();
+    const auto wait =
+        std::min<std::chrono::steady_clock::duration>(left, std::chrono::milliseconds(50));
+    if (wait > std::chrono::steady_clock::duration::zero() &&
+        probe.wait_for(wait) == std::future_status::ready) {
+      return true;
+    }
+    if (std::chrono::steady_clock::now() > until) return false;
   }
 }
 

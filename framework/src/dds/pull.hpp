@@ -47,8 +47,9 @@ class DdsPullSource final : public PullSource, public eprosima::fastdds::dds::Da
   DdsPullSource(DdsParticipant& participant, InputPort& input, const std::string& source,
                 const std::string& requester);
   ~DdsPullSource() override;
-  /// Waits until the producer's pull server is matched both ways.
-  bool wait_matched(std::chrono::milliseconds timeout) const;
+  /// Waits until the producer's pull server is matched both ways and has answered a pull of no
+  /// cues (so that the input's first pull is not lost to discovery still under way).
+  bool wait_matched(std::chrono::milliseconds timeout);
   std::shared_future<std::shared_ptr<const void>> request(PullQuery query, Stamp t) override;
   std::shared_future<CueBlock> request(const PullBlock& block) override;
   void on_data_available(eprosima::fastdds::dds::DataReader* reader) override;
