@@ -8,36 +8,44 @@
 
 namespace oscar::coordinator {
 
+namespace {
+// A service in the applet scheduler's vocabulary: its name, access and needs.
+YAML::Node scheduler_service(const ServiceSpec& svc) {
+  YAML::Node s;
+  s["name"] = svc.name;
+  s["exclusive_only"] = svc.exclusive_only;
+  for (const auto& n : svc.needs) {
+    YAML::Node d;
+    d["service"] = n.service;
+    d["access"] = n.exclusive ? "exclusive" : "shared";
+    s["depends_on"].push_back(d);
+  }
+  return s;
+}
+
+// An applet in the scheduler's vocabulary: its entry without what is the coordinator's (type)
+// and where it runs (process, host). The nodes keep their lines for the scheduler's messages.
+YAML::Node scheduler_applet(const AppletSpec& a) {
+  YAML::Node applet;
+  for (const auto& kv : a.node) {
+    const auto key = kv.first.as<std::string>();
+    if (key != "type" && key != "process" && key != "host") applet[kv.first] = kv.second;
+  }
+  return applet;
+}
+}  // namespace
+
 applets::SystemConfig applet_system(const SystemSpec& system) {
   // The applet scheduler's own YAML vocabulary, assembled from the system file's nodes (which
   // keep their lines, so its messages point into the system file).
   YAML::Node doc;
   doc["services"] = YAML::Node(YAML::NodeType::Sequence);
-  for (const auto& svc : system.services) {
-    YAML::Node s;
-    s["name"] = svc.name;
-    s["exclusive_only"] = svc.exclusive_only;
-    for (const auto& n : svc.needs) {
-      YAML::Node d;
-      d["service"] = n.service;
-      d["access"] = n.exclusive ? "exclusive" : "shared";
-      s["depends_on"].push_back(d);
-    }
-    doc["services"].push_back(s);
-  }
+  for (const auto& svc : system.services) doc["services"].push_back(scheduler_service(svc));
   if (!system.coordinator) return applets::load_system(doc, system.file);
   const auto& c = *system.coordinator;
   if (c.scheduler.IsDefined() && !c.scheduler.IsNull()) doc["scheduler"] = c.scheduler;
   doc["applets"] = YAML::Node(YAML::NodeType::Sequence);
-  for (const auto& a : c.applets) {
-    YAML::Node applet;
-    for (const auto& kv : a.node) {
-      // type and where it runs (process, host) are the coordinator's, not the scheduler's.
-      const auto key = kv.first.as<std::string>();
-      if (key != "type" && key != "process" && key != "host") applet[kv.first] = kv.second;
-    }
-    doc["applets"].push_back(applet);
-  }
+  for (const auto& a : c.applets) doc["applets"].push_back(scheduler_applet(a));
   // A kernel's wishes are the bundles of an applet named after it (docs/coordinator.md).
   for (const auto& w : c.wishes) {
     YAML::Node applet;
@@ -52,29 +60,11 @@ YAML::Node scheduler_doc(const SystemAddition& addition) {
   YAML::Node doc;
   if (!addition.services.empty()) {
     doc["services"] = YAML::Node(YAML::NodeType::Sequence);
-    for (const auto& svc : addition.services) {
-      YAML::Node s;
-      s["name"] = svc.name;
-      s["exclusive_only"] = svc.exclusive_only;
-      for (const auto& n : svc.needs) {
-        YAML::Node d;
-        d["service"] = n.service;
-        d["access"] = n.exclusive ? "exclusive" : "shared";
-        s["depends_on"].push_back(d);
-      }
-      doc["services"].push_back(s);
-    }
+    for (const auto& svc : addition.services) doc["services"].push_back(scheduler_service(svc));
   }
   if (!addition.applets.empty()) {
     doc["applets"] = YAML::Node(YAML::NodeType::Sequence);
-    for (const auto& a : addition.applets) {
-      YAML::Node applet;
-      for (const auto& kv : a.node) {
-        const auto key = kv.first.as<std::string>();
-        if (key != "type" && key != "process" && key != "host") applet[kv.first] = kv.second;
-      }
-      doc["applets"].push_back(applet);
-    }
+    for (const auto& a : addition.applets) doc["applets"].push_back(scheduler_applet(a));
   }
   return doc;
 }
