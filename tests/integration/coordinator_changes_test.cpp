@@ -222,16 +222,22 @@ constexpr const char* kVisitor = R"(applets:
     bundles: [ { name: camera, priority: high, requested: true, resources: [ { service: Camera } ] } ]
 )";
 
+// The process "visitors" running the applets of `spec`, which join the system. Named like the
+// system's own processes (file and --domain), so that the fixture cleans up after it too; its
+// output goes to the system's log folder as `out`.
+test::Process visitors(const CoordinatedSystem& c, const std::string& spec,
+                       const std::string& out) {
+  return test::Process({test::bin("oscar-applet"), c.sys.file(), "--applets", spec, "--module",
+                        "visitors", "--domain", std::to_string(c.sys.domain())},
+                       c.sys.log_dir() + "/" + out);
+}
+
 TEST(CoordinatorChanges, AnAppletJoiningFromAnotherProcessIsAddedAndRemovedWhenItIsKilled) {
   CoordinatedSystem c("changes_join", two_camera_system());
   c.sys.running();
   const TempYaml file("changes_join_spec", kVisitor);
   const std::string& spec = file;
-  // Named like the system's own processes (file and --domain), so that the fixture cleans up
-  // after it too.
-  test::Process visitor({test::bin("oscar-applet"), c.sys.file(), "--applets", spec, "--module",
-                         "visitors", "--domain", std::to_string(c.sys.domain())},
-                        c.sys.log_dir() + "/visitors.out");
+  test::Process visitor = visitors(c, spec, "visitors.out");
   c.wait_plan(
       [](const AppletPlan& p) {
         return CoordinatedSystem::applet(p, "visitor") == "visitors holding" &&
@@ -252,9 +258,7 @@ TEST(CoordinatorChanges, AnAppletJoiningFromAnotherProcessIsAddedAndRemovedWhenI
   EXPECT_TRUE(c.logged("it joined by its hello, so it is removed"));
   c.wait_cam_mode("deactivated");
   // Its name is free again: a new start of the process joins again.
-  test::Process again({test::bin("oscar-applet"), c.sys.file(), "--applets", spec, "--module",
-                       "visitors", "--domain", std::to_string(c.sys.domain())},
-                      c.sys.log_dir() + "/visitors-again.out");
+  test::Process again = visitors(c, spec, "visitors-again.out");
   c.wait_plan(
       [](const AppletPlan& p) {
         return CoordinatedSystem::holders(p, "Camera") == Strings{"visitor"};
@@ -268,9 +272,7 @@ TEST(CoordinatorChanges, ARestartedCoordinatorAddsAJoinedAppletAgainFromItsHello
   c.sys.running();
   const TempYaml file("changes_rejoin_spec", kVisitor);
   const std::string& spec = file;
-  test::Process visitor({test::bin("oscar-applet"), c.sys.file(), "--applets", spec, "--module",
-                         "visitors", "--domain", std::to_string(c.sys.domain())},
-                        c.sys.log_dir() + "/visitors.out");
+  test::Process visitor = visitors(c, spec, "visitors.out");
   c.wait_plan(
       [](const AppletPlan& p) {
         return CoordinatedSystem::holders(p, "Camera") == Strings{"visitor"};

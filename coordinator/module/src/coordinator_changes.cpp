@@ -107,16 +107,20 @@ void Coordinator::add_locked(const SystemAddition& addition, const YAML::Node& /
   wake();
 }
 
+SystemAddition Coordinator::read_addition(const YAML::Node& root, const std::string& name) {
+  std::vector<ServiceSpec> now;
+  {
+    std::lock_guard lock(services_mutex_);
+    now = services_;
+  }
+  return system_.parse_addition(root, name, now);
+}
+
 std::optional<std::string> Coordinator::add_spec(const std::string& spec, const std::string& name) {
   try {
     std::lock_guard changing(change_mutex_);
     const auto root = applets::parse_yaml(spec, name);
-    std::vector<ServiceSpec> now;
-    {
-      std::lock_guard lock(services_mutex_);
-      now = services_;
-    }
-    const auto addition = system_.parse_addition(root, name, now);
+    const auto addition = read_addition(root, name);
     add_locked(addition, root, name, "");
   } catch (const std::exception& e) {
     return std::string(e.what());
@@ -130,12 +134,7 @@ std::optional<std::string> Coordinator::join(const std::string& applet, const st
   try {
     std::lock_guard changing(change_mutex_);
     const auto root = applets::parse_yaml(spec, name);
-    std::vector<ServiceSpec> now;
-    {
-      std::lock_guard lock(services_mutex_);
-      now = services_;
-    }
-    const auto addition = system_.parse_addition(root, name, now);
+    const auto addition = read_addition(root, name);
     if (!addition.services.empty() || addition.applets.size() != 1 ||
         addition.applets.front().name != applet) {
       throw std::invalid_argument(fmt::format(

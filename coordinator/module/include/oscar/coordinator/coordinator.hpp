@@ -103,6 +103,8 @@ class Coordinator final : public AppletGateway {
   applets::AppletCode code_of(Applet* applet);
   // Adds what `addition` (read from `root`, named `name`) says; `remote` names the process of
   // an applet joining from another process (its hello), else empty. With change_mutex_ held.
+  // `root` (a spec named `name`) checked against the system's services as they are now.
+  SystemAddition read_addition(const YAML::Node& root, const std::string& name);
   void add_locked(const SystemAddition& addition, const YAML::Node& root, const std::string& name,
                   const std::string& remote);
   // Removes an applet; `by_operator` keeps its joined process's session from joining again.
