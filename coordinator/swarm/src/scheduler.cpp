@@ -2,10 +2,7 @@
 
 #include <fmt/format.h>
 #include <algorithm>
-#include <boost/geometry.hpp>
-#include <boost/geometry/algorithms/point_on_surface.hpp>
 #include <cmath>
-#include <random>
 #include <stdexcept>
 
 #include "oscar/swarm/dubins_path_finder.hpp"
@@ -13,8 +10,6 @@
 #include "scheduler_state.hpp"
 
 namespace oscar::swarm {
-
-namespace bg = boost::geometry;
 
 void check_time(double t, const std::string& what) {
   if (!std::isfinite(t)) throw std::invalid_argument(fmt::format("{} must be finite", what));
@@ -224,60 +219,54 @@ void Scheduler::set_present(double t) {
   settings_.present = t;
 }
 
-std::vector<Point> Scheduler::sample_locations(const Polygon& area) {
-  // First a point inside the area (its centroid if inside), then uniform samples (seed §4.2.1, Ort:
-  // any P ∈ A ∩ S will do). The static obstacles are checked per node with its radius.
-  std::vector<Point> result;
-  Point c;
-  bg::centroid(area, c);
-  if (!strictly_inside(c, area)) bg::point_on_surface(area, c);
-  result.push_back(c);
-  const auto box = bg::return_envelope<bg::model::box<Point>>(area);
-  std::mt19937 rng(settings_.seed * 7919u + sample_counter_++);
-  std::uniform_real_distribution<double> ux(box.min_corner().x(), box.max_corner().x());
-  std::uniform_real_distribution<double> uy(box.min_corner().y(), box.max_corner().y());
-  for (int tries = 0; static_cast<int>(result.size()) < settings_.location_samples && tries < 1000;
-       ++tries) {
-    const Point p(ux(rng), uy(rng));
-    bool blocked = false;
-    for (const auto& o : world_.static_obstacles) blocked = blocked || strictly_inside(p, o);
-    if (strictly_inside(p, area) && !blocked) result.push_back(p);
-  }
-  return result;
-}
-
 bool Scheduler::locked_by_other(const NodeState& n, TransactionId tx, double lo, double hi) const {
   for (const auto& l : n.locks) {
-    if (l.tx != tx && lo < l.hi && l.lo < hi) return true;
+    if (l.tx != tx && lo < l.section.hi && l.section.lo < hi) return true;
   }
   return false;
 }
 
 void Scheduler::record(TransactionId tx, NodeState& n, double lo, double hi) {
-  auto& changes = transactions_[tx];
-  auto it = changes.find(n.spec.id);
-  if (it == changes.end()) {
-    changes[n.spec.id] = Change{lo, hi, {}, {}};
-    n.locks.push_back({tx, lo, hi});
-    return;
+  // The transaction's sections stay disjoint: a new one swallows only its own overlapping ones, so
+  // what lies between two sections (another transaction's open change) is never spliced over.
+  auto& sections = transactions_.at(tx).changes[n.spec.id].sections;
+  Section merged{lo, hi};
+  for (bool grew = true; grew;) {
+    grew = false;
+    std::erase_if(sections, [&](const Section& s) {
+      if (s.hi < merged.lo || merged.hi < s.lo) return false;
+      merged = {std::min(merged.lo, s.lo), std::max(merged.hi, s.hi)};
+      grew = true;
+      return true;
+    });
   }
-  it->second.lo = std::min(it->second.lo, lo);
-  it->second.hi = std::max(it->second.hi, hi);
-  for (auto& l : n.locks) {
-    if (l.tx == tx) l = {tx, it->second.lo, it->second.hi};
-  }
+  sections.push_back(merged);
+  std::erase_if(n.locks, [&](const NodeState::Lock& l) { return l.tx == tx; });
+  for (const auto& s : sections) n.locks.push_back({tx, s});
 }
 
-TransactionId Scheduler::open_transaction() {
+TransactionId Scheduler::open_transaction(bool atomic, std::string what) {
   const TransactionId id = next_transaction_++;
-  transactions_[id];
+  transactions_[id] = Transaction{{}, atomic, std::move(what)};
   return id;
 }
 
 std::vector<TransactionId> Scheduler::open_transactions() const {
   std::vector<TransactionId> ids;
-  for (const auto& [id, changes] : transactions_) ids.push_back(id);
+  for (const auto& [id, tx] : transactions_) ids.push_back(id);
   return ids;
+}
+
+const Scheduler::JobSet* Scheduler::set_of(const std::string& job_id) const {
+  const auto it = sets_.find(job_id);
+  return it == sets_.end() ? nullptr : it->second.get();
+}
+
+void Scheduler::keep_as_set(std::string what, const std::vector<Job>& jobs) {
+  auto set = std::make_shared<JobSet>();
+  set->what = std::move(what);
+  for (const auto& j : jobs) set->ids.push_back(j.id);
+  for (const auto& j : jobs) sets_[j.id] = set;
 }
 
 void Scheduler::finish(TransactionId tx, const std::string& node, bool commit) {
@@ -285,9 +274,15 @@ void Scheduler::finish(TransactionId tx, const std::string& node, bool commit) {
   if (it == transactions_.end()) {
     throw std::invalid_argument(fmt::format("unknown or finished transaction {}", tx));
   }
-  auto& changes = it->second;
+  auto& changes = it->second.changes;
   if (!node.empty()) {
     state(node);  // throws on an unknown node
+    if (it->second.atomic && changes.size() > 1) {
+      throw std::invalid_argument(fmt::format(
+          "transaction {} ({}) changes {} nodes and {}s only as a whole: all or nothing (seed "
+          "§4.2.2), not for node '{}' alone",
+          tx, it->second.what, changes.size(), commit ? "commit" : "abort", node));
+    }
   }
   for (auto c = changes.begin(); c != changes.end();) {
     if (!node.empty() && c->first != node) {
@@ -298,7 +293,7 @@ void Scheduler::finish(TransactionId tx, const std::string& node, bool commit) {
     const Change& ch = c->second;
     auto by_start = [](const Job& a, const Job& b) { return a.start < b.start; };
     if (commit) {
-      n.committed = n.committed.spliced(n.working, ch.lo, ch.hi);
+      for (const auto& s : ch.sections) n.committed = n.committed.spliced(n.working, s.lo, s.hi);
       for (const auto& r : ch.removed) {
         std::erase_if(n.committed_jobs, [&](const Job& j) { return j.id == r.id; });
       }
@@ -309,7 +304,7 @@ void Scheduler::finish(TransactionId tx, const std::string& node, bool commit) {
       }
       std::sort(n.committed_jobs.begin(), n.committed_jobs.end(), by_start);
     } else {
-      n.working = n.working.spliced(n.committed, ch.lo, ch.hi);
+      for (const auto& s : ch.sections) n.working = n.working.spliced(n.committed, s.lo, s.hi);
       for (const auto& id : ch.added) {
         std::erase_if(n.working_jobs, [&](const Job& j) { return j.id == id; });
       }
@@ -317,9 +312,38 @@ void Scheduler::finish(TransactionId tx, const std::string& node, bool commit) {
       std::sort(n.working_jobs.begin(), n.working_jobs.end(), by_start);
     }
     std::erase_if(n.locks, [&](const NodeState::Lock& l) { return l.tx == tx; });
+    // A job's set membership ends with the job.
+    for (const auto& id : ch.added) {
+      if (!job_exists(id)) sets_.erase(id);
+    }
+    for (const auto& r : ch.removed) {
+      if (!job_exists(r.id)) sets_.erase(r.id);
+    }
     c = changes.erase(c);
   }
   if (changes.empty() || node.empty()) transactions_.erase(it);
+}
+
+void Scheduler::remove_node(const std::string& id) {
+  const auto it =
+      std::find_if(nodes_.begin(), nodes_.end(), [&](const auto& n) { return n->spec.id == id; });
+  if (it == nodes_.end()) throw std::invalid_argument(fmt::format("unknown node id '{}'", id));
+  const NodeState& n = **it;
+  if (!n.locks.empty()) {
+    throw std::invalid_argument(fmt::format(
+        "node '{}' cannot be removed: open transaction {} changes it (commit or abort it first)",
+        id, n.locks.front().tx));
+  }
+  for (const auto& j : n.working_jobs) {
+    if (j.end() > settings_.present) {
+      throw std::invalid_argument(fmt::format(
+          "node '{}' cannot be removed: job '{}' ends at {}, after the present {} (seed §5.5.2: "
+          "only a node without unfinished jobs; unschedule them first)",
+          id, j.id, j.end(), settings_.present));
+    }
+  }
+  for (const auto& j : n.working_jobs) sets_.erase(j.id);
+  nodes_.erase(it);
 }
 
 void Scheduler::commit(TransactionId id, const std::string& node) { finish(id, node, true); }

@@ -113,7 +113,7 @@ bool Scheduler::try_candidate(const Slot& c, const JobSpec& spec, TransactionId 
     n.working = n.working.spliced(section, c.t1, stay_until);
     scheduled = Job{spec.id, n.spec.id, c.at.x(), c.at.y(), *start, spec.duration, spec};
     n.working_jobs.insert(n.working_jobs.begin() + static_cast<long>(c.index), scheduled);
-    transactions_[tx][n.spec.id].added.push_back(spec.id);
+    transactions_.at(tx).changes[n.spec.id].added.push_back(spec.id);
     return true;
   }
   return false;
@@ -129,7 +129,9 @@ bool Scheduler::try_schedule(const JobSpec& spec, TransactionId tx, const std::o
                          t_max, t_fh);
     return false;
   }
-  const auto locations = at ? std::vector<Point>{*at} : sample_locations(spec.area);
+  const auto locations =
+      at ? std::vector<Point>{*at}
+         : sample_locations(spec.area, world_.static_obstacles, settings_.location_samples);
   bool any_location = false;
   bool any_slot = false;
   for (const auto& p : locations) {
@@ -140,7 +142,9 @@ bool Scheduler::try_schedule(const JobSpec& spec, TransactionId tx, const std::o
       if (try_candidate(c, spec, tx, scheduled)) return true;
     }
   }
-  if (!any_location) {
+  if (locations.empty()) {
+    reason = fmt::format("job '{}': its area lies wholly within static obstacles", spec.id);
+  } else if (!any_location) {
     reason = fmt::format("job '{}': no sampled location in the area is free for any node", spec.id);
   } else if (!any_slot) {
     reason = fmt::format("job '{}': no node has an idle slot meeting conditions 4.2-4.4", spec.id);
@@ -240,7 +244,7 @@ bool Scheduler::try_unschedule(const std::string& job_id, TransactionId tx, bool
       n.working = n.working.spliced(*section, t1, t2);
     }
     record(tx, n, lo, hi);
-    transactions_[tx][n.spec.id].removed.push_back(*it);
+    transactions_.at(tx).changes[n.spec.id].removed.push_back(*it);
     list.erase(it);
     return true;
   }
@@ -255,10 +259,25 @@ bool Scheduler::try_unschedule(const std::string& job_id, TransactionId tx, bool
   throw std::invalid_argument(fmt::format("unknown job id '{}'", job_id));
 }
 
+namespace {
+
+std::string set_member_refusal(const std::string& job_id, const std::string& set) {
+  return fmt::format(
+      "job '{}' belongs to the {}: alone it cannot be unscheduled, removed or rescheduled without "
+      "breaking the set's guarantee (seed §4.2.2-4.2.4); unschedule the set as a whole",
+      job_id, set);
+}
+
+}  // namespace
+
 // unschedule and remove_job: one removal in a transaction of its own, kept on success, aborted
 // on failure or throw.
 ScheduleResult Scheduler::removal(const std::string& job_id, bool replan) {
   ScheduleResult result;
+  if (const JobSet* set = set_of(job_id)) {
+    result.reason = set_member_refusal(job_id, set->what);
+    return result;
+  }
   const TransactionId tx = open_transaction();
   try {
     result.ok = try_unschedule(job_id, tx, replan, result.reason);
@@ -278,10 +297,48 @@ ScheduleResult Scheduler::unschedule(const std::string& job_id) { return removal
 
 ScheduleResult Scheduler::remove_job(const std::string& job_id) { return removal(job_id, false); }
 
+ScheduleResult Scheduler::unschedule_set(const std::string& member_id) {
+  const JobSet* set = set_of(member_id);
+  if (!set) {
+    if (!job_exists(member_id)) {
+      throw std::invalid_argument(fmt::format("unknown job id '{}'", member_id));
+    }
+    throw std::invalid_argument(
+        fmt::format("job '{}' belongs to no periodic or dependent set", member_id));
+  }
+  const auto keep = sets_.at(member_id);  // the set outlives its members' removal below
+  ScheduleResult result;
+  const TransactionId tx = open_transaction(true, "unscheduling of the " + keep->what);
+  const double t_fh = frozen_horizon_time();
+  try {
+    for (const auto& id : keep->ids) {
+      const auto job = std::find_if(nodes_.begin(), nodes_.end(), [&](const auto& n) {
+        return std::any_of(n->working_jobs.begin(), n->working_jobs.end(),
+                           [&](const Job& j) { return j.id == id && j.start >= t_fh; });
+      });
+      if (job == nodes_.end()) continue;  // started already, or gone with a removed node
+      if (!try_unschedule(id, tx, true, result.reason)) {
+        abort(tx);
+        return result;
+      }
+    }
+  } catch (...) {
+    abort(tx);
+    throw;
+  }
+  result.ok = true;
+  result.transaction = tx;
+  return result;
+}
+
 ScheduleResult Scheduler::reschedule(const JobSpec& spec) {
   validate(spec, true);
   ScheduleResult result;
-  const TransactionId tx = open_transaction();
+  if (const JobSet* set = set_of(spec.id)) {
+    result.reason = set_member_refusal(spec.id, set->what);
+    return result;
+  }
+  const TransactionId tx = open_transaction(true, fmt::format("rescheduling of job '{}'", spec.id));
   Job job;
   try {
     if (try_unschedule(spec.id, tx, true, result.reason) &&

@@ -1,5 +1,6 @@
 // Atomic job sets: periodic (seed §4.2.3, A.2) and dependent (§4.2.4, A.3).
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -32,10 +33,12 @@ ScheduleResult Scheduler::schedule(const PeriodicSpec& spec) {
   ScheduleResult result;
   // Same location: one location for all repetitions, tried in turn (A.2); independent: each job
   // samples its own.
-  const auto locations =
-      spec.same_location ? sample_locations(spec.area) : std::vector<Point>{Point()};
+  const auto locations = spec.same_location ? sample_locations(spec.area, world_.static_obstacles,
+                                                               settings_.location_samples)
+                                            : std::vector<Point>{Point()};
+  const std::string what = "periodic set " + fmt::format("{}", fmt::join(spec.ids, ", "));
   for (const auto& p : locations) {
-    const TransactionId tx = open_transaction();
+    const TransactionId tx = open_transaction(true, what);
     std::vector<Job> done;
     bool ok = true;
     for (const auto& job : jobs) {
@@ -52,6 +55,7 @@ ScheduleResult Scheduler::schedule(const PeriodicSpec& spec) {
       result.reason.clear();
       result.transaction = tx;
       result.jobs = std::move(done);
+      keep_as_set(what, result.jobs);
       return result;
     }
     abort(tx);  // all or nothing (§4.2.2)
@@ -72,7 +76,10 @@ ScheduleResult Scheduler::schedule(const DependentSpec& spec) {
       return result;
     }
   }
-  const TransactionId tx = open_transaction();
+  std::vector<std::string> ids;
+  for (const auto& j : spec.jobs) ids.push_back(j.id);
+  const std::string what = "dependent set " + fmt::format("{}", fmt::join(ids, ", "));
+  const TransactionId tx = open_transaction(true, what);
   std::map<std::string, double> fixed;
   std::set<std::string> pending;
   for (const auto& j : spec.jobs) pending.insert(j.id);
@@ -110,6 +117,7 @@ ScheduleResult Scheduler::schedule(const DependentSpec& spec) {
   }
   result.ok = true;
   result.transaction = tx;
+  keep_as_set(what, result.jobs);
   return result;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // Internal state of the Scheduler, shared by its translation units.
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -16,21 +17,41 @@ struct Scheduler::NodeState {
   std::vector<Job> working_jobs;
   struct Lock {
     TransactionId tx;
-    double lo, hi;
+    Section section;
   };
   std::vector<Lock> locks;  // §4.2.7: trajectory sections changed by open transactions
 };
 
-// What one transaction changed on one node.
+// What one transaction changed on one node: disjoint sections of its trajectory (commit and abort
+// splice exactly these, never what lies between them) and the jobs it added and removed.
 struct Scheduler::Change {
-  double lo = 0, hi = 0;
+  std::vector<Section> sections;
   std::vector<std::string> added;
   std::vector<Job> removed;
+};
+
+// An open transaction (§4.2.7). An atomic one (a job set, a job moved between nodes) commits or
+// aborts as a whole: its changes on one node mean nothing without those on the others.
+struct Scheduler::Transaction {
+  std::map<std::string, Change> changes;  // by node id
+  bool atomic = false;
+  std::string what;  // for messages: "periodic set P1, P2"
+};
+
+// A periodic or dependent set (§4.2.3, §4.2.4): its members are unscheduled together or not at all.
+struct Scheduler::JobSet {
+  std::string what;  // "periodic set P1, P2, P3"
+  std::vector<std::string> ids;
 };
 
 // Precision limit of seed §5.3.1: doubles keep ~0.1 ns resolution up to this many seconds.
 inline constexpr double kMaxAbsTime = 1e6;
 
 void check_time(double t, const std::string& what);
+
+/// Up to `count` locations of the area minus the obstacles, spread breadth first over ever smaller
+/// rectangles (seed Anhang A.1, SAMPLE_LOCATIONS); none if nothing of the area is free.
+std::vector<Point> sample_locations(const Polygon& area, const std::vector<Polygon>& obstacles,
+                                    int count);
 
 }  // namespace oscar::swarm

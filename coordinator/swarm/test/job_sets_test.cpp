@@ -146,21 +146,22 @@ TEST(Transactions, CommitAndAbortPerNode) {
   Scheduler s({}, {});
   s.add_node({"n1", 0.1, 1, 0, 0, 0, 0});
   s.add_node({"n2", 0.1, 1, 0, 10, 0, 0});
-  // Two jobs at the same time far apart: one per node, one transaction.
-  std::vector<JobSpec> jobs{{"A", square(-1, -1, 1, 1), 10, 15, 5},
-                            {"B", square(-1, 9, 1, 11), 10, 15, 5}};
-  const auto r = s.schedule(DependentSpec{jobs, {}});
-  ASSERT_TRUE(r.ok) << r.reason;
-  EXPECT_NE(r.jobs[0].node, r.jobs[1].node);
-  s.commit(r.transaction, "n1");
-  EXPECT_EQ(s.open_transactions().size(), 1u);
-  s.abort(r.transaction, "n2");
+  // Two single jobs far apart, one per node, each in a transaction of its own.
+  const auto a = s.schedule(JobSpec{"A", square(-1, -1, 1, 1), 10, 15, 5});
+  const auto b = s.schedule(JobSpec{"B", square(-1, 9, 1, 11), 10, 15, 5});
+  ASSERT_TRUE(a.ok && b.ok);
+  ASSERT_EQ(a.jobs[0].node, "n1");
+  ASSERT_EQ(b.jobs[0].node, "n2");
+  s.commit(a.transaction, "n2");  // a node the transaction does not change: nothing to do
+  EXPECT_EQ(s.open_transactions().size(), 2u);
+  s.commit(a.transaction, "n1");
+  s.abort(b.transaction, "n2");
   EXPECT_TRUE(s.open_transactions().empty());
   EXPECT_EQ(s.jobs("n1").size(), 1u);
   EXPECT_TRUE(s.jobs("n2").empty());
   EXPECT_TRUE(s.jobs("n2", false).empty());
   try {
-    s.commit(r.transaction);
+    s.commit(a.transaction);
     FAIL();
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("unknown or finished transaction"), std::string::npos);

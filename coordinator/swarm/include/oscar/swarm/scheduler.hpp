@@ -26,7 +26,7 @@ struct SchedulerSettings {
   double dependency_margin = 0;  ///< d_m of eq. 4.10/4.11
   int location_samples = 10;     ///< locations tried per job (§4.2.1, Ort)
   double wait_threshold = 0;     ///< d_th of §4.3.4
-  unsigned seed = 1;             ///< seed of the location sampler
+  unsigned seed = 1;             ///< seed of the random path planner (OMPL)
 };
 
 /// A periodic job set (seed §4.2.3): job i starts within [start + i·period, start + (i+1)·period -
@@ -84,20 +84,27 @@ class Scheduler {
   /// Schedules dependent jobs, all or nothing, earliest implicit deadline first (§4.2.4, A.3).
   /// @throws std::invalid_argument on unknown ids or a cycle.
   ScheduleResult schedule(const DependentSpec& spec);
-  /// Removes a job and re-plans the trajectory around the gap (§4.2.5).
+  /// Removes a job and re-plans the trajectory around the gap (§4.2.5). A member of a periodic or
+  /// dependent set is refused (the set would lose its guarantee): use unschedule_set.
   /// @throws std::invalid_argument on an unknown id.
   ScheduleResult unschedule(const std::string& job_id);
+  /// Unschedules the members of the set `member_id` belongs to that start after the frozen
+  /// horizon, in one atomic transaction; members already started stay (§4.2.5 for a set).
+  /// @throws std::invalid_argument on an unknown id or a job that belongs to no set.
+  ScheduleResult unschedule_set(const std::string& member_id);
   /// Removes a job without re-planning (§4.2.5).
   /// @throws std::invalid_argument on an unknown id.
   ScheduleResult remove_job(const std::string& job_id);
-  /// Unschedules and schedules again atomically (§4.2.6).
+  /// Unschedules and schedules again atomically (§4.2.6). Set members are refused as by unschedule.
   ScheduleResult reschedule(const JobSpec& spec);
 
-  /// Commits a transaction, wholly or for one node (§4.2.7).
-  /// @throws std::invalid_argument on an unknown transaction or node.
+  /// Commits a transaction, wholly or for one node (§4.2.7). An atomic transaction (a job set, or
+  /// a job moved between nodes) that changes several nodes commits only as a whole.
+  /// @throws std::invalid_argument on an unknown transaction or node, or one node of an atomic
+  /// transaction that changes several.
   void commit(TransactionId id, const std::string& node = "");
-  /// Aborts a transaction, wholly or for one node (§4.2.7).
-  /// @throws std::invalid_argument on an unknown transaction or node.
+  /// Aborts a transaction, wholly or for one node (§4.2.7); atomic ones only as a whole.
+  /// @throws std::invalid_argument as commit.
   void abort(TransactionId id, const std::string& node = "");
   /// The open transactions, oldest first.
   std::vector<TransactionId> open_transactions() const;
@@ -106,6 +113,12 @@ class Scheduler {
   /// (eq. 4.5), excluding slots locked by transactions other than `tx` (§4.2.7).
   std::vector<Slot> qualifying_slots(const JobSpec& spec, const Point& at,
                                      TransactionId tx = 0) const;
+
+  /// Removes a node that has no job left to do (seed §4.1, §5.5.2): every job of it ends before the
+  /// present and no open transaction changes it. From then on it is no obstacle to anyone (§4.1:
+  /// removed robots vanish).
+  /// @throws std::invalid_argument on an unknown node, unfinished jobs or an open transaction.
+  void remove_node(const std::string& id);
 
   /// Moves the present forward (§4.2.1).
   /// @throws std::invalid_argument if t is before the present or not finite.
@@ -128,11 +141,18 @@ class Scheduler {
   const SchedulerSettings& settings() const { return settings_; }
 
  private:
+  struct Section {
+    double lo = 0, hi = 0;
+  };
   struct NodeState;
   struct Change;
+  struct Transaction;
+  struct JobSet;
   NodeState& state(const std::string& id);
   const NodeState& state(const std::string& id) const;
-  TransactionId open_transaction();
+  TransactionId open_transaction(bool atomic = false, std::string what = "");
+  const JobSet* set_of(const std::string& job_id) const;
+  void keep_as_set(std::string what, const std::vector<Job>& jobs);
   bool try_schedule(const JobSpec& spec, TransactionId tx, const std::optional<Point>& at,
                     std::string& reason, Job& scheduled);
   bool try_candidate(const Slot& c, const JobSpec& spec, TransactionId tx, Job& scheduled);
@@ -143,7 +163,6 @@ class Scheduler {
                                       const Point& at, double t) const;
   bool locked_by_other(const NodeState& n, TransactionId tx, double lo, double hi) const;
   void record(TransactionId tx, NodeState& n, double lo, double hi);
-  std::vector<Point> sample_locations(const Polygon& area);
   const SpatialPathFinder& finder(const NodeState& n) const;
   std::vector<MovingObstacle> obstacles_for(const NodeState& n) const;
   TrajectoryPlanner::PathFunction path_function(const NodeState& n) const;
@@ -156,9 +175,9 @@ class Scheduler {
   std::vector<std::unique_ptr<NodeState>> nodes_;
   mutable std::map<double, std::unique_ptr<SpatialPathFinder>> finders_;  // by node radius
   mutable std::map<std::pair<double, double>, std::unique_ptr<DubinsPathFinder>> dubins_finders_;
-  std::map<TransactionId, std::map<std::string, Change>> transactions_;
+  std::map<TransactionId, Transaction> transactions_;
+  std::map<std::string, std::shared_ptr<const JobSet>> sets_;  // by member job id
   TransactionId next_transaction_ = 1;
-  unsigned sample_counter_ = 0;
 };
 
 }  // namespace oscar::swarm

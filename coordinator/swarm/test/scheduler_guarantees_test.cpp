@@ -1,0 +1,200 @@
+// Regressions of the planner review: transactions keep disjoint sections, sets stay sets after
+// scheduling, nodes are removed only when done, locations are sampled from the free area (A.1).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "expect_error.hpp"
+#include "oscar/swarm/scheduler.hpp"
+
+namespace oscar::swarm {
+namespace {
+
+using test::expect_error;
+
+Polygon square(double x0, double y0, double x1, double y1) {
+  return make_polygon({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, "square");
+}
+
+bool near(const Point& p, double x, double y) { return std::hypot(p.x() - x, p.y() - y) < 1e-6; }
+
+// One node with committed jobs J1 at (3,0) from 5 and J2 at (3,0) from 40; job X at (-3,0) in
+// the pause between them stays open (transaction A); then a periodic set places P0 before J1 and
+// P1 after J2 (transaction B): B changes two sections with A's open section between them.
+struct Interleaved {
+  Scheduler s{{}, {}};
+  ScheduleResult a, b;
+  Interleaved() {
+    s.add_node({"n1", 0.1, 1, 0, 0, 0, 0});
+    for (const auto& j : {JobSpec{"J1", square(2.9, -0.1, 3.1, 0.1), 5, 15, 2},
+                          JobSpec{"J2", square(2.9, -0.1, 3.1, 0.1), 40, 50, 2}}) {
+      const auto r = s.schedule(j);
+      EXPECT_TRUE(r.ok) << r.reason;
+      s.commit(r.transaction);
+    }
+    a = s.schedule(JobSpec{"X", square(-3.1, -0.1, -2.9, 0.1), 20, 30, 2});
+    EXPECT_TRUE(a.ok) << a.reason;
+    b = s.schedule(PeriodicSpec{{"P0", "P1"}, square(0.9, -0.1, 1.1, 0.1), true, 0, 50, 1});
+    EXPECT_TRUE(b.ok) << b.reason;
+    EXPECT_LT(b.jobs[0].start, 5);   // before J1
+    EXPECT_GT(b.jobs[1].start, 42);  // after J2
+  }
+  Point working_at(double t) const { return s.trajectory("n1", false).position_at(t); }
+  Point committed_at(double t) const { return s.trajectory("n1", true).position_at(t); }
+};
+
+TEST(Transactions, AbortingASetAroundAnotherOpenJobKeepsThatJobsDetour) {
+  Interleaved w;
+  const double x_start = w.a.jobs[0].start;
+  ASSERT_TRUE(near(w.working_at(x_start + 1), -3, 0));
+  w.s.abort(w.b.transaction);
+  EXPECT_TRUE(near(w.working_at(x_start + 1), -3, 0)) << "the set's abort undid X's detour";
+  w.s.commit(w.a.transaction);
+  EXPECT_TRUE(near(w.committed_at(x_start + 1), -3, 0)) << "X committed without going there";
+  ASSERT_EQ(w.s.jobs("n1").size(), 3u);
+}
+
+TEST(Transactions, CommittingASetAroundAnotherOpenJobLeavesThatDetourUncommitted) {
+  Interleaved w;
+  const double x_start = w.a.jobs[0].start;
+  w.s.commit(w.b.transaction);
+  EXPECT_FALSE(near(w.committed_at(x_start + 1), -3, 0)) << "X's open detour was committed";
+  EXPECT_TRUE(near(w.committed_at(w.b.jobs[0].start), 1, 0));
+  EXPECT_TRUE(near(w.committed_at(w.b.jobs[1].start), 1, 0));
+  w.s.abort(w.a.transaction);
+  EXPECT_TRUE(near(w.working_at(x_start + 1), w.committed_at(x_start + 1).x(), 0));
+  EXPECT_TRUE(near(w.working_at(w.b.jobs[1].start), 1, 0)) << "X's abort undid the set";
+  EXPECT_EQ(w.s.jobs("n1", false).size(), 4u);
+}
+
+// Two nodes far apart, a periodic set whose repetitions go one to each.
+Scheduler two_nodes() {
+  Scheduler s({}, {});
+  s.add_node({"n1", 0.1, 1, 0, 0, 0, 0});
+  s.add_node({"n2", 0.1, 1, 0, 10, 0, 0});
+  return s;
+}
+
+TEST(JobSets, MembersAreNotUnscheduledRemovedOrRescheduledAlone) {
+  Scheduler s = two_nodes();
+  const auto set = s.schedule(DependentSpec{
+      {{"A", square(-1, -1, 1, 1), 10, 15, 5}, {"B", square(-1, 9, 1, 11), 30, 40, 5}},
+      {{"B", {"A"}}}});
+  ASSERT_TRUE(set.ok) << set.reason;
+  s.commit(set.transaction);
+  for (const auto& r : {s.unschedule("A"), s.remove_job("A"),
+                        s.reschedule({"A", square(-1, -1, 1, 1), 20, 29, 5})}) {
+    EXPECT_FALSE(r.ok);
+    EXPECT_NE(r.reason.find("belongs to the dependent set A, B"), std::string::npos) << r.reason;
+  }
+  EXPECT_TRUE(s.open_transactions().empty());
+  EXPECT_EQ(s.jobs("n1").size() + s.jobs("n2").size(), 2u);
+  const auto gone = s.unschedule_set("B");
+  ASSERT_TRUE(gone.ok) << gone.reason;
+  s.commit(gone.transaction);
+  EXPECT_TRUE(s.jobs("n1").empty());
+  EXPECT_TRUE(s.jobs("n2").empty());
+  // Membership ends with the jobs: a new single job may take a former member's id.
+  const auto single = s.schedule(JobSpec{"A", square(-1, -1, 1, 1), 10, 15, 5});
+  ASSERT_TRUE(single.ok) << single.reason;
+  s.commit(single.transaction);
+  EXPECT_TRUE(s.unschedule("A").ok);
+  expect_error([&] { s.unschedule_set("nope"); }, "unknown job id 'nope'");
+}
+
+TEST(JobSets, UnschedulingASetKeepsWhatHasStarted) {
+  Scheduler s = two_nodes();
+  const auto set =
+      s.schedule(PeriodicSpec{{"P0", "P1", "P2"}, square(-1, -1, 1, 1), true, 0, 20, 2});
+  ASSERT_TRUE(set.ok) << set.reason;
+  s.commit(set.transaction);
+  s.set_present(set.jobs[1].start + 0.5);  // P0 done, P1 under way
+  const auto rest = s.unschedule_set("P0");
+  ASSERT_TRUE(rest.ok) << rest.reason;
+  s.commit(rest.transaction);
+  std::vector<std::string> left;
+  for (const auto& n : {"n1", "n2"}) {
+    for (const auto& j : s.jobs(n)) left.push_back(j.id);
+  }
+  EXPECT_EQ(left, (std::vector<std::string>{"P0", "P1"}));
+}
+
+TEST(JobSets, AnAtomicTransactionOverSeveralNodesFinishesOnlyAsAWhole) {
+  Scheduler s = two_nodes();
+  const auto set = s.schedule(DependentSpec{
+      {{"A", square(-1, -1, 1, 1), 10, 15, 5}, {"B", square(-1, 9, 1, 11), 10, 15, 5}}, {}});
+  ASSERT_TRUE(set.ok) << set.reason;
+  ASSERT_NE(set.jobs[0].node, set.jobs[1].node);
+  expect_error([&] { s.commit(set.transaction, "n1"); },
+               "(dependent set A, B) changes 2 nodes and commits only as a whole");
+  expect_error([&] { s.abort(set.transaction, "n2"); }, "aborts only as a whole");
+  s.abort(set.transaction);
+  EXPECT_TRUE(s.jobs("n1", false).empty());
+  EXPECT_TRUE(s.jobs("n2", false).empty());
+  // An aborted set leaves no membership behind either.
+  const auto single = s.schedule(JobSpec{"A", square(-1, -1, 1, 1), 10, 15, 5});
+  ASSERT_TRUE(single.ok);
+  s.commit(single.transaction);
+  EXPECT_TRUE(s.unschedule("A").ok);
+}
+
+TEST(Nodes, ANodeIsRemovedOnlyWhenItsJobsAreDone) {
+  Scheduler s = two_nodes();
+  const auto r = s.schedule(JobSpec{"A", square(-1, -1, 1, 1), 10, 15, 5});
+  ASSERT_TRUE(r.ok);
+  const std::string node = r.jobs[0].node;
+  expect_error([&] { s.remove_node(node); }, "open transaction");
+  s.commit(r.transaction);
+  expect_error([&] { s.remove_node(node); }, "job 'A' ends at 15");
+  expect_error([&] { s.remove_node("n9"); }, "unknown node id 'n9'");
+  s.set_present(15);
+  s.remove_node(node);
+  EXPECT_EQ(s.node_ids().size(), 1u);
+  // §4.1: a removed node vanishes, it is no obstacle: the other node may drive through its place.
+  const std::string other = node == "n1" ? "n2" : "n1";
+  const Point gone_at = node == "n1" ? Point(0, 0) : Point(0, 10);
+  const auto through = s.schedule(JobSpec{
+      "B", square(gone_at.x() - 0.2, gone_at.y() - 0.2, gone_at.x() + 0.2, gone_at.y() + 0.2), 16,
+      100, 1});
+  ASSERT_TRUE(through.ok) << through.reason;
+  EXPECT_EQ(through.jobs[0].node, other);
+}
+
+TEST(LocationSampling, SamplesTheAreaMinusStaticObstacles) {
+  // The area's centroid lies in an obstacle; with one sample (A.1: the free area's first sample),
+  // the job still finds a place.
+  World world;
+  world.static_obstacles.push_back(square(1, 1, 3, 3));
+  Scheduler s(world, {.location_samples = 1});
+  s.add_node({"n1", 0.1, 1, -2, -2, 0, 0});
+  const auto r = s.schedule(JobSpec{"A", square(0, 0, 4, 4), 0, 100, 1});
+  ASSERT_TRUE(r.ok) << r.reason;
+  const Point at = r.jobs[0].location();
+  EXPECT_FALSE(strictly_inside(at, world.static_obstacles[0]));
+  EXPECT_TRUE(strictly_inside(at, square(0, 0, 4, 4)));
+  const auto walled = s.schedule(JobSpec{"B", square(1.5, 1.5, 2.5, 2.5), 0, 100, 1});
+  EXPECT_FALSE(walled.ok);
+  EXPECT_NE(walled.reason.find("wholly within static obstacles"), std::string::npos)
+      << walled.reason;
+}
+
+TEST(LocationSampling, SamplesSpreadOverTheAreaAndRepeat) {
+  // An L-shaped free area whose first sample (top strip) is too far for the job's window: a later
+  // sample, in a rectangle of the split, lies in the right strip near the node.
+  auto place = [](int samples) {
+    World world;
+    world.static_obstacles.push_back(square(0, 0, 9, 9));  // leaves an L of width 1
+    Scheduler s(world, {.location_samples = samples});
+    s.add_node({"n1", 0.1, 1, 9.5, -1, 0, 0});
+    const auto r = s.schedule(JobSpec{"A", square(0, 0, 10, 10), 0, 8, 1});
+    return r.ok ? std::optional<Point>(r.jobs[0].location()) : std::nullopt;
+  };
+  const auto a = place(20), b = place(20);
+  ASSERT_TRUE(a && b);
+  EXPECT_TRUE(near(*a, b->x(), b->y())) << "sampling is deterministic";
+  EXPECT_GT(a->x(), 9);
+}
+
+}  // namespace
+}  // namespace oscar::swarm
