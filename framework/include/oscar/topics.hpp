@@ -16,6 +16,7 @@
 #include <oscar/pullPubSubTypes.h>
 #include <oscar/registryPubSubTypes.h>
 #include <oscar/schedPubSubTypes.h>
+#include <oscar/swarmPubSubTypes.h>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
@@ -91,6 +92,12 @@ TopicSpec<SchedNotice, SchedNoticePubSubType> sched_notice();
 /// An applet's commands to modules through the coordinator, and their replies.
 TopicSpec<SchedCommand, SchedCommandPubSubType> sched_command();
 TopicSpec<SchedCommandReply, SchedCommandReplyPubSubType> sched_command_reply();
+
+/// The live swarm (docs/swarm.md): jobs submitted to the coordinator and its replies (reliable,
+/// volatile, keep all), and the swarm's status (keep last 1; `oscar swarm status`).
+TopicSpec<SwarmRequest, SwarmRequestPubSubType> swarm_request();
+TopicSpec<SwarmReply, SwarmReplyPubSubType> swarm_reply();
+TopicSpec<SwarmStatus, SwarmStatusPubSubType> swarm_status();
 
 }  // namespace topics
 }  // namespace oscar

@@ -115,4 +115,16 @@ TopicSpec<SchedCommandReply, SchedCommandReplyPubSubType> sched_command_reply() 
   return {"oscar/sched/command_reply", qos::command_writer(), qos::command_reader()};
 }
 
+TopicSpec<SwarmRequest, SwarmRequestPubSubType> swarm_request() {
+  return {"oscar/swarm/request", qos::command_writer(), qos::command_reader()};
+}
+
+TopicSpec<SwarmReply, SwarmReplyPubSubType> swarm_reply() {
+  return {"oscar/swarm/reply", qos::command_writer(), qos::command_reader()};
+}
+
+TopicSpec<SwarmStatus, SwarmStatusPubSubType> swarm_status() {
+  return {"oscar/swarm/status", qos::state_writer(1), qos::state_reader(1)};
+}
+
 }  // namespace oscar::topics
