@@ -113,6 +113,39 @@ Scheduler circle_world(int nodes, bool block, int jobs_per_node = 0) {
   return s;
 }
 
+// `nodes` nodes and `jobs` jobs (each committed) in a 200 m square with `obstacles` static
+// squares of 1-3 m at random places: how static obstacles scale the whole scheduling.
+struct StaticRun {
+  double seconds;
+  int scheduled;
+};
+StaticRun static_world_run(int obstacles, int nodes, int jobs) {
+  std::mt19937 rng(7);
+  auto uni = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  World w;
+  for (int i = 0; i < obstacles; ++i)
+    w.static_obstacles.push_back(square(uni(5, 195), uni(5, 195), uni(0.5, 1.5)));
+  Scheduler s(std::move(w), {.frozen_horizon = 1, .location_samples = 3});
+  for (int added = 0, tries = 0; added < nodes && tries < 100 * nodes; ++tries) {
+    try {
+      s.add_node({fmt::format("n{}", added), 0.3, 1.0, uni(0, 200), uni(0, 200), 0, 0});
+      ++added;
+    } catch (const std::invalid_argument&) {
+    }
+  }
+  int scheduled = 0;
+  const auto t0 = Clock::now();
+  for (int j = 0; j < jobs; ++j) {
+    const double x = uni(5, 195), y = uni(5, 195), t = uni(0, 2500), d = uni(5, 30);
+    const auto r = s.schedule(JobSpec{fmt::format("J{}", j), square(x, y, 2), t, t + d + 300, d});
+    if (r.ok) {
+      s.commit(r.transaction);
+      ++scheduled;
+    }
+  }
+  return {ms_since(t0) / 1000, scheduled};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -120,12 +153,14 @@ int main(int argc, char** argv) {
   bool json = false;
   int repeat = 5, e2e_nodes = 100, e2e_obstacles = 50, e2e_jobs = 1000;
   double max_seconds = 120;
+  int static_max = 400;
   app.add_flag("--json", json, "print JSON instead of tables");
   app.add_option("--repeat", repeat, "measurements per point (the minimum is reported)");
   app.add_option("--nodes", e2e_nodes, "end-to-end: nodes");
   app.add_option("--obstacles", e2e_obstacles, "end-to-end: moving obstacles");
   app.add_option("--jobs", e2e_jobs, "end-to-end: jobs");
   app.add_option("--max-seconds", max_seconds, "end-to-end: stop scheduling after this long");
+  app.add_option("--static-max", static_max, "static obstacles series: up to this many");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 
   nlohmann::json doc;
@@ -192,6 +227,19 @@ int main(int argc, char** argv) {
     const bool ok = s.schedule(d).ok;
     return Timed{ms_since(t0), ok};
   });
+
+  // Static obstacles: 20 nodes and 100 jobs among more and more static squares (one run each).
+  doc["series"]["static_obstacles"] = nlohmann::json::array();
+  if (!json)
+    fmt::print("\n{:<34} {:>6} {:>11} {:>9}\n", "static_obstacles (20 nodes, 100 jobs)", "n",
+               "s total", "scheduled");
+  for (int n : {25, 50, 100, 200, 400}) {
+    if (n > static_max) break;
+    const auto r = static_world_run(n, 20, 100);
+    doc["series"]["static_obstacles"].push_back(
+        {{"n", n}, {"seconds", r.seconds}, {"scheduled", r.scheduled}});
+    if (!json) fmt::print("{:<34} {:>6} {:>11.3f} {:>9}\n", "", n, r.seconds, r.scheduled);
+  }
 
   // End to end: a 200 m square, random moving obstacles and jobs, every success committed.
   {
