@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -229,18 +230,28 @@ class Parser {
       ds.jobs.push_back(job(jn));
       new_job_id(jn, ds.jobs.back().id);
     }
-    if (const auto deps = o["depends"]) {
-      for (const auto& kv : deps) {
-        auto& list = ds.depends[kv.first.as<std::string>()];
-        for (const auto& d : kv.second) list.push_back(text(d, "depends"));
-      }
-    }
+    if (const auto deps = o["depends"]) ds.depends = depends(deps);
     try {
       topological_order(ds.jobs, ds.depends);
     } catch (const std::invalid_argument& e) {
       fail(o["depends"] ? o["depends"] : o, e.what());
     }
     return ds;
+  }
+
+  // `C: [A, B]` per job: a scalar or a mapping in place of the list would be skipped silently.
+  std::map<std::string, std::vector<std::string>> depends(const YAML::Node& node) const {
+    if (!node.IsMap()) fail(node, "depends: expected a mapping of job id to a list of job ids");
+    std::map<std::string, std::vector<std::string>> result;
+    for (const auto& kv : node) {
+      const std::string id = text(kv.first, "depends: job id");
+      const std::string what = fmt::format("depends.{}", id);
+      if (result.count(id)) fail(kv.first, what + ": given twice");
+      if (!kv.second.IsSequence()) fail(kv.second, what + ": expected a list of job ids");
+      auto& list = result[id];
+      for (const auto& d : kv.second) list.push_back(text(d, what));
+    }
+    return result;
   }
 
   // commit and abort: which transaction (0 = the last open one) and optionally which node.

@@ -95,5 +95,27 @@ TEST(Problem, BadInputNamesFileLineAndRule) {
   expect_error("nodes: [ {id: a", "not valid YAML");
 }
 
+const std::string kTwoDependentJobs = R"(operations:
+  - op: schedule_dependent
+    jobs:
+      - { id: A, area: [[1,0],[2,0],[2,1],[1,1]], earliest_start: 0, latest_finish: 60, duration: 5 }
+      - { id: B, area: [[3,0],[4,0],[4,1],[3,1]], earliest_start: 0, latest_finish: 60, duration: 5 }
+)";
+
+TEST(Problem, DependsNeedsAListOfJobIdsPerJob) {
+  // `A: B` was skipped without a word, and A was scheduled before B.
+  expect_error(kNodes + kTwoDependentJobs + "    depends: { A: B }\n",
+               "p.yaml:9:19: depends.A: expected a list of job ids");
+  expect_error(kNodes + kTwoDependentJobs + "    depends: { A: { B: 1 } }\n",
+               "depends.A: expected a list of job ids");
+  expect_error(kNodes + kTwoDependentJobs + "    depends: [A, B]\n",
+               "p.yaml:9:14: depends: expected a mapping of job id to a list of job ids");
+  expect_error(kNodes + kTwoDependentJobs + "    depends: { A: [B], A: [] }\n",
+               "p.yaml:9:24: depends.A: given twice");
+  const auto p = parse_problem(kNodes + kTwoDependentJobs + "    depends: { A: [B] }\n", "p.yaml");
+  ASSERT_EQ(p.operations.size(), 1u);
+  EXPECT_EQ(p.operations[0].dependent.depends.at("A"), std::vector<std::string>{"B"});
+}
+
 }  // namespace
 }  // namespace oscar::swarm
