@@ -3,12 +3,15 @@
 #include <yaml-cpp/yaml.h>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
 
 #include "oscar/swarm/dependency_windows.hpp"
 
@@ -55,6 +58,22 @@ class Parser {
     return v;
   }
 
+  // Fails unless `node` is a mapping with only these keys, each once: a misspelt optional key
+  // would be ignored, and of two equal keys yaml-cpp reads the first.
+  void check_keys(const YAML::Node& node, const std::string& what,
+            std::initializer_list<std::string_view> allowed) const {
+    if (!node.IsMap()) fail(node, what + ": expected a mapping");
+    std::set<std::string> seen;
+    for (const auto& kv : node) {
+      const std::string& key = kv.first.Scalar();
+      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
+        fail(kv.first, fmt::format("{}: unknown key '{}' (expected one of: {})", what, key,
+                                   fmt::join(allowed, ", ")));
+      }
+      if (!seen.insert(key).second) fail(kv.first, fmt::format("{}: '{}' given twice", what, key));
+    }
+  }
+
   std::string text(const YAML::Node& node, const std::string& what) const {
     if (!node.IsScalar() || node.Scalar().empty())
       fail(node, what + ": expected a non-empty string");
@@ -81,6 +100,7 @@ class Parser {
     JobSpec j;
     j.id = text(required(node, "id", "job"), "job id");
     const std::string what = fmt::format("job '{}'", j.id);
+    check_keys(node, what, {"id", "area", "earliest_start", "latest_finish", "duration"});
     j.area = polygon(required(node, "area", what), what + " area");
     j.earliest_start = time(required(node, "earliest_start", what), what + " earliest_start");
     j.latest_finish = time(required(node, "latest_finish", what), what + " latest_finish");
@@ -94,6 +114,7 @@ class Parser {
   }
 
   World world(const YAML::Node& node) const {
+    check_keys(node, "world", {"static", "dynamic"});
     World w;
     if (const auto st = node["static"]) {
       for (std::size_t i = 0; i < st.size(); ++i) {
@@ -112,6 +133,7 @@ class Parser {
     NodeSpec s;
     s.id = text(required(n, "id", "node"), "node id");
     const std::string what = fmt::format("node '{}'", s.id);
+    check_keys(n, what, {"id", "radius", "max_speed", "start", "turning_radius"});
     if (!node_ids_.insert(s.id).second) fail(n, what + ": duplicate node id");
     s.radius_m = number(required(n, "radius", what), what + " radius");
     s.max_speed_mps = number(required(n, "max_speed", what), what + " max_speed");
@@ -137,6 +159,7 @@ class Parser {
 
  private:
   MovingObstacle moving_obstacle(const YAML::Node& node, const std::string& what) const {
+    check_keys(node, what, {"shape", "trajectory"});
     MovingObstacle o;
     o.shape = polygon(required(node, "shape", what), what + " shape");
     const auto traj = required(node, "trajectory", what);
@@ -160,22 +183,28 @@ class Parser {
     using K = Operation::Kind;
     if (op.name == "schedule" || op.name == "reschedule") {
       op.kind = op.name == "schedule" ? K::kSchedule : K::kReschedule;
+      check_keys(o, op.name, {"op", "job"});
       op.job = job_operation(o, op.name);
     } else if (op.name == "schedule_periodic") {
       op.kind = K::kPeriodic;
+      check_keys(o, op.name, {"op", "ids", "area", "same_location", "start", "period", "duration"});
       op.periodic = periodic(o);
     } else if (op.name == "schedule_dependent") {
       op.kind = K::kDependent;
+      check_keys(o, op.name, {"op", "jobs", "depends"});
       op.dependent = dependent(o);
     } else if (op.name == "unschedule" || op.name == "remove") {
       op.kind = op.name == "unschedule" ? K::kUnschedule : K::kRemove;
+      check_keys(o, op.name, {"op", "id"});
       op.id = text(required(o, "id", op.name), op.name + " id");
       if (!job_ids_.count(op.id)) fail(o, fmt::format("{}: unknown job id '{}'", op.name, op.id));
     } else if (op.name == "commit" || op.name == "abort") {
       op.kind = op.name == "commit" ? K::kCommit : K::kAbort;
+      check_keys(o, op.name, {"op", "transaction", "node"});
       finish(o, op);
     } else if (op.name == "set_present") {
       op.kind = K::kSetPresent;
+      check_keys(o, op.name, {"op", "t"});
       op.t = time(required(o, "t", op.name), "set_present t");
       if (op.t < present) {
         fail(o, fmt::format("set_present: present time must not go backwards ({} < {})", op.t,
@@ -290,11 +319,15 @@ Problem parse_problem(const std::string& text, const std::string& source) {
                                             e.mark.line + 1, e.mark.column + 1, e.msg));
   }
   if (!root.IsMap()) throw std::invalid_argument(source + ": expected a mapping at the top");
+  p.check_keys(root, "top level", {"world", "nodes", "settings", "operations"});
   Problem problem;
   problem.source = source;
   if (const auto world = root["world"]) problem.world = p.world(world);
   for (const auto& n : p.required(root, "nodes", "problem")) problem.nodes.push_back(p.node(n));
   if (const auto st = root["settings"]) {
+    p.check_keys(
+        st, "settings",
+        {"present", "frozen_horizon", "dependency_margin", "location_samples", "wait_threshold"});
     auto& s = problem.settings;
     if (st["present"]) s.present = p.time(st["present"], "settings.present");
     if (st["frozen_horizon"])

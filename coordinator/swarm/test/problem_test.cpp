@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "oscar/swarm/problem_runner.hpp"
 
@@ -115,6 +117,61 @@ TEST(Problem, DependsNeedsAListOfJobIdsPerJob) {
   const auto p = parse_problem(kNodes + kTwoDependentJobs + "    depends: { A: [B] }\n", "p.yaml");
   ASSERT_EQ(p.operations.size(), 1u);
   EXPECT_EQ(p.operations[0].dependent.depends.at("A"), std::vector<std::string>{"B"});
+}
+
+TEST(Problem, EveryMappingRefusesUnknownKeys) {
+  // A misspelt optional key was ignored: same_locaton: false planned the same location for all.
+  const std::string job =
+      "{ id: J, area: [[1,0],[2,0],[2,1],[1,1]], earliest_start: 0, "
+      "latest_finish: 60, duration: 5";
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {kNodes + "setings: {}\n",
+       "p.yaml:4:1: top level: unknown key 'setings' (expected one of: "
+       "world, nodes, settings, operations)"},
+      {kNodes + "world: { statics: [] }\n", "p.yaml:4:10: world: unknown key 'statics'"},
+      {kNodes + "world: { dynamic: [ { shape: [[0,0],[1,0],[1,1]], trajectory: [[5,5,0]], "
+                "speed: 1 } ] }\n",
+       "p.yaml:4:74: world.dynamic[0]: unknown key 'speed' (expected one of: shape, trajectory)"},
+      {"nodes:\n  - { id: n1, radius: 0.1, max_speed: 0.5, start: [0, 0, 0], turning_radus: 1 }\n",
+       "p.yaml:2:62: node 'n1': unknown key 'turning_radus' (expected one of: id, radius, "
+       "max_speed, start, turning_radius)"},
+      {kNodes + "settings: { location_sample: 3 }\n",
+       "p.yaml:4:13: settings: unknown key 'location_sample' (expected one of: present, "
+       "frozen_horizon, dependency_margin, location_samples, wait_threshold)"},
+      {kNodes + "operations:\n  - { op: schedule, job: " + job + ", duraton: 5 } }\n",
+       "p.yaml:5:119: job 'J': unknown key 'duraton' (expected one of: id, area, earliest_start, "
+       "latest_finish, duration)"},
+      {kNodes + "operations:\n  - { op: schedule, job: " + job + " }, commit: true }\n",
+       "p.yaml:5:121: schedule: unknown key 'commit' (expected one of: op, job)"},
+      {kNodes + "operations:\n  - { op: reschedule, jobs: " + job + " } }\n",
+       "reschedule: unknown key 'jobs'"},
+      {kNodes + "operations:\n  - { op: schedule_periodic, ids: [P1, P2], area: "
+                "[[1,0],[2,0],[2,1],[1,1]], same_locaton: false, start: 0, period: 20, "
+                "duration: 5 }\n",
+       "p.yaml:5:78: schedule_periodic: unknown key 'same_locaton' (expected one of: op, ids, "
+       "area, same_location, start, period, duration)"},
+      {kNodes + "operations:\n  - { op: schedule_dependent, jobs: [], depend: { A: [B] } }\n",
+       "p.yaml:5:41: schedule_dependent: unknown key 'depend' (expected one of: op, jobs, "
+       "depends)"},
+      {kNodes + "operations:\n  - { op: schedule_dependent, jobs: [" + job +
+           ", latest_start: 3 }] }\n",
+       "job 'J': unknown key 'latest_start'"},
+      {kNodes + "operations:\n  - { op: schedule, job: " + job +
+           " } }\n  - { op: unschedule, id: J, replan: false }\n",
+       "p.yaml:6:30: unschedule: unknown key 'replan' (expected one of: op, id)"},
+      {kNodes + "operations:\n  - { op: schedule, job: " + job +
+           " } }\n  - { op: remove, job: J }\n",
+       "remove: unknown key 'job'"},
+      {kNodes + "operations:\n  - { op: commit, nodes: n1 }\n",
+       "p.yaml:5:19: commit: unknown key 'nodes' (expected one of: op, transaction, node)"},
+      {kNodes + "operations:\n  - { op: abort, tx: 1 }\n", "abort: unknown key 'tx'"},
+      {kNodes + "operations:\n  - { op: set_present, time: 5 }\n",
+       "p.yaml:5:24: set_present: unknown key 'time' (expected one of: op, t)"},
+      {kNodes + "settings: { present: 0, present: 5 }\n",
+       "p.yaml:4:25: settings: 'present' given "
+       "twice"},
+  };
+  for (const auto& [text, message] : cases) expect_error(text, message);
 }
 
 }  // namespace
