@@ -61,7 +61,7 @@ class Parser {
   // Fails unless `node` is a mapping with only these keys, each once: a misspelt optional key
   // would be ignored, and of two equal keys yaml-cpp reads the first.
   void check_keys(const YAML::Node& node, const std::string& what,
-            std::initializer_list<std::string_view> allowed) const {
+                  std::initializer_list<std::string_view> allowed) const {
     if (!node.IsMap()) fail(node, what + ": expected a mapping");
     std::set<std::string> seen;
     for (const auto& kv : node) {
@@ -72,6 +72,20 @@ class Parser {
       }
       if (!seen.insert(key).second) fail(kv.first, fmt::format("{}: '{}' given twice", what, key));
     }
+  }
+
+  // Fails unless `node` is a list: yaml-cpp would iterate a scalar as an empty list.
+  YAML::Node list(const YAML::Node& node, const std::string& what) const {
+    if (!node.IsSequence()) fail(node, what + ": expected a list");
+    return node;
+  }
+
+  bool boolean(const YAML::Node& node, const std::string& what) const {
+    bool v = false;
+    if (!node.IsScalar() || !YAML::convert<bool>::decode(node, v)) {
+      fail(node, what + ": expected true or false");
+    }
+    return v;
   }
 
   std::string text(const YAML::Node& node, const std::string& what) const {
@@ -116,12 +130,14 @@ class Parser {
   World world(const YAML::Node& node) const {
     check_keys(node, "world", {"static", "dynamic"});
     World w;
-    if (const auto st = node["static"]) {
+    if (node["static"]) {
+      const auto st = list(node["static"], "world.static");
       for (std::size_t i = 0; i < st.size(); ++i) {
         w.static_obstacles.push_back(polygon(st[i], fmt::format("world.static[{}]", i)));
       }
     }
-    if (const auto dyn = node["dynamic"]) {
+    if (node["dynamic"]) {
+      const auto dyn = list(node["dynamic"], "world.dynamic");
       for (std::size_t i = 0; i < dyn.size(); ++i) {
         w.dynamic_obstacles.push_back(moving_obstacle(dyn[i], fmt::format("world.dynamic[{}]", i)));
       }
@@ -242,7 +258,8 @@ class Parser {
       new_job_id(id, ps.ids.back());
     }
     ps.area = polygon(required(o, "area", name), "schedule_periodic area");
-    if (o["same_location"]) ps.same_location = o["same_location"].as<bool>();
+    if (o["same_location"])
+      ps.same_location = boolean(o["same_location"], "schedule_periodic same_location");
     ps.start = time(required(o, "start", name), "schedule_periodic start");
     ps.period = number(required(o, "period", name), "schedule_periodic period");
     ps.duration = number(required(o, "duration", name), "schedule_periodic duration");
@@ -254,7 +271,7 @@ class Parser {
 
   DependentSpec dependent(const YAML::Node& o) {
     DependentSpec ds;
-    const auto jobs = required(o, "jobs", "schedule_dependent");
+    const auto jobs = list(required(o, "jobs", "schedule_dependent"), "schedule_dependent jobs");
     for (const auto& jn : jobs) {
       ds.jobs.push_back(job(jn));
       new_job_id(jn, ds.jobs.back().id);
@@ -323,7 +340,9 @@ Problem parse_problem(const std::string& text, const std::string& source) {
   Problem problem;
   problem.source = source;
   if (const auto world = root["world"]) problem.world = p.world(world);
-  for (const auto& n : p.required(root, "nodes", "problem")) problem.nodes.push_back(p.node(n));
+  for (const auto& n : p.list(p.required(root, "nodes", "problem"), "nodes")) {
+    problem.nodes.push_back(p.node(n));
+  }
   if (const auto st = root["settings"]) {
     p.check_keys(
         st, "settings",
@@ -347,7 +366,7 @@ Problem parse_problem(const std::string& text, const std::string& source) {
       p.fail(st["location_samples"], "settings.location_samples: must be >= 1");
   }
   if (const auto ops = root["operations"]) {
-    problem.operations = p.operations(ops, problem.settings.present);
+    problem.operations = p.operations(p.list(ops, "operations"), problem.settings.present);
   }
   return problem;
 }

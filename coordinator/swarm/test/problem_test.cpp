@@ -174,5 +174,23 @@ TEST(Problem, EveryMappingRefusesUnknownKeys) {
   for (const auto& [text, message] : cases) expect_error(text, message);
 }
 
+TEST(Problem, ListsAndBooleansAreWhatTheySay) {
+  // A scalar in place of a list was read as an empty list; a mapping or a bad boolean ended with
+  // yaml-cpp's message, without the file.
+  expect_error(kNodes + "world: { static: 5 }\n", "p.yaml:4:18: world.static: expected a list");
+  expect_error(kNodes + "world: { dynamic: { shape: [] } }\n",
+               "p.yaml:4:19: world.dynamic: expected a list");
+  expect_error("nodes: { id: n1 }\n", "p.yaml:1:8: nodes: expected a list");
+  expect_error(kNodes + "operations: { op: commit }\n", "p.yaml:4:13: operations: expected a list");
+  expect_error(kNodes + "operations:\n  - { op: schedule_dependent, jobs: A }\n",
+               "p.yaml:5:37: schedule_dependent jobs: expected a list");
+  expect_error(kNodes +
+                   "operations:\n  - { op: schedule_periodic, ids: [P1], area: "
+                   "[[1,0],[2,0],[2,1],[1,1]], same_location: maybe, start: 0, period: 20, "
+                   "duration: 5 }\n",
+               "p.yaml:5:89: schedule_periodic same_location: expected true or false");
+  expect_error(kNodes + "world: 5\n", "p.yaml:4:8: world: expected a mapping");
+}
+
 }  // namespace
 }  // namespace oscar::swarm
