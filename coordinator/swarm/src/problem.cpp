@@ -19,6 +19,11 @@ namespace oscar::swarm {
 
 namespace {
 
+// Locations tried per job: each costs a round of slot searches, so more than this is a typo.
+constexpr long long kMaxLocationSamples = 10000;
+// A transaction number in a file; the scheduler opens one per operation.
+constexpr long long kMaxTransaction = 1'000'000'000;
+
 class Parser {
  public:
   explicit Parser(std::string source) : source_(std::move(source)) {}
@@ -48,6 +53,18 @@ class Parser {
            fmt::format("{} = {}: times must lie within ±1e6 s (precision, seed §5.3.1)", what, t));
     }
     return t;
+  }
+
+  // An integer within [lo, hi]: a fraction is refused, not truncated, and the range keeps the
+  // conversion from double defined.
+  long long integer(const YAML::Node& node, const std::string& what, long long lo,
+                    long long hi) const {
+    const double v = number(node, what);
+    if (v != std::floor(v) || v < static_cast<double>(lo) || v > static_cast<double>(hi)) {
+      fail(node,
+           fmt::format("{} = {}: expected an integer from {} to {}", what, node.Scalar(), lo, hi));
+    }
+    return static_cast<long long>(v);
   }
 
   const YAML::Node required(const YAML::Node& map, const std::string& key,
@@ -303,10 +320,8 @@ class Parser {
   // commit and abort: which transaction (0 = the last open one) and optionally which node.
   void finish(const YAML::Node& o, Operation& op) const {
     if (o["transaction"]) {
-      const double t = number(o["transaction"], op.name + " transaction");
-      if (t < 1 || t != std::floor(t))
-        fail(o["transaction"], op.name + " transaction: expected a positive integer");
-      op.transaction = static_cast<TransactionId>(t);
+      op.transaction = static_cast<TransactionId>(
+          integer(o["transaction"], op.name + " transaction", 1, kMaxTransaction));
     }
     if (o["node"]) {
       op.node = text(o["node"], op.name + " node");
@@ -356,14 +371,12 @@ Problem parse_problem(const std::string& text, const std::string& source) {
     if (st["wait_threshold"])
       s.wait_threshold = p.number(st["wait_threshold"], "settings.wait_threshold");
     if (st["location_samples"])
-      s.location_samples =
-          static_cast<int>(p.number(st["location_samples"], "settings.location_samples"));
+      s.location_samples = static_cast<int>(
+          p.integer(st["location_samples"], "settings.location_samples", 1, kMaxLocationSamples));
     if (s.frozen_horizon < 0) p.fail(st["frozen_horizon"], "settings.frozen_horizon: must be >= 0");
     if (s.dependency_margin < 0)
       p.fail(st["dependency_margin"], "settings.dependency_margin: must be >= 0");
     if (s.wait_threshold < 0) p.fail(st["wait_threshold"], "settings.wait_threshold: must be >= 0");
-    if (s.location_samples < 1)
-      p.fail(st["location_samples"], "settings.location_samples: must be >= 1");
   }
   if (const auto ops = root["operations"]) {
     problem.operations = p.operations(p.list(ops, "operations"), problem.settings.present);

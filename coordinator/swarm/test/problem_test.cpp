@@ -192,5 +192,22 @@ TEST(Problem, ListsAndBooleansAreWhatTheySay) {
   expect_error(kNodes + "world: 5\n", "p.yaml:4:8: world: expected a mapping");
 }
 
+TEST(Problem, CountsAreIntegersInTheirRange) {
+  // location_samples: 2.7 was truncated to 2, and 1e300 was cast to int (undefined behaviour).
+  for (const std::string v : {"2.7", "0", "-3", "10001", "1e300"}) {
+    expect_error(
+        kNodes + "settings: { location_samples: " + v + " }\n",
+        "p.yaml:4:31: settings.location_samples = " + v + ": expected an integer from 1 to 10000");
+  }
+  EXPECT_EQ(parse_problem(kNodes + "settings: { location_samples: 10000 }\n", "p.yaml")
+                .settings.location_samples,
+            10000);
+  for (const std::string v : {"1.5", "0", "1e300"}) {
+    expect_error(
+        kNodes + "operations:\n  - { op: commit, transaction: " + v + " }\n",
+        "p.yaml:5:32: commit transaction = " + v + ": expected an integer from 1 to 1000000000");
+  }
+}
+
 }  // namespace
 }  // namespace oscar::swarm
