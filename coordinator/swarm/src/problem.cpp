@@ -357,6 +357,7 @@ Problem parse_problem(const std::string& text, const std::string& source) {
   if (const auto world = root["world"]) problem.world = p.world(world);
   for (const auto& n : p.list(p.required(root, "nodes", "problem"), "nodes")) {
     problem.nodes.push_back(p.node(n));
+    problem.node_positions.push_back({n.Mark().line + 1, n.Mark().column + 1});
   }
   if (const auto st = root["settings"]) {
     p.check_keys(

@@ -7,9 +7,26 @@
 
 namespace oscar::swarm {
 
+namespace {
+
+// Adds node i of the problem; what the scheduler refuses (a start inside an obstacle, say) is
+// reported at the node's place in the file.
+void add_node(Scheduler& scheduler, const Problem& problem, std::size_t i) {
+  try {
+    scheduler.add_node(problem.nodes[i]);
+  } catch (const std::invalid_argument& e) {
+    if (i >= problem.node_positions.size()) throw;
+    const auto& at = problem.node_positions[i];
+    throw std::invalid_argument(
+        fmt::format("{}:{}:{}: {}", problem.source, at.line, at.column, e.what()));
+  }
+}
+
+}  // namespace
+
 ProblemRunner::ProblemRunner(const Problem& problem)
     : problem_(problem), scheduler_(problem.world, problem.settings) {
-  for (const auto& n : problem.nodes) scheduler_.add_node(n);
+  for (std::size_t i = 0; i < problem.nodes.size(); ++i) add_node(scheduler_, problem, i);
 }
 
 void ProblemRunner::run() {

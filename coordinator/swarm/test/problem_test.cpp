@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "expect_error.hpp"
 #include "oscar/swarm/problem_runner.hpp"
 
 namespace oscar::swarm {
@@ -207,6 +208,18 @@ TEST(Problem, CountsAreIntegersInTheirRange) {
         kNodes + "operations:\n  - { op: commit, transaction: " + v + " }\n",
         "p.yaml:5:32: commit transaction = " + v + ": expected an integer from 1 to 1000000000");
   }
+}
+
+TEST(Problem, ANodeTheSchedulerRefusesIsReportedWhereItIsInTheFile) {
+  // The scheduler's message came without file and line.
+  const auto p = parse_problem(R"(world: { static: [[[-1,-1],[1,-1],[1,1],[-1,1]]] }
+nodes:
+  - { id: n1, radius: 0.1, max_speed: 0.5, start: [5, 5, 0] }
+  - { id: n2, radius: 0.1, max_speed: 0.5, start: [0, 0, 0] }
+)",
+                               "p.yaml");
+  test::expect_error([&] { ProblemRunner runner(p); },
+                     "p.yaml:4:5: node 'n2': start lies within radius of a static obstacle");
 }
 
 }  // namespace

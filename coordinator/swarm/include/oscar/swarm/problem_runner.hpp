@@ -22,7 +22,8 @@ struct OperationOutcome {
 class ProblemRunner {
  public:
   /// Builds the scheduler and adds the nodes.
-  /// @throws std::invalid_argument if a node is invalid or collides.
+  /// @throws std::invalid_argument if a node is invalid or collides, with the node's
+  /// "source:line:column" when the problem has its position.
   explicit ProblemRunner(const Problem& problem);
 
   /// Runs all operations; failures are outcomes, not exceptions.
