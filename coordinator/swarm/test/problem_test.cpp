@@ -222,5 +222,17 @@ nodes:
                      "p.yaml:4:5: node 'n2': start lies within radius of a static obstacle");
 }
 
+TEST(Problem, ABowTieIsReportedAsSelfIntersecting) {
+  // It was "polygon must be simple (not self-intersecting): Geometry has wrong orientation".
+  try {
+    parse_problem(kNodes + "world: { static: [[[0,0],[1,1],[1,0],[0,1]]] }\n", "p.yaml");
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "p.yaml:4:19: world.static[0]: polygon is self-intersecting (two of its edges cross "
+              "or touch); it must be simple");
+  }
+}
+
 }  // namespace
 }  // namespace oscar::swarm
