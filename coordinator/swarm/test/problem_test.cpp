@@ -234,5 +234,46 @@ TEST(Problem, ABowTieIsReportedAsSelfIntersecting) {
   }
 }
 
+TEST(Problem, TheJsonHasEachNodesLoadFromThePresentToTheLastJobsEnd) {
+  // n1 drives 2 m at 0.5 m/s (t 0-4) and works 10 s (4-14); n2 stays. With the present at 2 the
+  // interval is [2, 14]: n1 L_J = 10/12, L_M = 2/12, L_S = 0, L = 1, L_v = 1 m / (0.5 m/s · 12 s).
+  const auto p = parse_problem(R"(
+nodes:
+  - { id: n1, radius: 0.1, max_speed: 0.5, start: [0, 0, 0] }
+  - { id: n2, radius: 0.1, max_speed: 0.5, start: [50, 50, 0] }
+operations:
+  - { op: schedule, job: { id: J, area: [[1.9,-0.1],[2.1,-0.1],[2.1,0.1],[1.9,0.1]], earliest_start: 0, latest_finish: 100, duration: 10 } }
+  - { op: commit }
+  - { op: set_present, t: 2 }
+)",
+                               "p.yaml");
+  ProblemRunner runner(p);
+  runner.run();
+  const auto doc = nlohmann::json::parse(runner.to_json());
+  ASSERT_EQ(doc["jobs"].size(), 1u);
+  ASSERT_EQ(doc["jobs"][0]["node"], "n1");
+  EXPECT_NEAR(doc["jobs"][0]["start"].get<double>(), 4, 1e-9);
+  ASSERT_EQ(doc["load_interval"].size(), 2u);
+  EXPECT_DOUBLE_EQ(doc["load_interval"][0].get<double>(), 2);
+  EXPECT_NEAR(doc["load_interval"][1].get<double>(), 14, 1e-9);
+  const auto expect_load = [&](int node, std::vector<double> figures) {
+    const auto& load = doc["nodes"][node]["load"];
+    int k = 0;
+    for (const char* key : {"job", "motion", "stationary", "total", "velocity"}) {
+      EXPECT_NEAR(load[key].get<double>(), figures[k++], 1e-9) << "node " << node << " " << key;
+    }
+  };
+  expect_load(0, {10.0 / 12, 2.0 / 12, 0, 1, 1.0 / 6});
+  expect_load(1, {0, 0, 1, 0, 0});
+
+  // No committed job after the present: no interval, no load.
+  const auto idle_problem = parse_problem(kNodes, "p.yaml");
+  ProblemRunner idle(idle_problem);
+  idle.run();
+  const auto none = nlohmann::json::parse(idle.to_json());
+  EXPECT_FALSE(none.contains("load_interval"));
+  EXPECT_FALSE(none["nodes"][0].contains("load"));
+}
+
 }  // namespace
 }  // namespace oscar::swarm
