@@ -283,6 +283,12 @@ class Parser {
     if (ps.duration <= 0 || ps.period < ps.duration) {
       fail(o, "schedule_periodic: need 0 < duration <= period (seed §4.2.3)");
     }
+    const double end = ps.start + static_cast<double>(ps.ids.size()) * ps.period;
+    if (end > 1e6) {
+      fail(o, fmt::format("schedule_periodic: the last repetition ends at start + {}·period = {}: "
+                          "times must lie within ±1e6 s (precision, seed §5.3.1)",
+                          ps.ids.size(), end));
+    }
     return ps;
   }
 
@@ -366,7 +372,7 @@ Problem parse_problem(const std::string& text, const std::string& source) {
     auto& s = problem.settings;
     if (st["present"]) s.present = p.time(st["present"], "settings.present");
     if (st["frozen_horizon"])
-      s.frozen_horizon = p.number(st["frozen_horizon"], "settings.frozen_horizon");
+      s.frozen_horizon = p.time(st["frozen_horizon"], "settings.frozen_horizon");
     if (st["dependency_margin"])
       s.dependency_margin = p.number(st["dependency_margin"], "settings.dependency_margin");
     if (st["wait_threshold"])

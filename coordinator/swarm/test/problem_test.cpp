@@ -275,5 +275,17 @@ operations:
   EXPECT_FALSE(none["nodes"][0].contains("load"));
 }
 
+TEST(Problem, TimesTheSchedulerChecksAreCheckedInTheFile) {
+  // Both were refused by the scheduler, without the place in the file (the periodic set only as
+  // a failed operation, after planning had begun).
+  expect_error(kNodes + "settings: { frozen_horizon: 1e300 }\n",
+               "p.yaml:4:29: settings.frozen_horizon = 1e+300: times must lie within ±1e6 s");
+  expect_error(kNodes +
+                   "operations:\n  - { op: schedule_periodic, ids: [P1, P2, P3], area: "
+                   "[[1,0],[2,0],[2,1],[1,1]], start: 999990, period: 20, duration: 5 }\n",
+               "p.yaml:5:5: schedule_periodic: the last repetition ends at start + 3·period = "
+               "1000050: times must lie within ±1e6 s");
+}
+
 }  // namespace
 }  // namespace oscar::swarm
