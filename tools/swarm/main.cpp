@@ -1,14 +1,43 @@
 // oscar-swarm: `oscar swarm plan PROBLEM.yaml|json [-o SCHEDULE.json] [--svg FILE] [--st NODE]`.
+#include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <oscar/command_line.hpp>
 
+#include <cerrno>
+#include <cstring>
 #include <exception>
 #include <fstream>
 #include <iostream>
+#include <stdexcept>
 
 #include "oscar/swarm/problem.hpp"
 #include "oscar/swarm/problem_runner.hpp"
 #include "svg.hpp"
+
+namespace {
+
+// An output that could not be written: exit code 1, where bad input is 2.
+struct OutputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Writes `text` to the file `path`, or to the standard output if `path` is empty; a failure to
+// open, write or close is an OutputError with the system's reason.
+void write_output(const std::string& path, const std::string& text) {
+  if (path.empty()) {
+    std::cout << text << std::flush;
+    if (!std::cout) {
+      throw OutputError(fmt::format("cannot write the standard output: {}", std::strerror(errno)));
+    }
+    return;
+  }
+  std::ofstream out(path);
+  out << text;
+  out.close();
+  if (!out) throw OutputError(fmt::format("cannot write '{}': {}", path, std::strerror(errno)));
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"oscar swarm: the swarm planner (seed 002)"};
@@ -17,24 +46,23 @@ int main(int argc, char** argv) {
   std::string problem_path, output, svg, st_node;
   plan->add_option("problem", problem_path, "problem file (YAML or JSON)")->required();
   plan->add_option("-o,--output", output, "write the schedule JSON here instead of stdout");
-  plan->add_option("--svg", svg, "draw world, paths and jobs into this SVG file");
-  plan->add_option("--st", st_node, "with --svg: draw the s-t diagram of this node's trajectory");
+  auto* svg_option =
+      plan->add_option("--svg", svg, "draw world, paths and jobs into this SVG file");
+  plan->add_option("--st", st_node, "with --svg: draw the s-t diagram of this node's trajectory")
+      ->needs(svg_option);
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     const auto problem = oscar::swarm::load_problem(problem_path);
     oscar::swarm::ProblemRunner runner(problem);
     runner.run();
-    const std::string json = runner.to_json();
-    if (output.empty()) {
-      std::cout << json << "\n";
-    } else {
-      std::ofstream(output) << json << "\n";
-    }
+    write_output(output, runner.to_json() + "\n");
     if (!svg.empty()) {
-      std::ofstream out(svg);
-      out << (st_node.empty() ? oscar::swarm::tools::world_svg(runner.scheduler())
-                              : oscar::swarm::tools::st_svg(runner.scheduler(), st_node));
+      write_output(svg, st_node.empty() ? oscar::swarm::tools::world_svg(runner.scheduler())
+                                        : oscar::swarm::tools::st_svg(runner.scheduler(), st_node));
     }
+  } catch (const OutputError& e) {
+    std::cerr << "oscar swarm plan: " << e.what() << "\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "oscar swarm plan: " << e.what() << "\n";
     return 2;

@@ -14,6 +14,37 @@ double distance(const Point& a, const Point& b) { return std::hypot(a.x() - b.x(
 
 const std::vector<Point>& vertices(const Polygon& polygon) { return polygon.outer(); }
 
+namespace {
+
+constexpr const char* kSelfIntersecting =
+    "polygon is self-intersecting (two of its edges cross or touch); it must be simple";
+constexpr const char* kZeroArea = "polygon has zero area";
+
+// The rule a polygon breaks, by Boost.Geometry's failure type (is_valid after bg::correct).
+std::string polygon_fault(const Polygon& polygon, bg::validity_failure_type failure) {
+  switch (failure) {
+    case bg::failure_wrong_topological_dimension:  // one or two distinct points
+      return "a polygon needs at least 3 distinct vertices";
+    case bg::failure_spikes:  // all vertices on one line count as spikes too
+      return std::abs(bg::area(polygon)) <= kEpsilon
+                 ? kZeroArea
+                 : "polygon has a spike (an edge runs back along the one before it)";
+    case bg::failure_self_intersections:
+      return kSelfIntersecting;
+    case bg::failure_wrong_orientation:
+      // bg::correct orients by the signed area: it is still wrong when the loops of a
+      // self-intersecting ring cancel out (a symmetric bow-tie).
+      return bg::intersects(polygon) ? kSelfIntersecting : kZeroArea;
+    default: {
+      std::string reason;
+      bg::is_valid(polygon, reason);
+      return "polygon is not valid: " + reason;
+    }
+  }
+}
+
+}  // namespace
+
 Polygon make_polygon(const std::vector<Point>& points, const std::string& what) {
   if (points.size() < 3) {
     throw std::invalid_argument(
@@ -27,13 +58,12 @@ Polygon make_polygon(const std::vector<Point>& points, const std::string& what) 
   Polygon polygon;
   polygon.outer().assign(points.begin(), points.end());
   bg::correct(polygon);
-  std::string reason;
-  if (!bg::is_valid(polygon, reason)) {
-    throw std::invalid_argument(
-        fmt::format("{}: polygon must be simple (not self-intersecting): {}", what, reason));
+  bg::validity_failure_type failure{};
+  if (!bg::is_valid(polygon, failure)) {
+    throw std::invalid_argument(fmt::format("{}: {}", what, polygon_fault(polygon, failure)));
   }
   if (std::abs(bg::area(polygon)) <= kEpsilon) {
-    throw std::invalid_argument(fmt::format("{}: polygon has zero area", what));
+    throw std::invalid_argument(fmt::format("{}: {}", what, kZeroArea));
   }
   return polygon;
 }

@@ -2,14 +2,34 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
+#include <utility>
 
 namespace oscar::swarm {
 
+namespace {
+
+// Adds node i of the problem; what the scheduler refuses (a start inside an obstacle, say) is
+// reported at the node's place in the file.
+void add_node(Scheduler& scheduler, const Problem& problem, std::size_t i) {
+  try {
+    scheduler.add_node(problem.nodes[i]);
+  } catch (const std::invalid_argument& e) {
+    if (i >= problem.node_positions.size()) throw;
+    const auto& at = problem.node_positions[i];
+    throw std::invalid_argument(
+        fmt::format("{}:{}:{}: {}", problem.source, at.line, at.column, e.what()));
+  }
+}
+
+}  // namespace
+
 ProblemRunner::ProblemRunner(const Problem& problem)
     : problem_(problem), scheduler_(problem.world, problem.settings) {
-  for (const auto& n : problem.nodes) scheduler_.add_node(n);
+  for (std::size_t i = 0; i < problem.nodes.size(); ++i) add_node(scheduler_, problem, i);
 }
 
 void ProblemRunner::run() {
@@ -98,6 +118,25 @@ nlohmann::json job_json(const Job& j) {
           {"y", j.y},   {"start", j.start}, {"duration", j.duration}};
 }
 
+// The interval the load figures cover: from the present to the end of the last committed job of
+// any node; none if that is not after the present.
+std::optional<std::pair<double, double>> load_interval(const Scheduler& s) {
+  double end = s.present();
+  for (const auto& id : s.node_ids()) {
+    for (const auto& j : s.jobs(id)) end = std::max(end, j.end());
+  }
+  if (end <= s.present()) return std::nullopt;
+  return std::pair{s.present(), end};
+}
+
+nlohmann::json load_json(const Load& l) {
+  return {{"job", l.job},
+          {"motion", l.motion},
+          {"stationary", l.stationary},
+          {"total", l.total},
+          {"velocity", l.velocity}};
+}
+
 }  // namespace
 
 std::string ProblemRunner::to_json(int indent) const {
@@ -116,13 +155,17 @@ std::string ProblemRunner::to_json(int indent) const {
   doc["jobs"] = nlohmann::json::array();
   doc["nodes"] = nlohmann::json::array();
   doc["open"] = nlohmann::json::array();
+  const auto interval = load_interval(scheduler_);
+  if (interval) doc["load_interval"] = {interval->first, interval->second};
   for (const auto& id : scheduler_.node_ids()) {
     const auto& n = scheduler_.node(id);
     for (const auto& j : scheduler_.jobs(id)) doc["jobs"].push_back(job_json(j));
-    doc["nodes"].push_back({{"id", id},
-                            {"radius", n.radius_m},
-                            {"max_speed", n.max_speed_mps},
-                            {"trajectory", trajectory_json(scheduler_.trajectory(id))}});
+    nlohmann::json node{{"id", id},
+                        {"radius", n.radius_m},
+                        {"max_speed", n.max_speed_mps},
+                        {"trajectory", trajectory_json(scheduler_.trajectory(id))}};
+    if (interval) node["load"] = load_json(scheduler_.load(id, interval->first, interval->second));
+    doc["nodes"].push_back(node);
   }
   if (!scheduler_.open_transactions().empty()) {
     // Open transactions: the working view (all open transactions applied), per node.

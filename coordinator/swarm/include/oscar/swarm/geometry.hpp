@@ -25,8 +25,9 @@ double distance(const Point& a, const Point& b);
 const std::vector<Point>& vertices(const Polygon& polygon);
 
 /// Builds a polygon from vertices, fixing orientation.
-/// @throws std::invalid_argument naming `what` if there are fewer than 3 vertices, a coordinate is
-/// not finite, the area is zero or the ring intersects itself.
+/// @throws std::invalid_argument naming `what` and the rule broken if there are fewer than 3
+/// (distinct) vertices, a coordinate is not finite, the ring intersects itself or has a spike, or
+/// the area is zero.
 Polygon make_polygon(const std::vector<Point>& points, const std::string& what);
 
 /// True if the point lies in the open interior, farther than kEpsilon from the boundary.

@@ -33,11 +33,19 @@ struct Operation {
   int line = 0;                   ///< 1-based line in the file
 };
 
+/// A place in the problem file (1-based), for messages.
+struct FilePosition {
+  int line = 0;
+  int column = 0;
+};
+
 /// A world, nodes, settings and operations.
 struct Problem {
   std::string source;  ///< file name for messages
   World world;
   std::vector<NodeSpec> nodes;
+  /// Where each of `nodes` is in the file, in the same order (empty if not read from a file).
+  std::vector<FilePosition> node_positions;
   SchedulerSettings settings;
   std::vector<Operation> operations;
 };

@@ -22,7 +22,8 @@ struct OperationOutcome {
 class ProblemRunner {
  public:
   /// Builds the scheduler and adds the nodes.
-  /// @throws std::invalid_argument if a node is invalid or collides.
+  /// @throws std::invalid_argument if a node is invalid or collides, with the node's
+  /// "source:line:column" when the problem has its position.
   explicit ProblemRunner(const Problem& problem);
 
   /// Runs all operations; failures are outcomes, not exceptions.
@@ -31,7 +32,8 @@ class ProblemRunner {
   const Scheduler& scheduler() const { return scheduler_; }
   const std::vector<OperationOutcome>& outcomes() const { return outcomes_; }
 
-  /// The output document of docs/swarm.md: operations, committed jobs and trajectories, open
+  /// The output document of docs/swarm.md: operations, committed jobs and trajectories, each
+  /// node's load (seed §4.4) from the present to the end of the last committed job, open
   /// transactions and the world.
   std::string to_json(int indent = 2) const;
 
