@@ -26,7 +26,10 @@ constexpr long long kMaxTransaction = 1'000'000'000;
 
 class Parser {
  public:
-  explicit Parser(std::string source) : source_(std::move(source)) {}
+  /// `live`: operations for a running swarm (oscar swarm submit): no commit, abort, set_present,
+  /// remove or remove_node, and job ids may refer to jobs submitted before.
+  explicit Parser(std::string source, bool live = false)
+      : source_(std::move(source)), live_(live) {}
 
   [[noreturn]] void fail(const YAML::Node& node, const std::string& message) const {
     const auto mark = node.Mark();
@@ -226,11 +229,27 @@ class Parser {
       op.kind = K::kDependent;
       check_keys(o, op.name, {"op", "jobs", "depends"});
       op.dependent = dependent(o);
-    } else if (op.name == "unschedule" || op.name == "remove") {
-      op.kind = op.name == "unschedule" ? K::kUnschedule : K::kRemove;
+    } else if (op.name == "unschedule" || op.name == "remove" || op.name == "unschedule_set") {
+      op.kind = op.name == "unschedule" ? K::kUnschedule
+                : op.name == "remove"   ? K::kRemove
+                                        : K::kUnscheduleSet;
       check_keys(o, op.name, {"op", "id"});
       op.id = text(required(o, "id", op.name), op.name + " id");
-      if (!job_ids_.count(op.id)) fail(o, fmt::format("{}: unknown job id '{}'", op.name, op.id));
+      // A live system's jobs were scheduled by earlier submissions: the coordinator knows them.
+      if (!live_ && !job_ids_.count(op.id)) {
+        fail(o, fmt::format("{}: unknown job id '{}'", op.name, op.id));
+      }
+    } else if (live_) {
+      fail(o, fmt::format("{}: not for a live swarm, where the robots commit and abort and the "
+                          "present is the clock (schedule, schedule_periodic, schedule_dependent, "
+                          "unschedule, unschedule_set, reschedule)",
+                          op.name));
+    } else if (op.name == "remove_node") {
+      op.kind = K::kRemoveNode;
+      check_keys(o, op.name, {"op", "node"});
+      op.node = text(required(o, "node", op.name), "remove_node node");
+      if (!node_ids_.count(op.node))
+        fail(o["node"], fmt::format("remove_node: unknown node id '{}'", op.node));
     } else if (op.name == "commit" || op.name == "abort") {
       op.kind = op.name == "commit" ? K::kCommit : K::kAbort;
       check_keys(o, op.name, {"op", "transaction", "node"});
@@ -246,7 +265,8 @@ class Parser {
       present = op.t;
     } else {
       fail(o, fmt::format("unknown op '{}' (schedule, schedule_periodic, schedule_dependent, "
-                          "unschedule, remove, reschedule, commit, abort, set_present)",
+                          "unschedule, unschedule_set, remove, reschedule, remove_node, commit, "
+                          "abort, set_present)",
                           op.name));
     }
     return op;
@@ -341,21 +361,42 @@ class Parser {
   }
 
   std::string source_;
+  bool live_ = false;
   std::set<std::string> node_ids_;
   std::set<std::string> job_ids_;
 };
 
 }  // namespace
 
-Problem parse_problem(const std::string& text, const std::string& source) {
-  Parser p(source);
-  YAML::Node root;
+namespace {
+
+YAML::Node load_yaml(const std::string& text, const std::string& source) {
   try {
-    root = YAML::Load(text);
+    return YAML::Load(text);
   } catch (const YAML::ParserException& e) {
     throw std::invalid_argument(fmt::format("{}:{}:{}: not valid YAML/JSON: {}", source,
                                             e.mark.line + 1, e.mark.column + 1, e.msg));
   }
+}
+
+}  // namespace
+
+World parse_world(const YAML::Node& node, const std::string& source) {
+  return Parser(source).world(node);
+}
+
+JobSpec parse_job(const std::string& text, const std::string& source) {
+  return Parser(source, true).job(load_yaml(text, source));
+}
+
+std::vector<Operation> parse_operations(const std::string& text, const std::string& source) {
+  Parser p(source, true);
+  return p.operations(p.list(load_yaml(text, source), "operations"), -1e6);  // no present to keep
+}
+
+Problem parse_problem(const std::string& text, const std::string& source) {
+  Parser p(source);
+  const YAML::Node root = load_yaml(text, source);
   if (!root.IsMap()) throw std::invalid_argument(source + ": expected a mapping at the top");
   p.check_keys(root, "top level", {"world", "nodes", "settings", "operations"});
   Problem problem;

@@ -53,8 +53,16 @@ void ProblemRunner::run() {
         case K::kUnschedule:
           r = scheduler_.unschedule(op.id);
           break;
+        case K::kUnscheduleSet:
+          r = scheduler_.unschedule_set(op.id);
+          break;
         case K::kRemove:
           r = scheduler_.remove_job(op.id);
+          break;
+        case K::kRemoveNode:
+          result_op = false;
+          scheduler_.remove_node(op.node);
+          out.ok = true;
           break;
         case K::kReschedule:
           r = scheduler_.reschedule(op.job);

@@ -346,6 +346,58 @@ void Scheduler::remove_node(const std::string& id) {
   nodes_.erase(it);
 }
 
+std::vector<Job> Scheduler::break_down(const std::string& id, double t, const Point& where) {
+  NodeState& n = state(id);
+  if (n.broken) throw std::invalid_argument(fmt::format("node '{}' broke down already", id));
+  check_time(t, fmt::format("node '{}' breakdown time", id));
+  if (t < settings_.present) {
+    throw std::invalid_argument(fmt::format("node '{}': breakdown time {} is before the present {}",
+                                            id, t, settings_.present));
+  }
+  if (!n.locks.empty()) {
+    throw std::invalid_argument(
+        fmt::format("node '{}': open transaction {} changes it (abort it first)", id,
+                    n.locks.front().tx));
+  }
+  std::vector<Job> lost;
+  for (const auto& j : n.committed_jobs) {
+    if (j.end() > t) lost.push_back(j);
+  }
+  for (const auto& j : lost) {
+    std::erase_if(n.committed_jobs, [&](const Job& k) { return k.id == j.id; });
+    sets_.erase(j.id);
+  }
+  const Trajectory standing({{where.x(), where.y(), t}});
+  n.committed = n.committed.spliced(standing, t, kForever);
+  n.working = n.committed;
+  n.working_jobs = n.committed_jobs;
+  n.broken = true;
+  return lost;
+}
+
+bool Scheduler::broken_down(const std::string& id) const { return state(id).broken; }
+
+std::vector<Scheduler::NodeChange> Scheduler::changes(TransactionId id) const {
+  const auto it = transactions_.find(id);
+  if (it == transactions_.end()) {
+    throw std::invalid_argument(fmt::format("unknown or finished transaction {}", id));
+  }
+  std::vector<NodeChange> result;
+  for (const auto& [node, ch] : it->second.changes) {
+    NodeChange c{node, {}, {}, {}};
+    for (const auto& s : ch.sections) c.sections.emplace_back(s.lo, s.hi);
+    const auto& working = state(node).working_jobs;
+    for (const auto& added : ch.added) {
+      for (const auto& j : working) {
+        if (j.id == added) c.added.push_back(j);
+      }
+    }
+    for (const auto& r : ch.removed) c.removed.push_back(r.id);
+    result.push_back(std::move(c));
+  }
+  return result;
+}
+
 void Scheduler::commit(TransactionId id, const std::string& node) { finish(id, node, true); }
 void Scheduler::abort(TransactionId id, const std::string& node) { finish(id, node, false); }
 

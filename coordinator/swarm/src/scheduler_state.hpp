@@ -20,6 +20,7 @@ struct Scheduler::NodeState {
     Section section;
   };
   std::vector<Lock> locks;  // §4.2.7: trajectory sections changed by open transactions
+  bool broken = false;      // broke down: an obstacle that takes no jobs
 };
 
 // What one transaction changed on one node: disjoint sections of its trajectory (commit and abort

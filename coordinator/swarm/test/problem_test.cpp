@@ -289,3 +289,61 @@ TEST(Problem, TimesTheSchedulerChecksAreCheckedInTheFile) {
 
 }  // namespace
 }  // namespace oscar::swarm
+
+namespace oscar::swarm {
+namespace {
+
+TEST(Problem, SetsAreUnscheduledWholeAndDoneNodesRemoved) {
+  const auto p = parse_problem(R"(
+nodes:
+  - { id: n1, radius: 0.1, max_speed: 1, start: [0, 0, 0] }
+  - { id: n2, radius: 0.1, max_speed: 1, start: [0, 10, 0] }
+operations:
+  - { op: schedule_periodic, ids: [P1, P2], area: [[1,1],[2,1],[2,2],[1,2]], start: 5, period: 10, duration: 2 }
+  - { op: commit }
+  - { op: unschedule, id: P2 }
+  - { op: unschedule_set, id: P2 }
+  - { op: commit }
+  - { op: remove_node, node: n2 }
+)",
+                               "p.yaml");
+  ProblemRunner runner(p);
+  runner.run();
+  const auto doc = nlohmann::json::parse(runner.to_json());
+  const auto& ops = doc["operations"];
+  ASSERT_EQ(ops.size(), 6u);
+  EXPECT_FALSE(ops[2]["ok"]);
+  EXPECT_NE(ops[2]["reason"].get<std::string>().find("belongs to the periodic set P1, P2"),
+            std::string::npos);
+  EXPECT_TRUE(ops[3]["ok"]);
+  EXPECT_TRUE(ops[5]["ok"]) << ops[5];
+  EXPECT_TRUE(doc["jobs"].empty());
+  EXPECT_EQ(runner.scheduler().node_ids(), std::vector<std::string>{"n1"});
+  expect_error(kNodes + "operations:\n  - { op: remove_node, node: n7 }\n",
+               "p.yaml:5:30: remove_node: unknown node id 'n7'");
+}
+
+TEST(Problem, LiveOperationsTakeOnlyWhatARunningSwarmDoes) {
+  const auto ops = parse_operations(R"(
+- { op: schedule, job: { id: J1, area: [[4,2],[6,2],[6,4],[4,4]], earliest_start: 10, latest_finish: 60, duration: 10 } }
+- { op: unschedule, id: J0 }
+- { op: unschedule_set, id: P1 }
+)",
+                                    "jobs.yaml");
+  ASSERT_EQ(ops.size(), 3u);
+  EXPECT_EQ(ops[1].id, "J0");  // submitted before: the coordinator knows it
+  EXPECT_EQ(ops[2].kind, Operation::Kind::kUnscheduleSet);
+  test::expect_error([] { parse_operations("- { op: commit }\n", "jobs.yaml"); },
+                     "jobs.yaml:1:3: commit: not for a live swarm");
+  test::expect_error(
+      [] {
+        parse_job(
+            "{id: J, area: [[0,0],[1,0]], earliest_start: 0, "
+            "latest_finish: 9, duration: 1}",
+            "--job 1");
+      },
+      "--job 1:1:15: job 'J' area");
+}
+
+}  // namespace
+}  // namespace oscar::swarm

@@ -161,6 +161,48 @@ TEST(Nodes, ANodeIsRemovedOnlyWhenItsJobsAreDone) {
   EXPECT_EQ(through.jobs[0].node, other);
 }
 
+TEST(Nodes, ABrokenDownNodeGivesUpItsJobsAndStaysAnObstacle) {
+  Scheduler s = two_nodes();
+  const auto r = s.schedule(JobSpec{"A", square(-1, -1, 1, 1), 20, 40, 5});
+  ASSERT_TRUE(r.ok);
+  const std::string node = r.jobs[0].node;
+  expect_error([&] { s.break_down(node, 1, Point(0, 0)); }, "open transaction");
+  s.commit(r.transaction);
+  const Point where = s.trajectory(node).position_at(2);
+  const auto lost = s.break_down(node, 2, where);
+  ASSERT_EQ(lost.size(), 1u);
+  EXPECT_EQ(lost[0].id, "A");
+  EXPECT_TRUE(s.broken_down(node));
+  EXPECT_TRUE(s.jobs(node).empty());
+  EXPECT_TRUE(near(s.trajectory(node).position_at(1000), where.x(), where.y()));
+  // The other node takes the job, next to the broken one, not on top of it.
+  const auto again = s.schedule(lost[0].spec);
+  ASSERT_TRUE(again.ok) << again.reason;
+  EXPECT_NE(again.jobs[0].node, node);
+  EXPECT_GT(distance(again.jobs[0].location(), where), 0.2 - 1e-9);
+  const auto on_top = s.schedule(JobSpec{
+      "B", square(where.x() - 0.01, where.y() - 0.01, where.x() + 0.01, where.y() + 0.01), 50,
+      100, 1});
+  EXPECT_FALSE(on_top.ok);
+  expect_error([&] { s.break_down(node, 3, where); }, "broke down already");
+}
+
+TEST(Transactions, ChangesNameTheSectionsAndJobsPerNode) {
+  Scheduler s = two_nodes();
+  const auto r = s.schedule(JobSpec{"A", square(-1, -1, 1, 1), 20, 40, 5});
+  ASSERT_TRUE(r.ok);
+  const auto changes = s.changes(r.transaction);
+  ASSERT_EQ(changes.size(), 1u);
+  EXPECT_EQ(changes[0].node, r.jobs[0].node);
+  ASSERT_EQ(changes[0].sections.size(), 1u);
+  EXPECT_LE(changes[0].sections[0].first, r.jobs[0].start);
+  ASSERT_EQ(changes[0].added.size(), 1u);
+  EXPECT_EQ(changes[0].added[0].id, "A");
+  EXPECT_TRUE(changes[0].removed.empty());
+  s.commit(r.transaction);
+  expect_error([&] { s.changes(r.transaction); }, "unknown or finished transaction");
+}
+
 TEST(LocationSampling, SamplesTheAreaMinusStaticObstacles) {
   // The area's centroid lies in an obstacle; with one sample (A.1: the free area's first sample),
   // the job still finds a place.

@@ -119,6 +119,27 @@ class Scheduler {
   /// removed robots vanish).
   /// @throws std::invalid_argument on an unknown node, unfinished jobs or an open transaction.
   void remove_node(const std::string& id);
+  /// A node that broke down at time `t` at `where` (beyond seed §4.1, whose robots never fail):
+  /// it stands there for good and takes no more jobs, but stays an obstacle to the others. Its
+  /// jobs that do not end by `t` are removed and returned, to be scheduled elsewhere; their set
+  /// memberships end.
+  /// @throws std::invalid_argument on an unknown node, one already broken down, `t` before the
+  /// present, or an open transaction that changes the node (abort it first).
+  std::vector<Job> break_down(const std::string& id, double t, const Point& where);
+  /// True once break_down took the node out of planning.
+  bool broken_down(const std::string& id) const;
+
+  /// What an open transaction changes on one node: the sections of its trajectory (their times;
+  /// the waypoints are the working trajectory's there) and its jobs added and removed.
+  struct NodeChange {
+    std::string node;
+    std::vector<std::pair<double, double>> sections;
+    std::vector<Job> added;
+    std::vector<std::string> removed;
+  };
+  /// The changes of an open transaction, by node.
+  /// @throws std::invalid_argument on an unknown or finished transaction.
+  std::vector<NodeChange> changes(TransactionId id) const;
 
   /// Moves the present forward (§4.2.1).
   /// @throws std::invalid_argument if t is before the present or not finite.
