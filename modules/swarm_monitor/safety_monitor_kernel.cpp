@@ -427,7 +427,7 @@ void SafetyMonitor::evaluate(Cycle& cycle, const std::string& key, Stamp t, cons
 void SafetyMonitor::report(Cycle& cycle, const CueHeader& header, Finding finding) {
   ++counts_[finding.kind];
   ++total_;
-  cycle.log().warn("violation {} ({} {} of its kind): {}", total_, finding.kind,
+  cycle.log().warn("violation {} ({}, {} of its kind): {}", total_, finding.kind,
                    counts_[finding.kind], finding.detail);
   SafetyViolation v;
   v.header().stamps(header.stamps());

@@ -505,5 +505,37 @@ TEST(SafetyMonitor, BadParametersAreRefusedNamingTheRule) {
                   "parameter 'inputs'")));
 }
 
+// The example of modules/swarm_monitor/README.md (tests/docs checks that it is this text).
+constexpr const char* kReadmeExample = R"(  - name: monitor
+    kernels:
+      - type: safety_monitor
+        name: safety
+        params:
+          static_obstacles: '[ [[2, 0], [4, 0], [4, 2], [2, 2]] ]'
+          moving_obstacles: >-
+            [ {shape: [[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]],
+            loop: [[0, 4, 0], [8, 4, 10], [0, 4, 20]]} ]
+          distance_tolerance: 0.001
+          job_tolerance: 0.05
+          max_extrapolation: 500ms
+        inputs: { r1: r1/state, r2: r2/state, r3: r3/state }
+    mode: { continuous: 20ms }
+)";
+
+TEST(SafetyMonitor, TheReadmeExampleBuildsAndWatchesItsObstacles) {
+  const auto module = YAML::Load(kReadmeExample)[0];
+  const auto spec = module["kernels"][0];
+  std::map<std::string, InputOverrides> inputs;
+  for (const auto& kv : spec["inputs"]) inputs[kv.first.Scalar()] = {};
+  KernelHarness h(spec["type"].Scalar(), spec["params"], spec["name"].Scalar(), inputs);
+  h.feed("r1", robot("r1", 3, 1, kT0));    // in the static obstacle
+  h.feed("r2", robot("r2", 0, 4, kT0));    // under the moving one at loop time 0
+  h.feed("r3", robot("r3", 10, 10, kT0));  // clear
+  h.step();
+  std::vector<std::string> kinds;
+  for (const auto& v : violations(h)) kinds.push_back(v->kind() + " " + v->robots().at(0));
+  EXPECT_THAT(kinds, ElementsAre("static_obstacle r1", "moving_obstacle r2"));
+}
+
 }  // namespace
 }  // namespace oscar::modules
