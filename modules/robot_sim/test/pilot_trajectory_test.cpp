@@ -41,6 +41,15 @@ TEST(PilotTrajectory, AClosedSpliceReplacesOnlyItsSpan) {
   EXPECT_DOUBLE_EQ(t.at(9 * kS).y, 0);
   EXPECT_EQ(t.transaction_at(9 * kS), 0u);
   EXPECT_EQ(t.transaction_at(5 * kS + 1), 0u) << "an open-ended section ends at its last waypoint";
+
+  PilotTrajectory moving(0, 0, 0);  // a detour in the middle of a leg: the leg goes on after it
+  moving.splice({{0, 0, 1 * kS}, {10, 0, 11 * kS}}, 1 * kS, 0, true, 1);
+  moving.splice({{2, 0, 3 * kS}, {2, 1, 4 * kS}, {4, 0, 5 * kS}}, 3 * kS, 5 * kS, false, 2);
+  EXPECT_DOUBLE_EQ(moving.at(2 * kS).x, 1);
+  EXPECT_DOUBLE_EQ(moving.at(4 * kS).y, 1);
+  EXPECT_DOUBLE_EQ(moving.at(8 * kS).x, 7);
+  EXPECT_DOUBLE_EQ(moving.at(8 * kS).speed, 1);
+  EXPECT_DOUBLE_EQ(moving.at(12 * kS).x, 10);
 }
 
 TEST(PilotTrajectory, AnOpenSpliceReplacesEverythingAfterItsStart) {
