@@ -25,9 +25,14 @@ class DubinsPathFinder {
     double resolution_m = 0.1;  ///< spacing of the returned polyline
   };
 
+  /// @throws std::invalid_argument unless the turning radius and resolution are finite and > 0
+  /// and iterations and restarts >= 1.
   DubinsPathFinder(std::vector<Polygon> obstacles, Settings settings);
 
-  /// A path from `from` to `to` as a polyline, or nullopt if none was found.
+  /// A path from `from` to `to` as a polyline, or nullopt if none was found: also for an end that
+  /// is not finite, and if start, goal and obstacles span more than 1e6 turning radii (beyond
+  /// what OMPL's Dubins arithmetic is trusted with). Never aborts on OMPL 1.5.2's Dubins
+  /// assertions (see SafeDubinsStateSpace in src/).
   std::optional<std::vector<Point>> find(const Point& from, const Point& to) const;
 
   /// The length of the last path found by OMPL (before sampling), for comparisons.
