@@ -1,16 +1,24 @@
 #include "oscar/swarm/dubins_path_finder.hpp"
 
 #include <ompl/base/ScopedState.h>
+#include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/base/spaces/SO2StateSpace.h>
 #include <ompl/base/terminationconditions/IterationTerminationCondition.h>
 #include <ompl/geometric/PathGeometric.h>
+#include <ompl/geometric/PathSimplifier.h>
 #include <ompl/geometric/SimpleSetup.h>
 #include <ompl/geometric/planners/rrt/RRT.h>
 #include <ompl/util/Console.h>
 
 #include <fmt/format.h>
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <memory>
+#include <random>
 #include <stdexcept>
+#include <utility>
 
 #include "safe_dubins_state_space.hpp"
 
@@ -26,6 +34,41 @@ namespace {
 constexpr double kMaxSpanInRadii = 1e6;
 
 bool finite(const Point& p) { return std::isfinite(p.x()) && std::isfinite(p.y()); }
+
+// An OMPL class whose random generator (the protected member rng_ of planners, state samplers and
+// the path simplifier) starts from `seed` instead of from OMPL's process-wide sequence of seeds.
+template <class Base>
+class Seeded : public Base {
+ public:
+  template <class... Args>
+  explicit Seeded(std::uint_fast32_t seed, Args&&... args) : Base(std::forward<Args>(args)...) {
+    this->rng_.setLocalSeed(seed);
+  }
+};
+
+// The generator of every seed in one query, from the settings' seed and the leg's ends: a leg
+// plans the same whatever the process planned before.
+std::shared_ptr<std::mt19937> query_seeds(unsigned seed, const Point& from, const Point& to) {
+  std::vector<std::uint32_t> words{seed};
+  for (const double v : {from.x(), from.y(), to.x(), to.y()}) {
+    const auto bits = std::bit_cast<std::uint64_t>(v);
+    words.push_back(static_cast<std::uint32_t>(bits));
+    words.push_back(static_cast<std::uint32_t>(bits >> 32));
+  }
+  std::seed_seq sequence(words.begin(), words.end());
+  return std::make_shared<std::mt19937>(sequence);
+}
+
+// Gives every state sampler of the Dubins space (RRT allocates one per attempt) a generator seeded
+// from `seeds`: the space's default sampler samples position and heading with its subspaces'.
+void seed_samplers(ob::DubinsStateSpace& space, const std::shared_ptr<std::mt19937>& seeds) {
+  space.getSubspace(0)->setStateSamplerAllocator([seeds](const ob::StateSpace* s) {
+    return std::make_shared<Seeded<ob::RealVectorStateSampler>>((*seeds)(), s);
+  });
+  space.getSubspace(1)->setStateSamplerAllocator([seeds](const ob::StateSpace* s) {
+    return std::make_shared<Seeded<ob::SO2StateSampler>>((*seeds)(), s);
+  });
+}
 
 // The region RRT samples: start, goal and every obstacle, plus room to turn.
 ob::RealVectorBounds planning_bounds(const Point& from, const Point& to,
@@ -59,8 +102,10 @@ std::optional<og::PathGeometric> plan(const Point& from, const Point& to,
                                       const SpatialPathFinder& exact,
                                       const DubinsPathFinder::Settings& settings) {
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  const auto seeds = query_seeds(settings.seed, from, to);
   auto space = std::make_shared<SafeDubinsStateSpace>(settings.turning_radius_m);
   space->setBounds(bounds);
+  seed_samplers(*space, seeds);
   og::SimpleSetup setup(space);
   setup.setStateValidityChecker([&exact](const ob::State* s) {
     const auto* st = s->as<ob::SE2StateSpace::StateType>();
@@ -90,14 +135,15 @@ std::optional<og::PathGeometric> plan(const Point& from, const Point& to,
   }
   // RRT* needs a symmetric metric, which Dubins is not: plain RRT, restarted a few times, each
   // result shortcut, the shortest kept.
-  setup.setPlanner(std::make_shared<og::RRT>(si));
+  setup.setPlanner(std::make_shared<Seeded<og::RRT>>((*seeds)(), si));
+  Seeded<og::PathSimplifier> simplifier((*seeds)(), si, setup.getGoal());
   bool found = false;
   for (int attempt = 0; attempt < settings.restarts; ++attempt) {
     setup.clear();
     ob::IterationTerminationCondition iterations(static_cast<unsigned>(settings.iterations));
     if (setup.solve(iterations) != ob::PlannerStatus::EXACT_SOLUTION) continue;
-    setup.simplifySolution();  // shortcutting keeps the validity checks
-    const og::PathGeometric& candidate = setup.getSolutionPath();
+    og::PathGeometric candidate = setup.getSolutionPath();
+    simplifier.simplifyMax(candidate);  // shortcutting keeps the validity checks
     if (!found || candidate.length() < path.length()) path = candidate;
     found = true;
   }

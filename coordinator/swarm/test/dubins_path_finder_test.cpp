@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <ompl/base/ScopedState.h>
-#include <ompl/util/RandomNumbers.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -21,12 +21,7 @@ Polygon square(double x0, double y0, double x1, double y1) {
   return make_polygon({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, "square");
 }
 
-class DubinsPathFinderTest : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() { ompl::RNG::setSeed(7); }
-};
-
-TEST_F(DubinsPathFinderTest, MatchesTheExactPlannerWhereBothApply) {
+TEST(DubinsPathFinderTest, MatchesTheExactPlannerWhereBothApply) {
   // Free space, headings along the line: a Dubins car drives straight.
   DubinsPathFinder dubins({}, {.turning_radius_m = 0.5, .iterations = 500, .resolution_m = 0.1});
   const auto path = dubins.find({0, 0}, {10, 0});
@@ -37,14 +32,14 @@ TEST_F(DubinsPathFinderTest, MatchesTheExactPlannerWhereBothApply) {
 
 // Regression (property test): a leg in -x direction has heading atan2(0, -1) = π, outside OMPL's
 // SO2 bounds [-π, π); OMPL aborted on an assertion.
-TEST_F(DubinsPathFinderTest, LegInNegativeXDirectionIsStraight) {
+TEST(DubinsPathFinderTest, LegInNegativeXDirectionIsStraight) {
   DubinsPathFinder dubins({}, {.turning_radius_m = 0.5, .iterations = 500, .resolution_m = 0.1});
   const auto path = dubins.find({10, 0}, {0, 0});
   ASSERT_TRUE(path);
   EXPECT_NEAR(path_length(*path), 10, 1e-6);
 }
 
-TEST_F(DubinsPathFinderTest, AroundAnObstacleNoShorterThanExactAndClose) {
+TEST(DubinsPathFinderTest, AroundAnObstacleNoShorterThanExactAndClose) {
   const std::vector<Polygon> obstacles{square(4, -2, 6, 2)};
   SpatialPathFinder exact(obstacles);
   DubinsPathFinder dubins(
@@ -64,7 +59,7 @@ TEST_F(DubinsPathFinderTest, AroundAnObstacleNoShorterThanExactAndClose) {
   std::printf("exact %.3f m, dubins (r = 0.5 m) %.3f m\n", le, ld);
 }
 
-TEST_F(DubinsPathFinderTest, NoPathIntoAnObstacle) {
+TEST(DubinsPathFinderTest, NoPathIntoAnObstacle) {
   DubinsPathFinder dubins({square(4, -2, 6, 2)},
                           {.turning_radius_m = 0.5, .iterations = 200, .resolution_m = 0.1});
   EXPECT_FALSE(dubins.find({0, 0}, {5, 0}));
@@ -161,7 +156,7 @@ TEST(SafeDubinsStateSpace, NearlyFullTurnsOfEveryWordAreComputed) {
 
 // Legs around a wall with small turning radii make RRT produce such pairs (fuzzing found about one
 // abort in a hundred legs before SafeDubinsStateSpace); every leg must end in a path or nullopt.
-TEST_F(DubinsPathFinderTest, LegsAroundAWallWithSmallTurningRadiiNeverAbort) {
+TEST(DubinsPathFinderTest, LegsAroundAWallWithSmallTurningRadiiNeverAbort) {
   std::mt19937 rng(5);
   auto uni = [&](double lo, double hi) { return std::uniform_real_distribution<>(lo, hi)(rng); };
   const std::vector<Polygon> wall{square(20, 10, 30, 40)};
@@ -182,7 +177,7 @@ TEST_F(DubinsPathFinderTest, LegsAroundAWallWithSmallTurningRadiiNeverAbort) {
   EXPECT_GT(found, 100);
 }
 
-TEST(DubinsPathFinder, RejectsSettingsOmplCannotPlanWith) {
+TEST(DubinsPathFinderTest, RejectsSettingsOmplCannotPlanWith) {
   EXPECT_THROW(DubinsPathFinder({}, {.turning_radius_m = 0}), std::invalid_argument);
   EXPECT_THROW(DubinsPathFinder({}, {.turning_radius_m = NAN}), std::invalid_argument);
   EXPECT_THROW(DubinsPathFinder({}, {.resolution_m = 0}), std::invalid_argument);
@@ -190,7 +185,7 @@ TEST(DubinsPathFinder, RejectsSettingsOmplCannotPlanWith) {
   EXPECT_THROW(DubinsPathFinder({}, {.restarts = 0}), std::invalid_argument);
 }
 
-TEST_F(DubinsPathFinderTest, LegsOmplCannotPlanAreNotFound) {
+TEST(DubinsPathFinderTest, LegsOmplCannotPlanAreNotFound) {
   DubinsPathFinder dubins({}, {.turning_radius_m = 0.5});
   EXPECT_FALSE(dubins.find({NAN, 0}, {10, 0}));
   EXPECT_FALSE(dubins.find({0, 0}, {INFINITY, 0}));
@@ -199,7 +194,56 @@ TEST_F(DubinsPathFinderTest, LegsOmplCannotPlanAreNotFound) {
   EXPECT_FALSE(tiny.find({0, 0}, {10, 0}));
 }
 
-TEST_F(DubinsPathFinderTest, SchedulerUsesItForNodesWithATurningRadius) {
+// True if both legs were found and are the same polyline, to the bit.
+bool same(const std::optional<std::vector<Point>>& a, const std::optional<std::vector<Point>>& b) {
+  return a && b &&
+         std::equal(a->begin(), a->end(), b->begin(), b->end(), [](const Point& p, const Point& q) {
+           return p.x() == q.x() && p.y() == q.y();
+         });
+}
+
+// Regression: OMPL's generators were seeded once per process, so a leg that needs RRT planned
+// differently depending on what was planned before it.
+TEST(DubinsPathFinderTest, SameLegPlansTheSameWhateverWasPlannedBefore) {
+  const std::vector<Polygon> obstacles{square(4, -2, 6, 2)};
+  const DubinsPathFinder::Settings settings{
+      .turning_radius_m = 0.5, .iterations = 1000, .restarts = 4, .seed = 7};
+  DubinsPathFinder dubins(obstacles, settings);
+  const auto first = dubins.find({0, 0}, {10, 0});
+  ASSERT_TRUE(first);
+  EXPECT_TRUE(dubins.find({0, 1}, {10, -1}));  // other legs, other finders in between
+  EXPECT_TRUE(DubinsPathFinder(obstacles, settings).find({0, -1}, {10, 1}));
+  EXPECT_TRUE(same(dubins.find({0, 0}, {10, 0}), first));
+  EXPECT_TRUE(same(DubinsPathFinder(obstacles, settings).find({0, 0}, {10, 0}), first));
+  auto reseeded = settings;
+  reseeded.seed = 8;
+  EXPECT_FALSE(same(DubinsPathFinder(obstacles, reseeded).find({0, 0}, {10, 0}), first));
+}
+
+// The same through the scheduler: SchedulerSettings::seed seeds the Dubins planner.
+TEST(DubinsPathFinderTest, SchedulerPlansTheSameProblemTheSameEveryTime) {
+  World w;
+  w.static_obstacles.push_back(square(4, -2, 6, 2));
+  auto plan = [&](unsigned seed) {
+    Scheduler s(w, {.seed = seed});
+    s.add_node({"car", 0.2, 1, 0, 0, 0, 0.5});
+    const auto r = s.schedule(JobSpec{"J", square(9, -1, 11, 1), 0, 100, 5});
+    EXPECT_TRUE(r.ok) << r.reason;
+    s.commit(r.transaction);
+    return s.trajectory("car").points();
+  };
+  auto same_trajectory = [](const std::vector<Waypoint>& a, const std::vector<Waypoint>& b) {
+    return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const auto& p, const auto& q) {
+      return p.x == q.x && p.y == q.y && p.t == q.t;
+    });
+  };
+  const auto first = plan(3);
+  const auto other = plan(4);  // other planning in between
+  EXPECT_TRUE(same_trajectory(plan(3), first));
+  EXPECT_FALSE(same_trajectory(other, first));
+}
+
+TEST(DubinsPathFinderTest, SchedulerUsesItForNodesWithATurningRadius) {
   World w;
   w.static_obstacles.push_back(square(4, -2, 6, 2));
   Scheduler s(w, {});
