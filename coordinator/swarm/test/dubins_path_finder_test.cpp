@@ -154,6 +154,25 @@ TEST(SafeDubinsStateSpace, NearlyFullTurnsOfEveryWordAreComputed) {
   }
 }
 
+// Regression (fuzzing): this leg, with these settings and seed, aborted in OMPL's dubinsLSL on a
+// pair RRT made. It depends on the exact random sequence, so a change to the planner may make it
+// pass without the guard; the tests above do not.
+TEST(DubinsPathFinderTest, LegThatAbortedOmplIsPlanned) {
+  const std::vector<Polygon> wall{square(20, 10, 30, 40)};
+  DubinsPathFinder dubins(wall, {.turning_radius_m = 0.0022792493887212198,
+                                 .iterations = 300,
+                                 .restarts = 2,
+                                 .resolution_m = 0.1,
+                                 .seed = 1});
+  const auto path = dubins.find({4.5671153690979054, 15.295945655379365},
+                                {38.748485111440914, 5.5870640990315596});
+  ASSERT_TRUE(path);
+  SpatialPathFinder exact(wall);
+  for (std::size_t k = 1; k < path->size(); ++k) {
+    EXPECT_TRUE(exact.visible((*path)[k - 1], (*path)[k])) << "segment " << k;
+  }
+}
+
 // Legs around a wall with small turning radii make RRT produce such pairs (fuzzing found about one
 // abort in a hundred legs before SafeDubinsStateSpace); every leg must end in a path or nullopt.
 TEST(DubinsPathFinderTest, LegsAroundAWallWithSmallTurningRadiiNeverAbort) {
