@@ -1,4 +1,5 @@
-// oscar-swarm: `oscar swarm plan PROBLEM.yaml|json [-o SCHEDULE.json] [--svg FILE] [--st NODE]`.
+// oscar-swarm: `oscar swarm plan PROBLEM.yaml|json [-o SCHEDULE.json] [--svg FILE] [--st NODE]
+// [--seed N]`.
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <oscar/command_line.hpp>
@@ -8,6 +9,7 @@
 #include <exception>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <stdexcept>
 
 #include "oscar/swarm/problem.hpp"
@@ -50,9 +52,12 @@ int main(int argc, char** argv) {
       plan->add_option("--svg", svg, "draw world, paths and jobs into this SVG file");
   plan->add_option("--st", st_node, "with --svg: draw the s-t diagram of this node's trajectory")
       ->needs(svg_option);
+  std::optional<unsigned> seed;
+  plan->add_option("--seed", seed, "seed of the planner's random choices (overrides the file)");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
-    const auto problem = oscar::swarm::load_problem(problem_path);
+    auto problem = oscar::swarm::load_problem(problem_path);
+    if (seed) problem.settings.seed = *seed;
     oscar::swarm::ProblemRunner runner(problem);
     runner.run();
     write_output(output, runner.to_json() + "\n");

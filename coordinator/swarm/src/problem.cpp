@@ -407,9 +407,9 @@ Problem parse_problem(const std::string& text, const std::string& source) {
     problem.node_positions.push_back({n.Mark().line + 1, n.Mark().column + 1});
   }
   if (const auto st = root["settings"]) {
-    p.check_keys(
-        st, "settings",
-        {"present", "frozen_horizon", "dependency_margin", "location_samples", "wait_threshold"});
+    p.check_keys(st, "settings",
+                 {"present", "frozen_horizon", "dependency_margin", "location_samples",
+                  "wait_threshold", "seed"});
     auto& s = problem.settings;
     if (st["present"]) s.present = p.time(st["present"], "settings.present");
     if (st["frozen_horizon"])
@@ -421,6 +421,8 @@ Problem parse_problem(const std::string& text, const std::string& source) {
     if (st["location_samples"])
       s.location_samples = static_cast<int>(
           p.integer(st["location_samples"], "settings.location_samples", 1, kMaxLocationSamples));
+    if (st["seed"])
+      s.seed = static_cast<unsigned>(p.integer(st["seed"], "settings.seed", 0, 4294967295));
     if (s.frozen_horizon < 0) p.fail(st["frozen_horizon"], "settings.frozen_horizon: must be >= 0");
     if (s.dependency_margin < 0)
       p.fail(st["dependency_margin"], "settings.dependency_margin: must be >= 0");

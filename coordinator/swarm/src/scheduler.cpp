@@ -108,7 +108,8 @@ TrajectoryPlanner::PathFunction Scheduler::path_function(const NodeState& n) con
     for (const auto& p : world_.static_obstacles)
       grown.push_back(inflate(p, n.spec.radius_m + 1e-6));
     d = std::make_unique<DubinsPathFinder>(
-        std::move(grown), DubinsPathFinder::Settings{n.spec.turning_radius_m, 2000, 8, 0.1});
+        std::move(grown),
+        DubinsPathFinder::Settings{n.spec.turning_radius_m, 2000, 8, 0.1, settings_.seed});
   }
   const DubinsPathFinder* f = d.get();
   return [f](const Point& a, const Point& b) { return f->find(a, b); };

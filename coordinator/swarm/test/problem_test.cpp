@@ -55,6 +55,17 @@ TEST(Problem, JsonInputWorksToo) {
   EXPECT_EQ(p.operations.size(), 1u);
 }
 
+TEST(Problem, SettingsSeedIsAnUnsignedInteger) {
+  EXPECT_EQ(parse_problem(kNodes + "settings: { seed: 4294967295 }\n", "p.yaml").settings.seed,
+            4294967295u);
+  EXPECT_EQ(parse_problem(kNodes, "p.yaml").settings.seed, 1u);  // SchedulerSettings' default
+  for (const auto* bad : {"-1", "4294967296", "2.5"}) {
+    expect_error(kNodes + "settings: { seed: " + bad + " }\n",
+                 std::string("p.yaml:4:19: settings.seed = ") + bad +
+                     ": expected an integer from 0 to 4294967295");
+  }
+}
+
 TEST(Problem, BadInputNamesFileLineAndRule) {
   expect_error(kNodes +
                    "operations:\n  - { op: schedule, job: { id: J, area: [[0,0],[1,0],[1,1]], "
@@ -138,7 +149,7 @@ TEST(Problem, EveryMappingRefusesUnknownKeys) {
        "max_speed, start, turning_radius)"},
       {kNodes + "settings: { location_sample: 3 }\n",
        "p.yaml:4:13: settings: unknown key 'location_sample' (expected one of: present, "
-       "frozen_horizon, dependency_margin, location_samples, wait_threshold)"},
+       "frozen_horizon, dependency_margin, location_samples, wait_threshold, seed)"},
       {kNodes + "operations:\n  - { op: schedule, job: " + job + ", duraton: 5 } }\n",
        "p.yaml:5:119: job 'J': unknown key 'duraton' (expected one of: id, area, earliest_start, "
        "latest_finish, duration)"},

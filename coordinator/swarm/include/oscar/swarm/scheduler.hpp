@@ -26,7 +26,7 @@ struct SchedulerSettings {
   double dependency_margin = 0;  ///< d_m of eq. 4.10/4.11
   int location_samples = 10;     ///< locations tried per job (§4.2.1, Ort)
   double wait_threshold = 0;     ///< d_th of §4.3.4
-  unsigned seed = 1;             ///< seed of the random path planner (OMPL)
+  unsigned seed = 1;             ///< seed of the random path planner (OMPL's, with each leg)
 };
 
 /// A periodic job set (seed §4.2.3): job i starts within [start + i·period, start + (i+1)·period -
