@@ -163,7 +163,7 @@ std::vector<Slot> Scheduler::qualifying_slots(const JobSpec& spec, const Point& 
   std::vector<Slot> candidates;
   for (const auto& node : nodes_) {
     const NodeState& n = *node;
-    if (n.broken || !finder(n).is_free(p)) continue;
+    if (n.broken || excluded_.contains(n.spec.id) || !finder(n).is_free(p)) continue;
     const double v = n.spec.max_speed_mps;
     for (std::size_t k = 0; k <= n.working_jobs.size(); ++k) {
       const double t1 = k == 0 ? n.spec.t : n.working_jobs[k - 1].end();

@@ -4,6 +4,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -128,6 +129,9 @@ class Scheduler {
   std::vector<Job> break_down(const std::string& id, double t, const Point& where);
   /// True once break_down took the node out of planning.
   bool broken_down(const std::string& id) const;
+  /// Nodes that new jobs must not go to until this is called again (a robot that refused a
+  /// request, when the request is planned again); they stay obstacles. Unknown ids are ignored.
+  void set_excluded(std::set<std::string> nodes) { excluded_ = std::move(nodes); }
 
   /// What an open transaction changes on one node: the sections of its trajectory (their times;
   /// the waypoints are the working trajectory's there) and its jobs added and removed.
@@ -198,6 +202,7 @@ class Scheduler {
   mutable std::map<std::pair<double, double>, std::unique_ptr<DubinsPathFinder>> dubins_finders_;
   std::map<TransactionId, Transaction> transactions_;
   std::map<std::string, std::shared_ptr<const JobSet>> sets_;  // by member job id
+  std::set<std::string> excluded_;
   TransactionId next_transaction_ = 1;
 };
 
