@@ -5,6 +5,7 @@
 #include "oscar/cue_type_info.hpp"
 #include "oscar/cue_types.hpp"
 #include "oscar/perception_types.hpp"
+#include "oscar/swarm_types.hpp"
 
 namespace oscar {
 namespace {
@@ -48,6 +49,8 @@ void register_standard_cue_types() {
   cue_type_info<CameraImage>();
   cue_type_info<TagDetections>();
   cue_type_info<LandmarkPose>();
+  cue_type_info<RobotState>();
+  cue_type_info<SafetyViolation>();
 }
 
 }  // namespace oscar

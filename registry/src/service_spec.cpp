@@ -395,7 +395,7 @@ void parse_coordinator(SystemSpec& s, const YAML::Node& node) {
   }
   if (!node.IsMap()) fail(s.file, node, "coordinator: expected a map with host and applets");
   check_yaml_keys(node, s.file, "coordinator",
-                  {"host", "applets", "scheduler", "restart", "applet_lease", "wishes"});
+                  {"host", "applets", "scheduler", "restart", "applet_lease", "wishes", "swarm"});
   CoordinatorSpec c;
   c.where = yaml_where(s.file, node);
   auto known_host = [&](const std::string& h) {
@@ -413,6 +413,7 @@ void parse_coordinator(SystemSpec& s, const YAML::Node& node) {
     c.host = s.hosts.front().name;
   }
   if (node["scheduler"]) c.scheduler = node["scheduler"];
+  if (node["swarm"]) c.swarm = node["swarm"];
   if (const auto lease = node["applet_lease"]) {
     try {
       c.applet_lease = std::chrono::duration_cast<std::chrono::milliseconds>(

@@ -1,5 +1,5 @@
 // oscar-swarm: `oscar swarm plan PROBLEM.yaml|json [-o SCHEDULE.json] [--svg FILE] [--st NODE]
-// [--seed N]`.
+// [--seed N]`; with the framework also `oscar swarm submit` and `oscar swarm status` (live.hpp).
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <oscar/command_line.hpp>
@@ -15,6 +15,9 @@
 #include "oscar/swarm/problem.hpp"
 #include "oscar/swarm/problem_runner.hpp"
 #include "svg.hpp"
+#ifdef OSCAR_SWARM_LIVE
+#include "live.hpp"
+#endif
 
 namespace {
 
@@ -54,7 +57,25 @@ int main(int argc, char** argv) {
       ->needs(svg_option);
   std::optional<unsigned> seed;
   plan->add_option("--seed", seed, "seed of the planner's random choices (overrides the file)");
+#ifdef OSCAR_SWARM_LIVE
+  oscar::swarm::tools::SubmitOptions submit;
+  oscar::swarm::tools::StatusOptions status;
+  oscar::swarm::tools::add_submit(app, submit);
+  oscar::swarm::tools::add_status(app, status);
+#endif
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
+#ifdef OSCAR_SWARM_LIVE
+  if (submit.command->parsed() || status.command->parsed()) {
+    const char* which = submit.command->parsed() ? "submit" : "status";
+    try {
+      return submit.command->parsed() ? oscar::swarm::tools::run_submit(submit)
+                                      : oscar::swarm::tools::run_status(status);
+    } catch (const std::exception& e) {
+      std::cerr << "oscar swarm " << which << ": " << e.what() << "\n";
+      return 2;
+    }
+  }
+#endif
   try {
     auto problem = oscar::swarm::load_problem(problem_path);
     if (seed) problem.settings.seed = *seed;

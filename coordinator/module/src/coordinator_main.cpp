@@ -14,6 +14,7 @@
 
 #include "oscar/coordinator/coordinator.hpp"
 #include "oscar/coordinator/plan_json.hpp"
+#include "oscar/coordinator/swarm_service.hpp"
 #include "oscar/cue_types.hpp"
 #include "oscar/kernel.hpp"
 #include "oscar/kernel_registry.hpp"
@@ -92,6 +93,10 @@ int main(int argc, char** argv) {
     oscar::DdsParticipant participant(system.domain, "oscar:coordinator-plan",
                                       oscar::NetworkConfig::for_host(system.root, spec.host));
     oscar::coordinator::Coordinator coordinator(system, participant, plugin_path);
+    std::unique_ptr<oscar::coordinator::SwarmService> swarm;
+    if (auto setup = oscar::coordinator::SwarmSetup::from(system)) {
+      swarm = std::make_unique<oscar::coordinator::SwarmService>(std::move(*setup), participant);
+    }
     // The coordinator's log goes where its module's goes: stdout and oscar/log (boot shows it).
     auto previous_logger = spdlog::default_logger();
     spdlog::set_default_logger(
@@ -99,12 +104,14 @@ int main(int argc, char** argv) {
     oscar::coordinator::the_coordinator = &coordinator;
     module.start(system.domain);
     coordinator.start();
+    if (swarm) swarm->start();
     std::thread signal_waiter([&] {
       int sig = 0;
       sigwait(&signals, &sig);
       module.request_stop();
     });
     module.wait();
+    if (swarm) swarm->stop();
     coordinator.stop();
     oscar::coordinator::the_coordinator = nullptr;
     spdlog::set_default_logger(previous_logger);  // before the module's log sink goes

@@ -116,6 +116,7 @@ struct WishSpec {
 struct CoordinatorSpec {
   std::string host;
   YAML::Node scheduler;  ///< scheduler options, as the applet scheduler reads them
+  YAML::Node swarm;      ///< the live swarm (robots, world, settings), as the coordinator reads it
   std::vector<AppletSpec> applets;
   std::vector<WishSpec> wishes;
   /// How long the coordinator waits for a beat of an applet in another process before it takes

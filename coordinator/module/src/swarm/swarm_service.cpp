@@ -1,0 +1,379 @@
+#include "oscar/coordinator/swarm_service.hpp"
+
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "oscar/config_client.hpp"
+#include "oscar/coordinator/cue_feed.hpp"
+#include "oscar/swarm_types.hpp"
+#include "oscar/time.hpp"
+#include "oscar/topic_io.hpp"
+#include "oscar/topics.hpp"
+#include "robot_link.hpp"
+#include "swarm_wire.hpp"
+
+namespace oscar::coordinator {
+
+using swarm::TransactionId;
+using namespace std::chrono_literals;
+
+struct SwarmService::Impl {
+  // A request, how often it was planned and the robots that refused it (not asked again).
+  struct Request {
+    SwarmRequest message;
+    int attempts = 0;
+    std::set<std::string> refused_by;
+  };
+  // A transaction waiting for its robots' answers.
+  struct Pending {
+    std::shared_ptr<Request> request;
+    std::set<std::string> asked, waiting;
+    std::vector<swarm::Job> jobs;
+  };
+  struct Robot {
+    SwarmSetup::Robot setup;
+    std::unique_ptr<CueFeed<RobotState>> state;
+    RobotLink* link = nullptr;
+    bool planned = false;  // added to the scheduler
+    bool lost = false;     // broke down or fell silent: out of planning
+    std::int64_t last_heard_ns = 0;
+    std::uint64_t states_seen = 0;
+  };
+  using Event = std::variant<SwarmRequest, RobotLink::Answer>;
+
+  SwarmSetup setup;
+  DdsParticipant& participant;
+  swarm_wire::Clock clock;
+  swarm::Scheduler scheduler;
+  ConfigClient client;
+  std::map<std::string, std::unique_ptr<RobotLink>> links;  // by module
+  std::map<std::string, Robot> robots;
+  std::map<TransactionId, Pending> pending;
+  // Where each committed job came from, to place it again when its robot breaks down.
+  std::map<std::string, std::shared_ptr<Request>> origin;
+  SwarmStatus counters;
+
+  std::mutex mutex;
+  std::condition_variable wake;
+  std::deque<Event> events;
+  bool stopping = false;
+  SwarmStatus published;
+  std::thread thread;
+  std::unique_ptr<TopicWriter<SwarmReply, SwarmReplyPubSubType>> replies;
+  std::unique_ptr<TopicWriter<SwarmStatus, SwarmStatusPubSubType>> status_writer;
+  std::unique_ptr<TopicReader<SwarmRequest, SwarmRequestPubSubType>> requests;
+
+  Impl(SwarmSetup s, DdsParticipant& p)
+      : setup(std::move(s)),
+        participant(p),
+        clock{wall_now() / 1'000'000'000 * 1'000'000'000},
+        scheduler(setup.world, with_present(setup.settings, clock.seconds(wall_now()))),
+        client(p, "coordinator") {}
+
+  static swarm::SchedulerSettings with_present(swarm::SchedulerSettings s, double now) {
+    s.present = now;
+    return s;
+  }
+
+  void post(Event e) {
+    {
+      std::lock_guard lock(mutex);
+      events.push_back(std::move(e));
+    }
+    wake.notify_all();
+  }
+
+  void start() {
+    for (const auto& r : setup.robots) {
+      auto& link = links[r.module];
+      if (!link) {
+        link = std::make_unique<RobotLink>(client, r.module, setup.ack_timeout,
+                                           [this](RobotLink::Answer a) { post(std::move(a)); });
+      }
+      Robot robot;
+      robot.setup = r;
+      robot.link = link.get();
+      robot.state = std::make_unique<CueFeed<RobotState>>(participant, r.kernel + "/state");
+      robots.emplace(r.kernel, std::move(robot));
+    }
+    replies = std::make_unique<TopicWriter<SwarmReply, SwarmReplyPubSubType>>(
+        participant, topics::swarm_reply());
+    status_writer = std::make_unique<TopicWriter<SwarmStatus, SwarmStatusPubSubType>>(
+        participant, topics::swarm_status());
+    thread = std::thread([this] { run(); });
+    requests = std::make_unique<TopicReader<SwarmRequest, SwarmRequestPubSubType>>(
+        participant, topics::swarm_request(),
+        [this](const SwarmRequest& r, const auto&) { post(r); });
+  }
+
+  void stop() {
+    requests.reset();
+    {
+      std::lock_guard lock(mutex);
+      if (stopping) return;
+      stopping = true;
+    }
+    wake.notify_all();
+    if (thread.joinable()) thread.join();
+    links.clear();  // before the feeds and the client they use
+    robots.clear();
+  }
+
+  void run() {
+    auto next_status = std::chrono::steady_clock::now();
+    for (;;) {
+      std::deque<Event> batch;
+      {
+        std::unique_lock lock(mutex);
+        wake.wait_for(lock, 50ms, [&] { return stopping || !events.empty(); });
+        if (stopping) return;
+        batch.swap(events);
+      }
+      const auto now = wall_now();
+      scheduler.set_present(std::max(scheduler.present(), clock.seconds(now)));
+      watch_robots(now);
+      for (auto& e : batch) {
+        try {
+          std::visit([this](auto& x) { handle(x); }, e);
+        } catch (const std::exception& ex) {
+          spdlog::error("swarm: {}", ex.what());  // a bug of ours: said, and the loop goes on
+        }
+      }
+      if (!batch.empty() || std::chrono::steady_clock::now() >= next_status) {
+        publish_status(now);
+        next_status = std::chrono::steady_clock::now() + 1s;
+      }
+    }
+  }
+
+  // ---- requests ----
+
+  void reply(const Request& r, SwarmOutcome outcome, TransactionId tx, const std::string& reason,
+             const std::vector<swarm::Job>& jobs = {}) {
+    SwarmReply m;
+    m.sender(r.message.sender());
+    m.request(r.message.id());
+    m.outcome(outcome);
+    m.transaction(tx);
+    m.reason(reason);
+    for (const auto& j : jobs) m.jobs().push_back(swarm_wire::placed(j, clock));
+    replies->write(m);
+  }
+
+  void handle(const SwarmRequest& message) {
+    auto r = std::make_shared<Request>();
+    r->message = message;
+    counters.jobs_submitted(counters.jobs_submitted() + jobs_in(message));
+    plan(r);
+  }
+
+  static std::uint64_t jobs_in(const SwarmRequest& m) {
+    if (m.kind() == SWARM_PERIODIC) return m.periodic_ids().size();
+    if (m.kind() == SWARM_DEPENDENT) return m.jobs().size();
+    return m.kind() == SWARM_SCHEDULE || m.kind() == SWARM_RESCHEDULE ? 1 : 0;
+  }
+
+  void plan(const std::shared_ptr<Request>& r) {
+    swarm::ScheduleResult result;
+    scheduler.set_excluded(r->refused_by);
+    try {
+      result = swarm_wire::apply(scheduler, r->message, clock);
+    } catch (const std::invalid_argument& e) {
+      scheduler.set_excluded({});
+      reply(*r, SWARM_REFUSED, 0, e.what());
+      return;
+    }
+    scheduler.set_excluded({});
+    if (!result.ok) {
+      reply(*r, r->attempts == 0 ? SWARM_REFUSED : SWARM_ABORTED, 0,
+            r->attempts == 0 ? result.reason
+                             : fmt::format("planned {} times, robots refused: {}", r->attempts + 1,
+                                           result.reason));
+      return;
+    }
+    const TransactionId tx = result.transaction;
+    Pending p{r, {}, {}, result.jobs};
+    for (const auto& change : scheduler.changes(tx)) {
+      auto it = robots.find(change.node);
+      p.asked.insert(change.node);
+      it->second.link->propose(swarm_wire::proposal(scheduler, tx, change, clock));
+    }
+    p.waiting = p.asked;
+    reply(*r, SWARM_PLANNED, tx, "", result.jobs);
+    if (p.asked.empty()) {
+      finish(tx, p);
+      return;
+    }
+    pending.emplace(tx, std::move(p));
+  }
+
+  void handle(const RobotLink::Answer& a) {
+    auto it = pending.find(a.transaction);
+    if (it == pending.end()) return;  // the transaction aborted already
+    Pending& p = it->second;
+    if (a.ack) {
+      p.waiting.erase(a.robot);
+      if (p.waiting.empty()) {
+        Pending done = std::move(p);
+        pending.erase(it);
+        finish(a.transaction, done);
+      }
+      return;
+    }
+    if (a.silent) {
+      counters.timeouts(counters.timeouts() + 1);
+    } else {
+      counters.naks(counters.naks() + 1);
+    }
+    spdlog::info("swarm: robot '{}' {} transaction {}: {}", a.robot,
+                 a.silent ? "did not answer" : "refused", a.transaction, a.reason);
+    Pending failed = std::move(p);
+    pending.erase(it);
+    scheduler.abort(a.transaction);
+    for (const auto& robot : failed.asked) {
+      // A silent robot may still have taken the proposal: it hears the abort as well.
+      if (robot != a.robot || a.silent) robots.at(robot).link->abort(robot, a.transaction);
+    }
+    auto& r = failed.request;
+    r->refused_by.insert(a.robot);
+    if (r->attempts >= setup.replan_attempts) {
+      reply(*r, SWARM_ABORTED, a.transaction,
+            fmt::format("robot '{}' {}: {} (planned {} times)", a.robot,
+                        a.silent ? "did not answer" : "refused", a.reason, r->attempts + 1));
+      return;
+    }
+    ++r->attempts;
+    counters.replans(counters.replans() + 1);
+    plan(r);
+  }
+
+  void finish(TransactionId tx, const Pending& p) {
+    scheduler.commit(tx);
+    for (const auto& robot : p.asked) robots.at(robot).link->commit(robot, tx);
+    for (const auto& j : p.jobs) origin[j.id] = p.request;
+    counters.jobs_committed(counters.jobs_committed() + p.jobs.size());
+    reply(*p.request, SWARM_COMMITTED, tx, "", p.jobs);
+  }
+
+  // ---- robots ----
+
+  void watch_robots(std::int64_t now) {
+    for (auto& [id, robot] : robots) {
+      if (robot.lost) continue;
+      const auto state = robot.state->latest();
+      if (robot.state->received() != robot.states_seen) {
+        robot.states_seen = robot.state->received();
+        robot.last_heard_ns = now;
+      }
+      if (!state) continue;
+      if (!robot.planned && !state->broken()) {
+        add(robot, *state);
+      } else if (robot.planned && state->broken()) {
+        lose(robot, *state, "broke down: " + state->fault());
+      } else if (robot.planned &&
+                 now - robot.last_heard_ns > std::chrono::nanoseconds(setup.lost_after).count()) {
+        lose(robot, *state,
+             fmt::format("sent no state for {} ms", (now - robot.last_heard_ns) / 1'000'000));
+      }
+    }
+  }
+
+  void add(Robot& robot, const RobotState& s) {
+    swarm::NodeSpec spec{robot.setup.kernel,  s.radius(),        s.max_speed(), s.x(), s.y(),
+                         scheduler.present(), s.turning_radius()};
+    try {
+      scheduler.add_node(spec);
+      robot.planned = true;
+      spdlog::info("swarm: robot '{}' joins planning at ({:.2f}, {:.2f})", spec.id, spec.x, spec.y);
+    } catch (const std::invalid_argument& e) {
+      robot.lost = true;
+      spdlog::error("swarm: robot '{}' cannot be planned: {}", spec.id, e.what());
+    }
+  }
+
+  void lose(Robot& robot, const RobotState& s, const std::string& why) {
+    const std::string id = robot.setup.kernel;
+    robot.lost = true;
+    spdlog::warn("swarm: robot '{}' {}; it leaves planning and its jobs go to others", id, why);
+    // Its open transactions abort first (the planner needs the robot unlocked), and go again.
+    std::vector<std::shared_ptr<Request>> again;
+    for (auto it = pending.begin(); it != pending.end();) {
+      if (!it->second.asked.count(id)) {
+        ++it;
+        continue;
+      }
+      scheduler.abort(it->first);
+      for (const auto& r : it->second.asked) robots.at(r).link->abort(r, it->first);
+      again.push_back(it->second.request);
+      it = pending.erase(it);
+    }
+    const auto jobs = scheduler.break_down(id, scheduler.present(), swarm::Point(s.x(), s.y()));
+    for (const auto& j : jobs) {
+      auto from = origin.find(j.id);
+      if (from == origin.end()) continue;
+      // The job alone, in its original window: what is left of it is planned again.
+      auto r = std::make_shared<Request>(*from->second);
+      r->message.kind(SWARM_SCHEDULE);
+      r->message.jobs().clear();
+      SwarmJobSpec spec;
+      spec.id(j.id);
+      for (const auto& p : swarm::vertices(j.spec.area)) {
+        spec.area().x().push_back(p.x());
+        spec.area().y().push_back(p.y());
+      }
+      spec.earliest_start_ns(clock.ns(j.spec.earliest_start));
+      spec.latest_finish_ns(clock.ns(j.spec.latest_finish));
+      spec.duration_s(j.spec.duration);
+      r->message.jobs().push_back(spec);
+      r->attempts = 0;
+      origin.erase(from);
+      again.push_back(r);
+    }
+    for (auto& r : again) {
+      counters.replans(counters.replans() + 1);
+      plan(r);
+    }
+  }
+
+  // ---- status ----
+
+  void publish_status(std::int64_t now) {
+    SwarmStatus s = counters;
+    s.now_ns(now);
+    for (const auto& [id, robot] : robots) {
+      if (robot.planned && !robot.lost) s.robots().push_back(id);
+      if (robot.lost) s.lost_robots().push_back(id);
+    }
+    for (const auto& id : scheduler.node_ids()) {
+      for (const auto& j : scheduler.jobs(id)) {
+        if (j.end() > scheduler.present()) s.jobs().push_back(swarm_wire::placed(j, clock));
+      }
+    }
+    s.open_transactions(scheduler.open_transactions());
+    status_writer->write(s);
+    std::lock_guard lock(mutex);
+    published = std::move(s);
+  }
+};
+
+SwarmService::SwarmService(SwarmSetup setup, DdsParticipant& participant)
+    : impl_(std::make_unique<Impl>(std::move(setup), participant)) {}
+
+SwarmService::~SwarmService() { stop(); }
+
+void SwarmService::start() { impl_->start(); }
+void SwarmService::stop() { impl_->stop(); }
+
+SwarmStatus SwarmService::status() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->published;
+}
+
+}  // namespace oscar::coordinator

@@ -1,0 +1,145 @@
+#include "swarm_wire.hpp"
+
+#include <fmt/format.h>
+#include <cmath>
+#include <stdexcept>
+
+namespace oscar::coordinator::swarm_wire {
+
+std::int64_t Clock::ns(double seconds) const {
+  return epoch_ns + static_cast<std::int64_t>(std::llround(seconds * 1e9));
+}
+
+std::string kind_name(SwarmRequestKind kind) {
+  switch (kind) {
+    case SWARM_SCHEDULE:
+      return "schedule";
+    case SWARM_PERIODIC:
+      return "periodic";
+    case SWARM_DEPENDENT:
+      return "dependent";
+    case SWARM_UNSCHEDULE:
+      return "unschedule";
+    case SWARM_RESCHEDULE:
+      return "reschedule";
+    case SWARM_UNSCHEDULE_SET:
+      return "unschedule_set";
+  }
+  return "request kind " + std::to_string(static_cast<int>(kind));
+}
+
+swarm::JobSpec job_spec(const SwarmJobSpec& wire, const Clock& clock) {
+  const std::string what = fmt::format("job '{}'", wire.id());
+  const auto& xs = wire.area().x();
+  const auto& ys = wire.area().y();
+  if (xs.size() != ys.size()) {
+    throw std::invalid_argument(
+        fmt::format("{} area: {} x but {} y coordinates", what, xs.size(), ys.size()));
+  }
+  std::vector<swarm::Point> points;
+  for (std::size_t i = 0; i < xs.size(); ++i) points.emplace_back(xs[i], ys[i]);
+  swarm::JobSpec spec;
+  spec.id = wire.id();
+  spec.area = swarm::make_polygon(points, what + " area");
+  spec.earliest_start = clock.seconds(wire.earliest_start_ns());
+  spec.latest_finish = clock.seconds(wire.latest_finish_ns());
+  spec.duration = wire.duration_s();
+  return spec;
+}
+
+namespace {
+
+const SwarmJobSpec& first_job(const SwarmRequest& r) {
+  if (r.jobs().empty()) {
+    throw std::invalid_argument(
+        fmt::format("a {} request needs its job in `jobs`", kind_name(r.kind())));
+  }
+  return r.jobs().front();
+}
+
+const std::string& job_id(const SwarmRequest& r) {
+  if (r.job_id().empty()) {
+    throw std::invalid_argument(
+        fmt::format("a {} request names its job in `job_id`", kind_name(r.kind())));
+  }
+  return r.job_id();
+}
+
+}  // namespace
+
+swarm::ScheduleResult apply(swarm::Scheduler& scheduler, const SwarmRequest& r,
+                            const Clock& clock) {
+  switch (r.kind()) {
+    case SWARM_SCHEDULE:
+      return scheduler.schedule(job_spec(first_job(r), clock));
+    case SWARM_RESCHEDULE:
+      return scheduler.reschedule(job_spec(first_job(r), clock));
+    case SWARM_UNSCHEDULE:
+      return scheduler.unschedule(job_id(r));
+    case SWARM_UNSCHEDULE_SET:
+      return scheduler.unschedule_set(job_id(r));
+    case SWARM_PERIODIC: {
+      const auto j = job_spec(first_job(r), clock);
+      return scheduler.schedule(swarm::PeriodicSpec{r.periodic_ids(), j.area, r.same_location(),
+                                                    j.earliest_start, r.period_s(), j.duration});
+    }
+    case SWARM_DEPENDENT: {
+      swarm::DependentSpec d;
+      for (const auto& j : r.jobs()) d.jobs.push_back(job_spec(j, clock));
+      for (const auto& dep : r.depends()) d.depends[dep.job()] = dep.after();
+      return scheduler.schedule(d);
+    }
+  }
+  throw std::invalid_argument(kind_name(r.kind()) + " is no request kind");
+}
+
+SwarmPlacedJob placed(const swarm::Job& job, const Clock& clock) {
+  SwarmPlacedJob p;
+  p.id(job.id);
+  p.robot(job.node);
+  p.x(job.x);
+  p.y(job.y);
+  p.start_ns(clock.ns(job.start));
+  p.duration_s(job.duration);
+  p.earliest_start_ns(clock.ns(job.spec.earliest_start));
+  p.latest_finish_ns(clock.ns(job.spec.latest_finish));
+  return p;
+}
+
+Trajectory proposal(const swarm::Scheduler& scheduler, swarm::TransactionId tx,
+                    const swarm::Scheduler::NodeChange& change, const Clock& clock) {
+  Trajectory t;
+  t.robot(change.node);
+  t.transaction(tx);
+  const auto& working = scheduler.trajectory(change.node, false);
+  for (const auto& [lo, hi] : change.sections) {
+    const auto part = swarm::Trajectory().spliced(working, lo, hi);
+    TrajectorySection s;
+    s.from_ns(clock.ns(lo));
+    s.open_end(hi >= swarm::kForever);
+    s.to_ns(clock.ns(s.open_end() ? part.end_time() : hi));
+    for (const auto& w : part.points()) {
+      SwarmWaypoint p;
+      p.x(w.x);
+      p.y(w.y);
+      p.t_ns(clock.ns(w.t));
+      s.waypoints().push_back(p);
+    }
+    t.sections().push_back(std::move(s));
+  }
+  for (const auto& j : change.added) {
+    RobotJob job;
+    job.id(j.id);
+    job.x(j.x);
+    job.y(j.y);
+    job.start_ns(clock.ns(j.start));
+    job.end_ns(clock.ns(j.end()));
+    job.earliest_start_ns(clock.ns(j.spec.earliest_start));
+    job.latest_finish_ns(clock.ns(j.spec.latest_finish));
+    t.jobs_added().push_back(job);
+  }
+  t.jobs_removed(change.removed);
+  return t;
+}
+
+}  // namespace oscar::coordinator::swarm_wire

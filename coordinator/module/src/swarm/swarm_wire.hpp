@@ -1,0 +1,40 @@
+#pragma once
+// Between the swarm's IDL (idl/oscar/swarm.idl) and the planner's types: times on the wire are
+// the system clock in ns, the planner counts seconds from the service's epoch (it keeps sub-ns
+// precision only within ±1e6 s, seed 002 §5.3.1).
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <oscar/swarm.h>
+
+#include "oscar/swarm/scheduler.hpp"
+
+namespace oscar::coordinator::swarm_wire {
+
+/// The planner's clock: seconds since `epoch_ns`.
+struct Clock {
+  std::int64_t epoch_ns = 0;
+  double seconds(std::int64_t ns) const { return static_cast<double>(ns - epoch_ns) * 1e-9; }
+  std::int64_t ns(double seconds) const;
+};
+
+/// @throws std::invalid_argument naming the job and the rule (area, window, duration).
+swarm::JobSpec job_spec(const SwarmJobSpec& wire, const Clock& clock);
+
+/// What a request asks the planner, as a call on `scheduler`.
+/// @throws std::invalid_argument on a request that is not well-formed, or as the planner throws.
+swarm::ScheduleResult apply(swarm::Scheduler& scheduler, const SwarmRequest& request,
+                            const Clock& clock);
+
+SwarmPlacedJob placed(const swarm::Job& job, const Clock& clock);
+
+/// The proposal for one robot of a transaction: its sections as the working trajectory has them.
+Trajectory proposal(const swarm::Scheduler& scheduler, swarm::TransactionId tx,
+                    const swarm::Scheduler::NodeChange& change, const Clock& clock);
+
+/// "schedule", "periodic" ... for messages.
+std::string kind_name(SwarmRequestKind kind);
+
+}  // namespace oscar::coordinator::swarm_wire

@@ -1,0 +1,274 @@
+// The live swarm (docs/swarm.md, "The live swarm") on a booted system: jobs submitted over DDS
+// are placed by the coordinator, proposed to robot_sim pilots, committed on their ACKs and done
+// by the robots at their place within their window; a NAK or a silent robot aborts that part and
+// the job goes elsewhere; a robot that breaks down gives its jobs to others; bad requests are
+// refused with the reason.
+#include <condition_variable>
+#include <map>
+#include <mutex>
+#include <optional>
+
+#include <gtest/gtest.h>
+
+#include "booted_system.hpp"
+#include "oscar/coordinator/cue_feed.hpp"
+#include "oscar/swarm_types.hpp"
+#include "oscar/time.hpp"
+#include "oscar/topic_io.hpp"
+#include "oscar/topics.hpp"
+
+namespace oscar {
+namespace {
+
+using namespace std::chrono_literals;
+
+// Five robots: r1 and r2 do as told; rn refuses everything; rs (a module of its own) answers
+// after the coordinator stopped waiting; rb (a module of its own) breaks down when told to.
+constexpr const char* kSystem = R"(
+system: swarm_live
+modules:
+  - name: robots
+    mode: { continuous: 50ms }
+    kernels:
+      - { type: robot_sim, name: r1, params: { start_x: 0, start_y: 0, max_speed: 2 } }
+      - { type: robot_sim, name: r2, params: { start_x: 0, start_y: 20, max_speed: 2 },
+          mode: { single_step: { trigger: module } } }
+      - { type: robot_sim, name: rn, params: { start_x: 20, start_y: 0, max_speed: 2, nak_probability: 1 },
+          mode: { single_step: { trigger: module } } }
+  - name: slow
+    mode: { continuous: 50ms }
+    kernels:
+      - { type: robot_sim, name: rs, params: { start_x: 20, start_y: 20, max_speed: 2, ack_delay_ms: 900 } }
+  - name: fragile
+    mode: { continuous: 50ms }
+    kernels:
+      - { type: robot_sim, name: rb, params: { start_x: 40, start_y: 0, max_speed: 2 } }
+coordinator:
+  swarm:
+    frozen_horizon_ms: 1500
+    ack_timeout_ms: 500
+    replan_attempts: 3
+)";
+
+// A square job area of side 0.2 m around (x, y), in the window [now + from_s, now + to_s].
+SwarmJobSpec job(const std::string& id, double x, double y, double from_s, double to_s,
+                 double duration_s) {
+  SwarmJobSpec j;
+  j.id(id);
+  j.area().x({x - 0.1, x + 0.1, x + 0.1, x - 0.1});
+  j.area().y({y - 0.1, y - 0.1, y + 0.1, y + 0.1});
+  const auto now = wall_now();
+  j.earliest_start_ns(now + static_cast<Stamp>(from_s * 1e9));
+  j.latest_finish_ns(now + static_cast<Stamp>(to_s * 1e9));
+  j.duration_s(duration_s);
+  return j;
+}
+
+class LiveSwarm : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    system_ = new test::BootedSystem("swarm_live", kSystem);
+    system_->running();
+    client_ = new Client(system_->participant());
+  }
+  static void TearDownTestSuite() {
+    delete client_;
+    delete system_;
+  }
+
+  // Submits requests and reads the coordinator's replies, status and the robots' states.
+  class Client {
+   public:
+    explicit Client(DdsParticipant& p)
+        : participant_(p),
+          writer_(p, topics::swarm_request()),
+          replies_(p, topics::swarm_reply(),
+                   [this](const SwarmReply& r, const auto&) {
+                     std::lock_guard lock(mutex_);
+                     replies_seen_[r.request()].push_back(r);
+                     changed_.notify_all();
+                   }),
+          status_(p, topics::swarm_status(), [this](const SwarmStatus& s, const auto&) {
+            std::lock_guard lock(mutex_);
+            status_seen_ = s;
+            changed_.notify_all();
+          }) {}
+
+    unsigned long long submit(SwarmRequest r) {
+      r.sender("swarm_live_test");
+      r.id(++next_id_);
+      writer_.write(r);
+      return r.id();
+    }
+    unsigned long long schedule(const SwarmJobSpec& j) {
+      SwarmRequest r;
+      r.kind(SWARM_SCHEDULE);
+      r.jobs().push_back(j);
+      return submit(r);
+    }
+
+    // The first reply to `request` with an outcome other than PLANNED, after `skip` such ones.
+    SwarmReply outcome(unsigned long long request, std::size_t skip = 0) {
+      std::unique_lock lock(mutex_);
+      SwarmReply found;
+      const bool ok = changed_.wait_for(lock, 30s, [&] {
+        std::size_t n = 0;
+        for (const auto& r : replies_seen_[request]) {
+          if (r.outcome() != SWARM_PLANNED && n++ == skip) {
+            found = r;
+            return true;
+          }
+        }
+        return false;
+      });
+      if (!ok) ADD_FAILURE() << "no outcome of request " << request;
+      return found;
+    }
+    std::vector<SwarmReply> replies(unsigned long long request) {
+      std::lock_guard lock(mutex_);
+      return replies_seen_[request];
+    }
+
+    SwarmStatus status(const std::function<bool(const SwarmStatus&)>& pred, const char* what) {
+      std::unique_lock lock(mutex_);
+      if (!changed_.wait_for(lock, 30s, [&] { return status_seen_ && pred(*status_seen_); })) {
+        ADD_FAILURE() << "the swarm status never showed " << what;
+      }
+      return status_seen_.value_or(SwarmStatus{});
+    }
+
+    coordinator::CueFeed<RobotState>& state(const std::string& robot) {
+      auto& f = states_[robot];
+      if (!f)
+        f = std::make_unique<coordinator::CueFeed<RobotState>>(participant_, robot + "/state");
+      return *f;
+    }
+
+   private:
+    DdsParticipant& participant_;
+    TopicWriter<SwarmRequest, SwarmRequestPubSubType> writer_;
+    std::mutex mutex_;
+    std::condition_variable changed_;
+    std::map<unsigned long long, std::vector<SwarmReply>> replies_seen_;
+    std::optional<SwarmStatus> status_seen_;
+    unsigned long long next_id_ = 0;
+    std::map<std::string, std::unique_ptr<coordinator::CueFeed<RobotState>>> states_;
+    TopicReader<SwarmReply, SwarmReplyPubSubType> replies_;
+    TopicReader<SwarmStatus, SwarmStatusPubSubType> status_;
+  };
+
+  // Waits until the robot reports working `job`; its state then.
+  static std::optional<RobotState> working(const std::string& robot, const std::string& job,
+                                           std::chrono::seconds within) {
+    auto& feed = client_->state(robot);
+    const auto until = std::chrono::steady_clock::now() + within;
+    while (std::chrono::steady_clock::now() < until) {
+      if (auto s = feed.latest(); s && s->job().id() == job) return s;
+      std::this_thread::sleep_for(20ms);
+    }
+    return std::nullopt;
+  }
+
+  static test::BootedSystem* system_;
+  static Client* client_;
+};
+
+test::BootedSystem* LiveSwarm::system_ = nullptr;
+LiveSwarm::Client* LiveSwarm::client_ = nullptr;
+
+TEST_F(LiveSwarm, AllRobotsJoinPlanning) {
+  const auto s = client_->status([](const SwarmStatus& x) { return x.robots().size() == 5; },
+                                 "five robots in planning");
+  EXPECT_EQ(s.robots().size(), 5u);
+}
+
+TEST_F(LiveSwarm, AJobSubmittedOverDdsIsDoneByTheNearestRobotAtItsPlaceInItsWindow) {
+  client_->status([](const SwarmStatus& x) { return x.robots().size() >= 4; }, "robots");
+  const auto id = client_->schedule(job("near_r1", 2, 1, 3, 30, 2));
+  const auto r = client_->outcome(id);
+  ASSERT_EQ(r.outcome(), SWARM_COMMITTED) << r.reason();
+  ASSERT_EQ(r.jobs().size(), 1u);
+  EXPECT_EQ(r.jobs()[0].robot(), "r1");
+  const auto s = working("r1", "near_r1", 40s);
+  ASSERT_TRUE(s) << "r1 never worked the job";
+  EXPECT_NEAR(s->x(), r.jobs()[0].x(), 0.01);
+  EXPECT_NEAR(s->y(), r.jobs()[0].y(), 0.01);
+  EXPECT_GE(s->header().stamps()[0], r.jobs()[0].earliest_start_ns());
+  EXPECT_LE(s->header().stamps()[0], r.jobs()[0].latest_finish_ns());
+  EXPECT_NEAR(s->x(), 2, 0.1 + 1e-9);
+  EXPECT_NEAR(s->y(), 1, 0.1 + 1e-9);
+}
+
+TEST_F(LiveSwarm, ANakAbortsThatRobotsPartAndTheJobIsPlacedElsewhere) {
+  client_->status([](const SwarmStatus& x) { return x.robots().size() >= 4; }, "robots");
+  const auto before = client_->status([](const SwarmStatus&) { return true; }, "a status");
+  const auto id = client_->schedule(job("near_rn", 19, 1, 3, 60, 2));  // rn is nearest
+  const auto r = client_->outcome(id);
+  ASSERT_EQ(r.outcome(), SWARM_COMMITTED) << r.reason();
+  EXPECT_NE(r.jobs()[0].robot(), "rn");
+  const auto planned = client_->replies(id);
+  ASSERT_GE(planned.size(), 3u);  // planned on rn, planned again elsewhere, committed
+  EXPECT_EQ(planned[0].outcome(), SWARM_PLANNED);
+  EXPECT_EQ(planned[0].jobs()[0].robot(), "rn");
+  const auto after = client_->status([&](const SwarmStatus& s) { return s.naks() > before.naks(); },
+                                     "the NAK counted");
+  EXPECT_GT(after.replans(), before.replans());
+}
+
+TEST_F(LiveSwarm, ASilentRobotTimesOutAndTheJobIsPlacedElsewhere) {
+  client_->status([](const SwarmStatus& x) { return x.robots().size() >= 4; }, "robots");
+  const auto before = client_->status([](const SwarmStatus&) { return true; }, "a status");
+  const auto id = client_->schedule(job("near_rs", 19, 19, 4, 60, 2));  // rs is nearest
+  const auto r = client_->outcome(id);
+  ASSERT_EQ(r.outcome(), SWARM_COMMITTED) << r.reason();
+  EXPECT_NE(r.jobs()[0].robot(), "rs");
+  const auto planned = client_->replies(id);
+  ASSERT_GE(planned.size(), 2u);
+  EXPECT_EQ(planned[0].jobs()[0].robot(), "rs");
+  client_->status([&](const SwarmStatus& s) { return s.timeouts() > before.timeouts(); },
+                  "the timeout counted");
+}
+
+TEST_F(LiveSwarm, BadJobSpecificationsAreRefusedWithTheReason) {
+  auto too_short = job("short", 5, 5, 3, 4, 2);  // a 1 s window for 2 s of work
+  const auto a = client_->outcome(client_->schedule(too_short));
+  EXPECT_EQ(a.outcome(), SWARM_REFUSED);
+  EXPECT_NE(a.reason().find("window"), std::string::npos) << a.reason();
+  auto bowtie = job("bowtie", 5, 5, 3, 30, 2);
+  bowtie.area().x({0, 1, 0, 1});
+  bowtie.area().y({0, 1, 1, 0});
+  const auto b = client_->outcome(client_->schedule(bowtie));
+  EXPECT_EQ(b.outcome(), SWARM_REFUSED);
+  EXPECT_NE(b.reason().find("job 'bowtie' area"), std::string::npos) << b.reason();
+  SwarmRequest nothing;
+  nothing.kind(SWARM_SCHEDULE);
+  const auto c = client_->outcome(client_->submit(nothing));
+  EXPECT_EQ(c.outcome(), SWARM_REFUSED);
+  EXPECT_NE(c.reason().find("needs its job"), std::string::npos) << c.reason();
+  const auto d = client_->outcome(client_->schedule(job("near_r1", 2, 1, 3, 30, 2)));
+  if (d.outcome() != SWARM_COMMITTED) {  // the first test's job may still be on r1's schedule
+    EXPECT_NE(d.reason().find("already scheduled"), std::string::npos) << d.reason();
+  }
+}
+
+TEST_F(LiveSwarm, ABrokenDownRobotsJobsGoToOthers) {
+  client_->status([](const SwarmStatus& x) { return x.robots().size() >= 4; }, "robots");
+  // rb is nearest; it breaks down before the job's window.
+  const auto id = client_->schedule(job("after_breakdown", 39, 1, 20, 90, 2));
+  const auto first = client_->outcome(id);
+  ASSERT_EQ(first.outcome(), SWARM_COMMITTED) << first.reason();
+  ASSERT_EQ(first.jobs()[0].robot(), "rb");
+  ASSERT_TRUE(system_->configure("fragile", CMD_SET_PARAM, {"rb", "breakdown_after_s", "0"}).ok());
+  const auto lost = client_->status(
+      [](const SwarmStatus& s) {
+        return std::find(s.lost_robots().begin(), s.lost_robots().end(), "rb") !=
+               s.lost_robots().end();
+      },
+      "rb lost");
+  const auto again = client_->outcome(id, 1);
+  ASSERT_EQ(again.outcome(), SWARM_COMMITTED) << again.reason();
+  EXPECT_NE(again.jobs()[0].robot(), "rb");
+}
+
+}  // namespace
+}  // namespace oscar
