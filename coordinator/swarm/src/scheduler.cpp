@@ -356,9 +356,8 @@ std::vector<Job> Scheduler::break_down(const std::string& id, double t, const Po
                                             id, t, settings_.present));
   }
   if (!n.locks.empty()) {
-    throw std::invalid_argument(
-        fmt::format("node '{}': open transaction {} changes it (abort it first)", id,
-                    n.locks.front().tx));
+    throw std::invalid_argument(fmt::format(
+        "node '{}': open transaction {} changes it (abort it first)", id, n.locks.front().tx));
   }
   std::vector<Job> lost;
   for (const auto& j : n.committed_jobs) {
@@ -377,6 +376,34 @@ std::vector<Job> Scheduler::break_down(const std::string& id, double t, const Po
 }
 
 bool Scheduler::broken_down(const std::string& id) const { return state(id).broken; }
+
+void Scheduler::forget_before(double t) {
+  if (t > settings_.present) {
+    throw std::invalid_argument(
+        fmt::format("forget_before: {} lies after the present {}", t, settings_.present));
+  }
+  auto from_t = [t](const Trajectory& tr) {
+    if (tr.empty() || tr.start_time() >= t) return tr;
+    Trajectory rest;
+    const Point p = tr.position_at(t);
+    rest.append({p.x(), p.y(), t});
+    for (const auto& w : tr.points()) {
+      if (w.t > t) rest.append(w);
+    }
+    return rest;
+  };
+  auto ended = [t](const Job& j) { return j.end() < t; };
+  for (auto& n : nodes_) {
+    n->committed = from_t(n->committed);
+    n->working = from_t(n->working);
+    for (const auto& j : n->committed_jobs) {
+      if (ended(j)) sets_.erase(j.id);
+    }
+    std::erase_if(n->committed_jobs, ended);
+    std::erase_if(n->working_jobs, ended);
+    n->spec.t = std::max(n->spec.t, t);  // the first pause starts here now
+  }
+}
 
 std::vector<Scheduler::NodeChange> Scheduler::changes(TransactionId id) const {
   const auto it = transactions_.find(id);

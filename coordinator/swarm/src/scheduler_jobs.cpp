@@ -142,7 +142,13 @@ bool Scheduler::try_schedule(const JobSpec& spec, TransactionId tx, const std::o
       if (try_candidate(c, spec, tx, scheduled)) return true;
     }
   }
-  if (locations.empty()) {
+  const bool any_node = std::any_of(nodes_.begin(), nodes_.end(), [&](const auto& n) {
+    return !n->broken && !excluded_.contains(n->spec.id);
+  });
+  if (!any_node) {
+    reason = fmt::format("job '{}': no node is in planning{}", spec.id,
+                         excluded_.empty() ? "" : " (besides those that refused it)");
+  } else if (locations.empty()) {
     reason = fmt::format("job '{}': its area lies wholly within static obstacles", spec.id);
   } else if (!any_location) {
     reason = fmt::format("job '{}': no sampled location in the area is free for any node", spec.id);

@@ -180,9 +180,9 @@ TEST(Nodes, ABrokenDownNodeGivesUpItsJobsAndStaysAnObstacle) {
   ASSERT_TRUE(again.ok) << again.reason;
   EXPECT_NE(again.jobs[0].node, node);
   EXPECT_GT(distance(again.jobs[0].location(), where), 0.2 - 1e-9);
-  const auto on_top = s.schedule(JobSpec{
-      "B", square(where.x() - 0.01, where.y() - 0.01, where.x() + 0.01, where.y() + 0.01), 50,
-      100, 1});
+  const auto on_top = s.schedule(
+      JobSpec{"B", square(where.x() - 0.01, where.y() - 0.01, where.x() + 0.01, where.y() + 0.01),
+              50, 100, 1});
   EXPECT_FALSE(on_top.ok);
   expect_error([&] { s.break_down(node, 3, where); }, "broke down already");
 }
@@ -201,6 +201,33 @@ TEST(Transactions, ChangesNameTheSectionsAndJobsPerNode) {
   EXPECT_TRUE(changes[0].removed.empty());
   s.commit(r.transaction);
   expect_error([&] { s.changes(r.transaction); }, "unknown or finished transaction");
+}
+
+TEST(Nodes, ForgettingThePastKeepsWhereNodesAreAndWhatIsToCome) {
+  Scheduler s = two_nodes();
+  for (const auto& j : {JobSpec{"A", square(2, -1, 4, 1), 5, 10, 2},
+                        JobSpec{"B", square(2, 9, 4, 11), 50, 60, 2}}) {
+    const auto r = s.schedule(j);
+    ASSERT_TRUE(r.ok) << r.reason;
+    s.commit(r.transaction);
+  }
+  s.set_present(30);
+  const std::string a_node = s.jobs("n1").empty() ? "n2" : "n1";
+  const Point at_20 = s.trajectory(a_node).position_at(20);
+  const Point b_at_55 = s.trajectory("n2").position_at(55);
+  s.forget_before(20);
+  EXPECT_GE(s.trajectory(a_node).start_time(), 20);
+  EXPECT_TRUE(near(s.trajectory(a_node).position_at(20), at_20.x(), at_20.y()));
+  EXPECT_TRUE(near(s.trajectory("n2").position_at(55), b_at_55.x(), b_at_55.y()));
+  std::vector<std::string> left;
+  for (const auto& n : {"n1", "n2"}) {
+    for (const auto& j : s.jobs(n)) left.push_back(j.id);
+  }
+  EXPECT_EQ(left, std::vector<std::string>{"B"});
+  // Planning goes on as before: a new job, and the old id is free again.
+  const auto again = s.schedule(JobSpec{"A", square(2, -1, 4, 1), 35, 45, 2});
+  EXPECT_TRUE(again.ok) << again.reason;
+  expect_error([&] { s.forget_before(31); }, "lies after the present");
 }
 
 TEST(LocationSampling, SamplesTheAreaMinusStaticObstacles) {

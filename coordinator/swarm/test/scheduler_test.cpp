@@ -104,6 +104,9 @@ TEST(Scheduler, InfeasibleJobIsAValueWithAReason) {
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.reason.find("4.2-4.4"), std::string::npos) << r.reason;
   EXPECT_TRUE(s.open_transactions().empty());
+  Scheduler empty({}, {});
+  const auto none = empty.schedule(job("J2", square(4, 2, 6, 4), 10, 60, 10));
+  EXPECT_EQ(none.reason, "job 'J2': no node is in planning");
 }
 
 TEST(Scheduler, UnscheduleReplansTheTrajectoryAroundTheGap) {

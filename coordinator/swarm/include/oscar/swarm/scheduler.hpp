@@ -145,6 +145,12 @@ class Scheduler {
   /// @throws std::invalid_argument on an unknown or finished transaction.
   std::vector<NodeChange> changes(TransactionId id) const;
 
+  /// Forgets what lies before `t` (at most the present): jobs that ended before it and the
+  /// trajectories' waypoints before it (each keeps its place at t). A long-running swarm calls it
+  /// now and then, so planning does not slow down with its history.
+  /// @throws std::invalid_argument if t is after the present.
+  void forget_before(double t);
+
   /// Moves the present forward (§4.2.1).
   /// @throws std::invalid_argument if t is before the present or not finite.
   void set_present(double t);
