@@ -128,6 +128,7 @@ struct SwarmService::Impl {
 
   void run() {
     auto next_status = std::chrono::steady_clock::now();
+    auto next_forget = next_status + 10s;
     for (;;) {
       std::deque<Event> batch;
       {
@@ -149,6 +150,10 @@ struct SwarmService::Impl {
       if (!batch.empty() || std::chrono::steady_clock::now() >= next_status) {
         publish_status(now);
         next_status = std::chrono::steady_clock::now() + 1s;
+      }
+      if (std::chrono::steady_clock::now() >= next_forget) {
+        forget_history();
+        next_forget = std::chrono::steady_clock::now() + 10s;
       }
     }
   }
@@ -340,6 +345,18 @@ struct SwarmService::Impl {
       counters.replans(counters.replans() + 1);
       plan(r);
     }
+  }
+
+  // What ended more than a minute ago is history: the planner and the origins forget it.
+  void forget_history() {
+    const double before = scheduler.present() - 60;
+    if (before <= clock.seconds(clock.epoch_ns)) return;
+    scheduler.forget_before(before);
+    std::set<std::string> planned;
+    for (const auto& id : scheduler.node_ids()) {
+      for (const auto& j : scheduler.jobs(id, false)) planned.insert(j.id);
+    }
+    std::erase_if(origin, [&](const auto& entry) { return !planned.contains(entry.first); });
   }
 
   // ---- status ----
