@@ -3,6 +3,7 @@
 // by the robots at their place within their window; a NAK or a silent robot aborts that part and
 // the job goes elsewhere; a robot that breaks down gives its jobs to others; bad requests are
 // refused with the reason.
+#include <cmath>
 #include <condition_variable>
 #include <map>
 #include <mutex>
@@ -43,6 +44,11 @@ modules:
     mode: { continuous: 50ms }
     kernels:
       - { type: robot_sim, name: rb, params: { start_x: 40, start_y: 0, max_speed: 2 } }
+  - name: monitor
+    mode: { continuous: 50ms }
+    kernels:
+      - { type: safety_monitor, name: safety,
+          inputs: { r1: r1/state, r2: r2/state, rn: rn/state, rs: rs/state, rb: rb/state } }
 coordinator:
   swarm:
     frozen_horizon_ms: 1500
@@ -70,8 +76,10 @@ class LiveSwarm : public ::testing::Test {
     system_ = new test::BootedSystem("swarm_live", kSystem);
     system_->running();
     client_ = new Client(system_->participant());
+    violations_ = system_->watch<SafetyViolation>("safety/violations").release();
   }
   static void TearDownTestSuite() {
+    delete violations_;
     delete client_;
     delete system_;
   }
@@ -169,12 +177,36 @@ class LiveSwarm : public ::testing::Test {
     return std::nullopt;
   }
 
+  // After each test: nothing it did brought robots too close, into an obstacle or off their
+  // jobs, by the safety monitor's own account.
+  void TearDown() override {
+    std::this_thread::sleep_for(300ms);  // the last states reach the monitor and its cues us
+    for (const auto& v : violations_->take()) {
+      ADD_FAILURE() << "safety violation " << v.kind() << ": " << v.detail();
+    }
+  }
+
+  // The committed jobs named `ids`, from the first status that lists them all.
+  static std::vector<SwarmPlacedJob> jobs_named(const std::vector<std::string>& ids) {
+    auto named = [&](const SwarmStatus& s) {
+      std::vector<SwarmPlacedJob> out;
+      for (const auto& j : s.jobs()) {
+        if (std::find(ids.begin(), ids.end(), j.id()) != ids.end()) out.push_back(j);
+      }
+      return out;
+    };
+    return named(client_->status(
+        [&](const SwarmStatus& s) { return named(s).size() >= ids.size(); }, "the jobs"));
+  }
+
   static test::BootedSystem* system_;
   static Client* client_;
+  static testing::CueWatch<SafetyViolation>* violations_;
 };
 
 test::BootedSystem* LiveSwarm::system_ = nullptr;
 LiveSwarm::Client* LiveSwarm::client_ = nullptr;
+testing::CueWatch<SafetyViolation>* LiveSwarm::violations_ = nullptr;
 
 TEST_F(LiveSwarm, AllRobotsJoinPlanning) {
   const auto s = client_->status([](const SwarmStatus& x) { return x.robots().size() == 5; },
@@ -268,6 +300,68 @@ TEST_F(LiveSwarm, ABrokenDownRobotsJobsGoToOthers) {
   const auto again = client_->outcome(id, 1);
   ASSERT_EQ(again.outcome(), SWARM_COMMITTED) << again.reason();
   EXPECT_NE(again.jobs()[0].robot(), "rb");
+}
+
+TEST_F(LiveSwarm, ADependentSetStaysWholeWhenOneOfItsRobotsRefuses) {
+  client_->status([](const SwarmStatus& x) { return x.robots().size() >= 4; }, "robots");
+  // A is nearest rn (which refuses), B nearest r2: the first plan asks both, rn's NAK aborts the
+  // whole set, and the set is planned again without rn.
+  SwarmRequest r;
+  r.kind(SWARM_DEPENDENT);
+  r.jobs().push_back(job("set_a", 21, -1, 3, 60, 2));
+  r.jobs().push_back(job("set_b", 1, 21, 3, 60, 2));
+  SwarmDependency d;
+  d.job("set_b");
+  d.after({"set_a"});
+  r.depends().push_back(d);
+  const auto id = client_->submit(r);
+  const auto outcome = client_->outcome(id);
+  ASSERT_EQ(outcome.outcome(), SWARM_COMMITTED) << outcome.reason();
+  const auto replies = client_->replies(id);
+  ASSERT_GE(replies.size(), 3u);
+  EXPECT_EQ(replies[0].outcome(), SWARM_PLANNED);
+  EXPECT_NE(replies[0].transaction(), outcome.transaction());
+  const auto placed = jobs_named({"set_a", "set_b"});
+  ASSERT_EQ(placed.size(), 2u) << "the set is placed once, whole";
+  EXPECT_NE(placed[0].id(), placed[1].id());
+  for (const auto& j : placed) EXPECT_NE(j.robot(), "rn") << j.id();
+  const auto& a = placed[0].id() == "set_a" ? placed[0] : placed[1];
+  const auto& b = placed[0].id() == "set_a" ? placed[1] : placed[0];
+  EXPECT_GE(b.start_ns(), a.start_ns() + static_cast<Stamp>(a.duration_s() * 1e9));
+}
+
+// True if two placed jobs are at least `clearance` apart or do not overlap in time.
+bool clear_of(const SwarmPlacedJob& a, const SwarmPlacedJob& b, double clearance) {
+  const auto end = [](const SwarmPlacedJob& j) {
+    return j.start_ns() + static_cast<Stamp>(j.duration_s() * 1e9);
+  };
+  return std::hypot(a.x() - b.x(), a.y() - b.y()) >= clearance || end(a) <= b.start_ns() ||
+         end(b) <= a.start_ns();
+}
+
+TEST_F(LiveSwarm, ConcurrentSubmissionsSeeEachOthersOpenTransactions) {
+  client_->status([](const SwarmStatus& x) { return x.robots().size() >= 4; }, "robots");
+  // Two requesters want the same 2 m square at once. The first plan goes to rs, which answers
+  // only after the coordinator stopped waiting, so that transaction is open while the second
+  // request is planned: the second must keep clear of it (and of where rs stands meanwhile).
+  const auto first = client_->schedule(job("spot_1", 21, 21, 4, 40, 3));
+  auto area = job("spot_2", 21, 21, 4, 40, 3);
+  area.area().x({20, 22, 22, 20});
+  area.area().y({20, 20, 22, 22});
+  const auto second = client_->schedule(area);
+  const auto r1 = client_->outcome(first);
+  const auto r2 = client_->outcome(second);
+  ASSERT_EQ(r1.outcome(), SWARM_COMMITTED) << r1.reason();
+  const auto planned_first = client_->replies(first).front();
+  ASSERT_EQ(planned_first.outcome(), SWARM_PLANNED);
+  ASSERT_EQ(planned_first.jobs()[0].robot(), "rs");
+  ASSERT_EQ(r2.outcome(), SWARM_COMMITTED) << r2.reason();
+  const auto& b = r2.jobs()[0];
+  const double clearance = 0.6;  // two robots' radii
+  EXPECT_TRUE(clear_of(planned_first.jobs()[0], b, clearance))
+      << "spot_2 was placed onto spot_1's open alternative";
+  EXPECT_TRUE(clear_of(r1.jobs()[0], b, clearance)) << "spot_1 and spot_2 collide";
+  EXPECT_GE(std::hypot(b.x() - 20, b.y() - 20), clearance) << "spot_2 lies where rs stands";
 }
 
 }  // namespace
