@@ -15,6 +15,9 @@
 #include "oscar/swarm/forbidden_regions.hpp"
 #include "oscar/swarm/scheduler.hpp"
 #include "oscar/swarm/trajectory_planner.hpp"
+#ifdef OSCAR_SWARM_LIVE
+#include "live_bench.hpp"
+#endif
 
 using namespace oscar::swarm;
 
@@ -154,6 +157,9 @@ int main(int argc, char** argv) {
   int repeat = 5, e2e_nodes = 100, e2e_obstacles = 50, e2e_jobs = 1000;
   double max_seconds = 120;
   int static_max = 400;
+  bool live = false;
+  std::vector<int> live_robots{10, 50};
+  double live_seconds = 60, live_rate = 0;
   app.add_flag("--json", json, "print JSON instead of tables");
   app.add_option("--repeat", repeat, "measurements per point (the minimum is reported)");
   app.add_option("--nodes", e2e_nodes, "end-to-end: nodes");
@@ -161,9 +167,39 @@ int main(int argc, char** argv) {
   app.add_option("--jobs", e2e_jobs, "end-to-end: jobs");
   app.add_option("--max-seconds", max_seconds, "end-to-end: stop scheduling after this long");
   app.add_option("--static-max", static_max, "static obstacles series: up to this many");
+#ifdef OSCAR_SWARM_LIVE
+  app.add_flag("--live", live,
+               "instead: boot robots, the coordinator and the safety monitor on this host and "
+               "submit jobs at a steady rate (submit -> committed, jobs done, NAKs, violations)");
+  app.add_option("--robots", live_robots, "--live: robot counts to run, in turn")->delimiter(',');
+  app.add_option("--seconds", live_seconds, "--live: how long jobs are submitted");
+  app.add_option("--rate", live_rate, "--live: jobs per second (default: robots / 5)");
+#endif
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 
   nlohmann::json doc;
+#ifdef OSCAR_SWARM_LIVE
+  if (live) {
+    doc["live"] = nlohmann::json::array();
+    for (int n : live_robots) {
+      auto r = oscar::bench::run_live(n, live_seconds, live_rate > 0 ? live_rate : n / 5.0);
+      if (!json) {
+        fmt::print(
+            "live: {} robots, {} jobs submitted, {} committed, {} done in their window, submit -> "
+            "committed p50 {:.1f} ms p99 {:.1f} ms, {} NAKs, {} timeouts, {} re-plans, {} safety "
+            "violations, coordinator CPU {:.1f} %\n",
+            r["robots"].get<int>(), r["jobs_submitted"].get<int>(), r["jobs_committed"].get<int>(),
+            r["jobs_done_in_window"].get<int>(), r["submit_to_commit_ms_p50"].get<double>(),
+            r["submit_to_commit_ms_p99"].get<double>(), r["naks"].get<long>(),
+            r["timeouts"].get<long>(), r["replans"].get<long>(), r["safety_violations"].get<long>(),
+            r["coordinator_cpu_percent"].get<double>());
+      }
+      doc["live"].push_back(std::move(r));
+    }
+    if (json) std::cout << doc.dump(2) << "\n";
+    return 0;
+  }
+#endif
   auto series = [&](const std::string& name, const std::vector<int>& sizes,
                     const std::function<Timed(int, bool)>& f) {
     // One array per dimension as the issue names it; each entry says which case it measures.
