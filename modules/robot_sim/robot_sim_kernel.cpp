@@ -126,17 +126,7 @@ void RobotSim::process(Cycle& cycle) {
   }
   committed_.forget_before(now);
   std::erase_if(jobs_, [&](const auto& kv) { return kv.second.end_ns() < now; });
-  const Motion m = committed_.at(now);
-  RobotState s;
-  append_stamp(s.header(), now);
-  s.robot(name_);
-  s.radius(params_.radius);
-  s.max_speed(params_.max_speed);
-  s.turning_radius(params_.turning_radius);
-  s.x(m.x);
-  s.y(m.y);
-  s.heading(m.heading);
-  s.speed(m.speed);
+  RobotState s = state_at(now, committed_.at(now));
   if (!broken_) {
     s.job(job_at(now));
     s.transaction(committed_.transaction_at(now));
@@ -149,16 +139,23 @@ void RobotSim::process(Cycle& cycle) {
 // Stub: it stands at its start, whole, and works nothing.
 void RobotSim::stub(Cycle& cycle) {
   clock(cycle.now());
+  state_.publish(state_at(cycle.now(), Motion{params_.start_x, params_.start_y,
+                                              std::remainder(params_.start_heading, 2 * M_PI), 0}));
+}
+
+// The state of this robot at `now` moving as `m`, working nothing.
+RobotState RobotSim::state_at(Stamp now, const Motion& m) const {
   RobotState s;
-  append_stamp(s.header(), cycle.now());
+  append_stamp(s.header(), now);
   s.robot(name_);
   s.radius(params_.radius);
   s.max_speed(params_.max_speed);
   s.turning_radius(params_.turning_radius);
-  s.x(params_.start_x);
-  s.y(params_.start_y);
-  s.heading(std::remainder(params_.start_heading, 2 * M_PI));
-  state_.publish(std::move(s));
+  s.x(m.x);
+  s.y(m.y);
+  s.heading(m.heading);
+  s.speed(m.speed);
+  return s;
 }
 
 // Why the robot refuses a proposal arriving at `now`, or "" if it takes it.

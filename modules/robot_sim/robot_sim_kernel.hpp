@@ -48,6 +48,7 @@ class RobotSim final : public Kernel {
   void clock(Stamp now);
   void break_down_if_due(Stamp now);
   RobotJob job_at(Stamp now) const;  // id empty: none
+  RobotState state_at(Stamp now, const Motion& m) const;
 
   Output<RobotState>& state_;
   Params params_;
