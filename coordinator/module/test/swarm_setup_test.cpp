@@ -53,6 +53,20 @@ TEST(SwarmSetup, RobotsAreEveryRobotSimKernelUnlessNamed) {
   EXPECT_EQ(one.ack_timeout.count(), 500);
 }
 
+TEST(SwarmSetup, ACoordinatorWithoutSwarmHasNone) {
+  const auto spec = SystemSpec::parse(YAML::Load(R"(
+system: s
+modules:
+  - name: fleet
+    kernels:
+      - { type: robot_sim, name: r1 }
+coordinator:
+  applets: []
+)"),
+                                      "s.yaml");
+  EXPECT_FALSE(SwarmSetup::from(spec).has_value());
+}
+
 TEST(SwarmSetup, BadKeysAndValuesAreRefusedAtTheirLine) {
   expect_refused("    robots: [nobody]\n", "s.yaml:13: swarm.robots: no kernel named 'nobody'");
   expect_refused("    ack_timout_ms: 300\n", "ack_timout_ms");

@@ -59,7 +59,10 @@ const SystemModule* host_of(const SystemSpec& system, const std::string& name,
 }  // namespace
 
 std::optional<SwarmSetup> SwarmSetup::from(const SystemSpec& system) {
-  if (!system.coordinator || !system.coordinator->swarm) return std::nullopt;
+  // Not `!swarm`: a default YAML::Node is a defined null, true as a bool.
+  if (!system.coordinator || !system.coordinator->swarm || system.coordinator->swarm.IsNull()) {
+    return std::nullopt;
+  }
   const YAML::Node node = system.coordinator->swarm;
   const std::string& file = system.file;
   if (!node.IsMap()) fail(file, node, "coordinator.swarm: expected a map (robots, world, ...)");
