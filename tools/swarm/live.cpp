@@ -126,16 +126,19 @@ const char* outcome_name(SwarmOutcome o) {
   return "?";
 }
 
+// A placed job as JSON; its start in seconds from `now`.
+nlohmann::json job_json(const SwarmPlacedJob& j, std::int64_t now) {
+  return {{"id", j.id()},
+          {"robot", j.robot()},
+          {"x", j.x()},
+          {"y", j.y()},
+          {"start_s", static_cast<double>(j.start_ns() - now) * 1e-9},
+          {"duration_s", j.duration_s()}};
+}
+
 nlohmann::json reply_json(const SwarmReply& r, std::int64_t now) {
   auto jobs = nlohmann::json::array();
-  for (const auto& j : r.jobs()) {
-    jobs.push_back({{"id", j.id()},
-                    {"robot", j.robot()},
-                    {"x", j.x()},
-                    {"y", j.y()},
-                    {"start_s", static_cast<double>(j.start_ns() - now) * 1e-9},
-                    {"duration_s", j.duration_s()}});
-  }
+  for (const auto& j : r.jobs()) jobs.push_back(job_json(j, now));
   return {{"request", r.request()},
           {"outcome", outcome_name(r.outcome())},
           {"transaction", r.transaction()},
@@ -177,7 +180,7 @@ int run_submit(const SubmitOptions& o) {
       *participant, topics::swarm_reply(), [&](const SwarmReply& r, const auto&) {
         if (r.sender() != sender) return;
         std::lock_guard lock(mutex);
-        if (o.json) std::printf("%s\n", reply_json(r, now).dump().c_str());
+        if (o.json) fmt::print("{}\n", reply_json(r, now).dump());
         if (r.outcome() != SWARM_PLANNED) final_replies[r.request()] = r;
         changed.notify_all();
       });
@@ -253,14 +256,7 @@ int run_status(const StatusOptions& o) {
   const auto& s = *status;
   if (o.json) {
     auto jobs = nlohmann::json::array();
-    for (const auto& j : s.jobs()) {
-      jobs.push_back({{"id", j.id()},
-                      {"robot", j.robot()},
-                      {"x", j.x()},
-                      {"y", j.y()},
-                      {"start_s", static_cast<double>(j.start_ns() - s.now_ns()) * 1e-9},
-                      {"duration_s", j.duration_s()}});
-    }
+    for (const auto& j : s.jobs()) jobs.push_back(job_json(j, s.now_ns()));
     const nlohmann::json doc{{"robots", s.robots()},
                              {"lost_robots", s.lost_robots()},
                              {"jobs", jobs},
@@ -270,24 +266,18 @@ int run_status(const StatusOptions& o) {
                              {"naks", s.naks()},
                              {"timeouts", s.timeouts()},
                              {"replans", s.replans()}};
-    std::printf("%s\n", doc.dump(2).c_str());
+    fmt::print("{}\n", doc.dump(2));
     return 0;
   }
-  std::printf("robots: %zu in planning", s.robots().size());
-  if (!s.lost_robots().empty()) {
-    std::printf(", lost: %s", fmt::format("{}", fmt::join(s.lost_robots(), ", ")).c_str());
-  }
-  std::printf("\njobs: %llu submitted, %llu committed, %zu to do; open transactions: %zu\n",
-              static_cast<unsigned long long>(s.jobs_submitted()),
-              static_cast<unsigned long long>(s.jobs_committed()), s.jobs().size(),
-              s.open_transactions().size());
-  std::printf(
-      "naks: %llu, timeouts: %llu, re-plans: %llu\n", static_cast<unsigned long long>(s.naks()),
-      static_cast<unsigned long long>(s.timeouts()), static_cast<unsigned long long>(s.replans()));
+  fmt::print("robots: {} in planning", s.robots().size());
+  if (!s.lost_robots().empty()) fmt::print(", lost: {}", fmt::join(s.lost_robots(), ", "));
+  fmt::print("\njobs: {} submitted, {} committed, {} to do; open transactions: {}\n",
+             s.jobs_submitted(), s.jobs_committed(), s.jobs().size(), s.open_transactions().size());
+  fmt::print("naks: {}, timeouts: {}, re-plans: {}\n", s.naks(), s.timeouts(), s.replans());
   for (const auto& j : s.jobs()) {
-    std::printf("  %-12s %-10s (%7.2f, %7.2f)  start %+8.1f s  %6.1f s\n", j.id().c_str(),
-                j.robot().c_str(), j.x(), j.y(),
-                static_cast<double>(j.start_ns() - s.now_ns()) * 1e-9, j.duration_s());
+    fmt::print("  {:<12} {:<10} ({:7.2f}, {:7.2f})  start {:+8.1f} s  {:6.1f} s\n", j.id(),
+               j.robot(), j.x(), j.y(), static_cast<double>(j.start_ns() - s.now_ns()) * 1e-9,
+               j.duration_s());
   }
   return 0;
 }
