@@ -1,5 +1,5 @@
 // Docs stay true: every code block in docs/, README.md and modules/*/README.md marked `<!--
-// snippet: PATH -->` must appear verbatim in PATH (STYLE.md: documentation code is cut from
+// snippet: PATH -->` must appear verbatim in PATH (documentation code is cut from
 // compiled files).
 #include <filesystem>
 #include <fstream>

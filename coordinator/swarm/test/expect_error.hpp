@@ -1,5 +1,5 @@
 #pragma once
-// Shared by the swarm tests: an error test checks the message (STYLE.md, Tests).
+// Shared by the swarm tests: an error test checks the message, not only that there is one.
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 #pragma once
-/// @file OSCAR_DEMAND: an always-on check for bugs in OSCAR's own code (STYLE.md, errors).
+/// @file OSCAR_DEMAND: an always-on check for bugs in OSCAR's own code.
 
 #include <source_location>
 #include <string_view>

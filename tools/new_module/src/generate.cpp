@@ -1,4 +1,4 @@
-// The files `oscar new-module` writes: a module folder as STYLE.md lays it out.
+// The files `oscar new-module` writes: a module folder as docs/kernels.md lays it out.
 #include <cmath>
 
 #include <fmt/format.h>
