@@ -157,9 +157,6 @@ int main(int argc, char** argv) {
   int repeat = 5, e2e_nodes = 100, e2e_obstacles = 50, e2e_jobs = 1000;
   double max_seconds = 120;
   int static_max = 400;
-  bool live = false;
-  std::vector<int> live_robots{10, 50};
-  double live_seconds = 60, live_rate = 0;
   app.add_flag("--json", json, "print JSON instead of tables");
   app.add_option("--repeat", repeat, "measurements per point (the minimum is reported)");
   app.add_option("--nodes", e2e_nodes, "end-to-end: nodes");
@@ -168,6 +165,9 @@ int main(int argc, char** argv) {
   app.add_option("--max-seconds", max_seconds, "end-to-end: stop scheduling after this long");
   app.add_option("--static-max", static_max, "static obstacles series: up to this many");
 #ifdef OSCAR_SWARM_LIVE
+  bool live = false;
+  std::vector<int> live_robots{10, 50};
+  double live_seconds = 60, live_rate = 0;
   app.add_flag("--live", live,
                "instead: boot robots, the coordinator and the safety monitor on this host and "
                "submit jobs at a steady rate (submit -> committed, jobs done, NAKs, violations)");
