@@ -112,6 +112,7 @@ nlohmann::json run_live(int robots, double seconds, double rate) {
   std::mutex mutex;
   std::condition_variable changed;
   std::map<unsigned long long, Submitted> jobs;
+  std::map<std::string, int> not_committed;  // final refusals and aborts by reason
   std::optional<SwarmStatus> status;
   const std::string sender = "bench";
   TopicWriter<SwarmRequest, SwarmRequestPubSubType> writer(sys.participant(),
@@ -121,6 +122,10 @@ nlohmann::json run_live(int robots, double seconds, double rate) {
         std::lock_guard lock(mutex);
         auto it = jobs.find(r.request());
         if (r.sender() != sender || it == jobs.end()) return;
+        if (r.outcome() == SWARM_REFUSED || r.outcome() == SWARM_ABORTED) {
+          const auto colon = r.reason().find(": ");  // the reason without the job's id
+          ++not_committed[colon == std::string::npos ? r.reason() : r.reason().substr(colon + 2)];
+        }
         if (r.outcome() == SWARM_COMMITTED && !it->second.commit_ms) {
           it->second.commit_ms =
               std::chrono::duration<double, std::milli>(Clock::now() - it->second.at).count();
@@ -132,6 +137,14 @@ nlohmann::json run_live(int robots, double seconds, double rate) {
         status = s;
         changed.notify_all();
       });
+  // Requests only once the coordinator reads them and its replies reach us (volatile topics: a
+  // reply sent before the match is lost).
+  for (const auto until = Clock::now() + 30s; writer.matched() == 0 || replies.matched() == 0;) {
+    if (Clock::now() > until) throw std::runtime_error("no coordinator reads oscar/swarm/request");
+    std::this_thread::sleep_for(10ms);
+  }
+  // Our side matched; the coordinator's reply writer may learn of our reader a moment later.
+  std::this_thread::sleep_for(1s);
   {
     std::unique_lock lock(mutex);
     if (!changed.wait_for(lock, 60s, [&] {
@@ -236,6 +249,7 @@ nlohmann::json run_live(int robots, double seconds, double rate) {
           {"naks", last.naks()},
           {"replans", last.replans()},
           {"timeouts", last.timeouts()},
+          {"not_committed", not_committed},
           {"coordinator_cpu_percent",
            cpu0 < 0 || cpu1 < 0 ? -1.0 : 100 * (cpu1 - cpu0) / busy_seconds}};
 }

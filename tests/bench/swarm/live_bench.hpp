@@ -9,7 +9,8 @@ namespace oscar::bench {
 /// domain, submits jobs at `rate` per second for `seconds`, watches the robots until the last
 /// job's window closed, and returns {"robots", "jobs_submitted", "jobs_committed",
 /// "jobs_done_in_window", "safety_violations", "submit_to_commit_ms_p50",
-/// "submit_to_commit_ms_p99", "naks", "replans", "timeouts", "coordinator_cpu_percent"}.
+/// "submit_to_commit_ms_p99", "naks", "replans", "timeouts", "not_committed" (reason -> count),
+/// "coordinator_cpu_percent"}.
 /// Progress goes to stderr.
 nlohmann::json run_live(int robots, double seconds, double rate);
 
