@@ -4,13 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-// GCC 12 reports a false maybe-uninitialized in Boost.Geometry's rescale policy of union_ (the
-// factor is set on every path that reads it); silenced for these headers only.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <boost/geometry.hpp>
-#include <boost/geometry/algorithms/point_on_surface.hpp>
-#pragma GCC diagnostic pop
+#include "boost_geometry.hpp"
 
 namespace oscar::swarm {
 

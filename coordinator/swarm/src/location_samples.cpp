@@ -2,11 +2,7 @@
 #include <algorithm>
 #include <deque>
 
-// GCC 12's false maybe-uninitialized in Boost.Geometry's rescale policy (see forbidden_regions.cpp).
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <boost/geometry.hpp>
-#pragma GCC diagnostic pop
+#include "boost_geometry.hpp"
 
 #include "scheduler_state.hpp"
 

@@ -4,12 +4,7 @@
 #include <limits>
 #include <queue>
 
-// GCC 12's false maybe-uninitialized in Boost.Geometry (see forbidden_regions.cpp).
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <boost/geometry.hpp>
-#include <boost/geometry/index/rtree.hpp>
-#pragma GCC diagnostic pop
+#include "boost_geometry.hpp"
 
 namespace oscar::swarm {
 
