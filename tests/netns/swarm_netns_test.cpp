@@ -1,17 +1,14 @@
 // The live swarm on two hosts (issue 18): config/swarm-warehouse-2hosts.yaml booted on two test
 // hosts (network namespaces): ten robots on each, the coordinator, the job stream and the safety
 // monitor on the first. Root only; skipped otherwise.
-#include <filesystem>
 #include <fstream>
 #include <regex>
 
 #include <fmt/format.h>
 
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
-#include "process.hpp"
-#include "test_hosts.hpp"
+#include "two_hosts.hpp"
 
 namespace oscar {
 namespace {
@@ -25,26 +22,9 @@ std::string read(const std::string& path) {
 TEST(SwarmOnTwoHosts, RobotsOfBothHostsTakeJobsWithoutASafetyViolation) {
   if (const auto why = test::TestHosts::unavailable(); !why.empty()) GTEST_SKIP() << why;
   test::TestHosts hosts(2);
-  auto root = YAML::LoadFile(std::string(OSCAR_SOURCE_DIR) + "/config/swarm-warehouse-2hosts.yaml");
-  root.remove("domain");
-  root["lease"] = "1s";  // as the other booted-system tests on a loaded machine
-  root["hosts"]["pc1"]["address"] = hosts.address(1);
-  root["hosts"]["pc2"]["netns"] = hosts.netns(2);
-  root["hosts"]["pc2"]["address"] = hosts.address(2);
-  const auto file = test::temp_path("warehouse2") + ".yaml";
-  {
-    YAML::Emitter out;
-    out << root;
-    std::ofstream(file) << out.c_str();
-  }
-  const auto log_dir = test::temp_path("warehouse2_logs");
-  std::filesystem::remove_all(log_dir);
-  auto argv = hosts.on(1);  // boot and the registry run on pc1
-  argv.insert(argv.end(),
-              {test::bin("oscar-boot"), file, "--domain", std::to_string(test::test_domain()),
-               "--log-dir", log_dir, "--timeout", "40", "--duration", "25"});
-  test::Process boot(argv, test::temp_path("warehouse2_boot.log"));
-  ASSERT_EQ(boot.wait(120s), 0) << boot.output();
+  const auto run = test::boot_on_two_hosts(hosts, "swarm-warehouse-2hosts.yaml", "warehouse2", 25);
+  ASSERT_EQ(run.exit_code, 0) << run.boot_output;
+  const auto& log_dir = run.log_dir;
 
   const auto coordinator = read(log_dir + "/pc1/coordinator.log");
   for (int i = 1; i <= 20; ++i) {
