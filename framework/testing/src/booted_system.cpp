@@ -88,13 +88,25 @@ std::vector<std::string> command_line(pid_t pid) {
   return args;
 }
 
-// True if a process with that pid exists and is not a zombie.
-bool alive(pid_t pid) {
-  std::ifstream stat(fmt::format("/proc/{}/stat", pid));
+// True if a thread's /proc stat file says it is neither a zombie nor dead.
+bool running(const fs::path& stat_file) {
+  std::ifstream stat(stat_file);
   std::string line;
   if (!std::getline(stat, line)) return false;
   const auto close = line.rfind(')');
-  return close != std::string::npos && close + 2 < line.size() && line[close + 2] != 'Z';
+  return close != std::string::npos && close + 2 < line.size() && line[close + 2] != 'Z' &&
+         line[close + 2] != 'X';
+}
+
+// True if a process with that pid has a thread that is not a zombie. A killed multi-threaded
+// process shows its main thread as a zombie while the others still exit and hold its files
+// (and with them the locks of its shared memory): it is alive until the last thread is gone.
+bool alive(pid_t pid) {
+  std::error_code ec;
+  for (const auto& task : fs::directory_iterator(fmt::format("/proc/{}/task", pid), ec)) {
+    if (running(task.path() / "stat")) return true;
+  }
+  return false;
 }
 
 // The processes boot started for this system: the registry, the monitors and the modules all
