@@ -5,10 +5,14 @@
 // refused with the reason.
 #include <cmath>
 #include <condition_variable>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <mutex>
 #include <optional>
 
+#include <fmt/format.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "booted_system.hpp"
@@ -17,11 +21,13 @@
 #include "oscar/time.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
+#include "process.hpp"  // tests/common
 
 namespace oscar {
 namespace {
 
 using namespace std::chrono_literals;
+using ::testing::HasSubstr;
 
 // Five robots: r1 and r2 do as told; rn refuses everything; rs (a module of its own) answers
 // after the coordinator stopped waiting; rb (a module of its own) breaks down when told to.
@@ -362,6 +368,66 @@ TEST_F(LiveSwarm, ConcurrentSubmissionsSeeEachOthersOpenTransactions) {
       << "spot_2 was placed onto spot_1's open alternative";
   EXPECT_TRUE(clear_of(r1.jobs()[0], b, clearance)) << "spot_1 and spot_2 collide";
   EXPECT_GE(std::hypot(b.x() - 20, b.y() - 20), clearance) << "spot_2 lies where rs stands";
+}
+
+// Runs `oscar swarm snapshot` with `args`; its exit code, its output and the picture it drew.
+struct Snapshot {
+  int exit_code = -1;
+  std::string output, svg;
+};
+Snapshot snapshot(std::vector<std::string> args) {
+  const auto dir = std::filesystem::temp_directory_path();
+  const auto file = (dir / fmt::format("swarm_snapshot_{}.svg", getpid())).string();
+  const auto log = (dir / fmt::format("swarm_snapshot_{}.log", getpid())).string();
+  args.insert(args.begin(), {test::bin("oscar-swarm"), "snapshot", "-o", file});
+  test::Process p(args, log);
+  Snapshot s;
+  s.exit_code = p.wait(30s).value_or(-1);
+  s.output = p.output();
+  std::ifstream in(file);
+  s.svg.assign(std::istreambuf_iterator<char>(in), {});
+  std::filesystem::remove(file);
+  std::filesystem::remove(log);
+  return s;
+}
+
+// The picture of the running swarm: the robots where they are, labelled, the committed path of
+// a robot on its way to a job, and the job with its start from now.
+TEST_F(LiveSwarm, TheSnapshotDrawsTheRobotsTheirCommittedPathsAndJobs) {
+  client_->status([](const SwarmStatus& x) { return x.robots().size() >= 4; }, "robots");
+  const auto id = client_->schedule(job("drawn", 6, 3, 20, 60, 2));
+  const auto r = client_->outcome(id);
+  ASSERT_EQ(r.outcome(), SWARM_COMMITTED) << r.reason();
+  ASSERT_EQ(r.jobs().size(), 1u);
+  const auto robot = r.jobs()[0].robot();
+  // The plan is published at most twice a second: the next one has the job.
+  std::this_thread::sleep_for(700ms);
+  const auto s = snapshot({"-d", std::to_string(system_->domain())});
+  ASSERT_EQ(s.exit_code, 0) << s.output;
+  EXPECT_THAT(s.svg, HasSubstr(">drawn @+"));
+  for (const std::string r_id : {"r1", "r2", "rn", "rs"}) {
+    EXPECT_THAT(s.svg, HasSubstr(">" + r_id + "</text>")) << r_id << " is not in the picture";
+  }
+  // Each robot is a disc; the one with the job has a path of more than its place now.
+  std::size_t discs = 0, paths = 0;
+  for (std::size_t at = 0; (at = s.svg.find("<circle", at)) != std::string::npos; ++at) ++discs;
+  for (std::size_t at = 0; (at = s.svg.find("<polyline points=\"", at)) != std::string::npos;
+       ++at) {
+    const auto end = s.svg.find('"', at + 18);
+    const auto points = s.svg.substr(at + 18, end - at - 18);
+    if (std::count(points.begin(), points.end(), ' ') >= 2) ++paths;  // two points or more
+  }
+  EXPECT_GE(discs, 5u + 1u) << "five robots and the job";
+  EXPECT_GE(paths, 1u) << robot << "'s path to the job is missing";
+}
+
+// Without a coordinator that plans a swarm, the snapshot says so and draws nothing.
+TEST(SwarmSnapshot, WithoutACoordinatorItSaysSoAndExits2) {
+  testing::FreeDomain nobody;
+  const auto s = snapshot({"-d", std::to_string(nobody.domain()), "--timeout", "0.5"});
+  EXPECT_EQ(s.exit_code, 2);
+  EXPECT_THAT(s.output, HasSubstr("no coordinator published a swarm plan on domain"));
+  EXPECT_TRUE(s.svg.empty());
 }
 
 }  // namespace

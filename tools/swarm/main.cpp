@@ -1,5 +1,5 @@
 // oscar-swarm: `oscar swarm plan PROBLEM.yaml|json [-o SCHEDULE.json] [--svg FILE] [--st NODE]
-// [--seed N]`; with the framework also `oscar swarm submit` and `oscar swarm status` (live.hpp).
+// [--seed N]`; with the framework also `oscar swarm submit`, `status` and `snapshot` (live.hpp).
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <oscar/command_line.hpp>
@@ -60,11 +60,25 @@ int main(int argc, char** argv) {
 #ifdef OSCAR_SWARM_LIVE
   oscar::swarm::tools::SubmitOptions submit;
   oscar::swarm::tools::StatusOptions status;
+  oscar::swarm::tools::SnapshotOptions snapshot;
   oscar::swarm::tools::add_submit(app, submit);
   oscar::swarm::tools::add_status(app, status);
+  oscar::swarm::tools::add_snapshot(app, snapshot);
 #endif
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 #ifdef OSCAR_SWARM_LIVE
+  if (snapshot.command->parsed()) {
+    try {
+      write_output(snapshot.output, oscar::swarm::tools::snapshot_svg(snapshot));
+    } catch (const OutputError& e) {
+      std::cerr << "oscar swarm snapshot: " << e.what() << "\n";
+      return 1;
+    } catch (const std::exception& e) {
+      std::cerr << "oscar swarm snapshot: " << e.what() << "\n";
+      return 2;
+    }
+    return 0;
+  }
   if (submit.command->parsed() || status.command->parsed()) {
     const char* which = submit.command->parsed() ? "submit" : "status";
     try {

@@ -123,13 +123,15 @@ std::string polygon(const Frame& f, const Polygon& p, const std::string& style) 
   return fmt::format("<polygon points=\"{}\" {}/>\n", pts, style);
 }
 
-// The picture's frame with its caption (one text line per entry) below the plot.
-std::string header(const std::vector<std::string>& caption) {
-  std::string out =
-      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"800\" height=\"820\" "
-      "font-family=\"sans-serif\" font-size=\"11\">\n<rect width=\"800\" height=\"820\" "
-      "fill=\"white\"/>\n";
-  double y = 820 - 6 - 14 * static_cast<double>(caption.size() - 1);
+// The picture's frame, `height` pixels high, with its caption (one text line per entry) at the
+// bottom.
+std::string header(const std::vector<std::string>& caption, double height = 820) {
+  std::string out = fmt::format(
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"800\" height=\"{0:.0f}\" "
+      "font-family=\"sans-serif\" font-size=\"11\">\n<rect width=\"800\" height=\"{0:.0f}\" "
+      "fill=\"white\"/>\n",
+      height);
+  double y = height - 6 - 14 * static_cast<double>(caption.size() - 1);
   for (const auto& line : caption) {
     out += fmt::format("<text x=\"20\" y=\"{:.0f}\">{}</text>\n", y, line);
     y += 14;
@@ -139,52 +141,93 @@ std::string header(const std::vector<std::string>& caption) {
 
 }  // namespace
 
-std::string world_svg(const Scheduler& s) {
+std::string world_svg(const WorldPicture& picture) {
   Frame f;
-  for (const auto& p : s.world().static_obstacles) f.add(p);
-  for (const auto& o : s.world().dynamic_obstacles) {
-    for (const auto& w : o.trajectory.points()) f.add(o.shape, w.x, w.y);  // the whole shape
+  for (const auto& p : picture.static_obstacles) f.add(p);
+  for (const auto& o : picture.moving_obstacles) {
+    for (const auto& p : o.path) f.add(o.shape, p.x(), p.y());  // the whole shape
   }
-  for (const auto& id : s.node_ids()) {
-    for (const auto& w : s.trajectory(id).points()) f.add(w.x, w.y);
+  for (const auto& r : picture.robots) {
+    for (const auto& p : r.path) f.add(p.x(), p.y());
+    if (r.now) {
+      f.add(r.now->x() - r.radius, r.now->y() - r.radius);
+      f.add(r.now->x() + r.radius, r.now->y() + r.radius);
+    }
   }
+  // As high as the world needs at the scale its width allows: the axis, its labels, the caption.
+  const double plot_height = (f.y1 - f.y0) * f.scale();
   std::string out = header(
-      {"oscar swarm plan: static obstacles (grey), moving obstacles at their start and their path "
-       "(orange, dashed),",
-       "node paths (colour, labelled at their start), jobs (dots: id @ start time in s)"});
+      picture.caption, kTop + plot_height + 50 + 14 * static_cast<double>(picture.caption.size()));
   out += x_axis(
       f.x0, f.x1, f.sy(f.y0) + 8, [&](double x) { return f.sx(x); }, "x [m]");
   out += y_axis(
       f.y0, f.y1, f.sx(f.x0) - 8, [&](double y) { return f.sy(y); }, "y [m]");
   LabelPlacer labels;
-  for (const auto& p : s.world().static_obstacles)
+  for (const auto& p : picture.static_obstacles)
     out += polygon(f, p, "fill=\"#bbb\" stroke=\"#666\"");
-  for (const auto& o : s.world().dynamic_obstacles) {
-    const auto& pts = o.trajectory.points();
-    out += polygon(f, translate(o.shape, pts.front().x, pts.front().y),
+  for (const auto& o : picture.moving_obstacles) {
+    out += polygon(f, translate(o.shape, o.now.x(), o.now.y()),
                    "fill=\"#fdb\" stroke=\"#f80\" fill-opacity=\"0.6\"");
     std::string line;
-    for (const auto& w : pts) line += fmt::format("{:.2f},{:.2f} ", f.sx(w.x), f.sy(w.y));
+    for (const auto& p : o.path) line += fmt::format("{:.2f},{:.2f} ", f.sx(p.x()), f.sy(p.y()));
     out += fmt::format(
         "<polyline points=\"{}\" fill=\"none\" stroke=\"#f80\" stroke-dasharray=\"5,4\"/>\n", line);
   }
   std::size_t k = 0;
-  for (const auto& id : s.node_ids()) {
+  for (const auto& r : picture.robots) {
     const char* colour = kColours[k++ % kColours.size()];
     std::string line;
-    for (const auto& w : s.trajectory(id).points())
-      line += fmt::format("{:.2f},{:.2f} ", f.sx(w.x), f.sy(w.y));
-    out += fmt::format("<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"2\"/>\n",
-                       line, colour);
-    const auto& start = s.trajectory(id).points().front();
-    out += labels.place(f.sx(start.x), f.sy(start.y), id, fmt::format(" fill=\"{}\"", colour));
-    for (const auto& j : s.jobs(id)) {
-      out += fmt::format("<circle cx=\"{:.2f}\" cy=\"{:.2f}\" r=\"4\" fill=\"{}\"/>\n", f.sx(j.x),
-                         f.sy(j.y), colour);
-      out += labels.place(f.sx(j.x), f.sy(j.y), fmt::format("{} @{:.1f}", j.id, j.start));
+    for (const auto& p : r.path) line += fmt::format("{:.2f},{:.2f} ", f.sx(p.x()), f.sy(p.y()));
+    if (!line.empty()) {
+      out +=
+          fmt::format("<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"2\"/>\n",
+                      line, colour);
+    }
+    if (r.now) {
+      out += fmt::format(
+          "<circle cx=\"{:.2f}\" cy=\"{:.2f}\" r=\"{:.2f}\" fill=\"{}\" stroke=\"#333\"/>\n",
+          f.sx(r.now->x()), f.sy(r.now->y()), std::max(r.radius * f.scale(), 3.0),
+          r.broken ? "#f00" : colour);
+    }
+    const auto label_at = r.now            ? std::optional<Point>(*r.now)
+                          : r.path.empty() ? std::nullopt
+                                           : std::optional<Point>(r.path.front());
+    if (label_at) {
+      out +=
+          labels.place(f.sx(label_at->x()), f.sy(label_at->y()),
+                       r.broken ? r.id + " (broken)" : r.id, fmt::format(" fill=\"{}\"", colour));
+    }
+    for (const auto& j : r.jobs) {
+      out += fmt::format("<circle cx=\"{:.2f}\" cy=\"{:.2f}\" r=\"4\" fill=\"{}\"/>\n",
+                         f.sx(j.at.x()), f.sy(j.at.y()), colour);
+      out += labels.place(f.sx(j.at.x()), f.sy(j.at.y()), j.label);
     }
   }
   return out + "</svg>\n";
+}
+
+std::string world_svg(const Scheduler& s) {
+  WorldPicture picture;
+  picture.caption = {
+      "oscar swarm plan: static obstacles (grey), moving obstacles at their start and their path "
+      "(orange, dashed),",
+      "node paths (colour, labelled at their start), jobs (dots: id @ start time in s)"};
+  picture.static_obstacles = s.world().static_obstacles;
+  for (const auto& o : s.world().dynamic_obstacles) {
+    const auto& pts = o.trajectory.points();
+    WorldPicture::MovingObstacle m{o.shape, {}, Point(pts.front().x, pts.front().y)};
+    for (const auto& w : pts) m.path.emplace_back(w.x, w.y);
+    picture.moving_obstacles.push_back(std::move(m));
+  }
+  for (const auto& id : s.node_ids()) {
+    WorldPicture::Robot r{id, {}, {}, std::nullopt, s.node(id).radius_m, false};
+    for (const auto& w : s.trajectory(id).points()) r.path.emplace_back(w.x, w.y);
+    for (const auto& j : s.jobs(id)) {
+      r.jobs.push_back({Point(j.x, j.y), fmt::format("{} @{:.1f}", j.id, j.start)});
+    }
+    picture.robots.push_back(std::move(r));
+  }
+  return world_svg(picture);
 }
 
 std::string st_svg(const Scheduler& s, const std::string& node) {

@@ -94,10 +94,12 @@ TopicSpec<SchedCommand, SchedCommandPubSubType> sched_command();
 TopicSpec<SchedCommandReply, SchedCommandReplyPubSubType> sched_command_reply();
 
 /// The live swarm (docs/swarm.md): jobs submitted to the coordinator and its replies (reliable,
-/// volatile, keep all), and the swarm's status (keep last 1; `oscar swarm status`).
+/// volatile, keep all), the swarm's status (keep last 1; `oscar swarm status`) and its committed
+/// plan (keep last 1; `oscar swarm snapshot`).
 TopicSpec<SwarmRequest, SwarmRequestPubSubType> swarm_request();
 TopicSpec<SwarmReply, SwarmReplyPubSubType> swarm_reply();
 TopicSpec<SwarmStatus, SwarmStatusPubSubType> swarm_status();
+TopicSpec<SwarmPlan, SwarmPlanPubSubType> swarm_plan();
 
 }  // namespace topics
 }  // namespace oscar

@@ -127,4 +127,8 @@ TopicSpec<SwarmStatus, SwarmStatusPubSubType> swarm_status() {
   return {"oscar/swarm/status", qos::state_writer(1), qos::state_reader(1)};
 }
 
+TopicSpec<SwarmPlan, SwarmPlanPubSubType> swarm_plan() {
+  return {"oscar/swarm/plan", qos::state_writer(1), qos::state_reader(1)};
+}
+
 }  // namespace oscar::topics

@@ -68,6 +68,8 @@ struct SwarmService::Impl {
   std::thread thread;
   std::unique_ptr<TopicWriter<SwarmReply, SwarmReplyPubSubType>> replies;
   std::unique_ptr<TopicWriter<SwarmStatus, SwarmStatusPubSubType>> status_writer;
+  std::unique_ptr<TopicWriter<SwarmPlan, SwarmPlanPubSubType>> plan_writer;
+  bool plan_changed = true;  // the committed plan changed since it was last published
   std::unique_ptr<TopicReader<SwarmRequest, SwarmRequestPubSubType>> requests;
 
   Impl(SwarmSetup s, DdsParticipant& p)
@@ -107,6 +109,8 @@ struct SwarmService::Impl {
         participant, topics::swarm_reply());
     status_writer = std::make_unique<TopicWriter<SwarmStatus, SwarmStatusPubSubType>>(
         participant, topics::swarm_status());
+    plan_writer = std::make_unique<TopicWriter<SwarmPlan, SwarmPlanPubSubType>>(
+        participant, topics::swarm_plan());
     thread = std::thread([this] { run(); });
     requests = std::make_unique<TopicReader<SwarmRequest, SwarmRequestPubSubType>>(
         participant, topics::swarm_request(),
@@ -129,6 +133,7 @@ struct SwarmService::Impl {
   void run() {
     auto next_status = std::chrono::steady_clock::now();
     auto next_forget = next_status + 10s;
+    auto next_plan = next_status;
     for (;;) {
       std::deque<Event> batch;
       {
@@ -150,6 +155,11 @@ struct SwarmService::Impl {
       if (!batch.empty() || std::chrono::steady_clock::now() >= next_status) {
         publish_status(now);
         next_status = std::chrono::steady_clock::now() + 1s;
+      }
+      if (plan_changed && std::chrono::steady_clock::now() >= next_plan) {
+        plan_writer->write(swarm_wire::plan(scheduler, clock));
+        plan_changed = false;
+        next_plan = std::chrono::steady_clock::now() + 500ms;  // at most twice a second
       }
       if (std::chrono::steady_clock::now() >= next_forget) {
         forget_history();
@@ -261,6 +271,7 @@ struct SwarmService::Impl {
 
   void finish(TransactionId tx, const Pending& p) {
     scheduler.commit(tx);
+    plan_changed = true;
     for (const auto& robot : p.asked) robots.at(robot).link->commit(robot, tx);
     for (const auto& j : p.jobs) origin[j.id] = p.request;
     counters.jobs_committed(counters.jobs_committed() + p.jobs.size());
@@ -296,6 +307,7 @@ struct SwarmService::Impl {
     try {
       scheduler.add_node(spec);
       robot.planned = true;
+      plan_changed = true;
       spdlog::info("swarm: robot '{}' joins planning at ({:.2f}, {:.2f})", spec.id, spec.x, spec.y);
     } catch (const std::invalid_argument& e) {
       robot.lost = true;
@@ -320,6 +332,7 @@ struct SwarmService::Impl {
       it = pending.erase(it);
     }
     const auto jobs = scheduler.break_down(id, scheduler.present(), swarm::Point(s.x(), s.y()));
+    plan_changed = true;
     for (const auto& j : jobs) {
       auto from = origin.find(j.id);
       if (from == origin.end()) continue;
@@ -352,6 +365,7 @@ struct SwarmService::Impl {
     const double before = scheduler.present() - 60;
     if (before <= clock.seconds(clock.epoch_ns)) return;
     scheduler.forget_before(before);
+    plan_changed = true;
     std::set<std::string> planned;
     for (const auto& id : scheduler.node_ids()) {
       for (const auto& j : scheduler.jobs(id, false)) planned.insert(j.id);
@@ -368,11 +382,7 @@ struct SwarmService::Impl {
       if (robot.planned && !robot.lost) s.robots().push_back(id);
       if (robot.lost) s.lost_robots().push_back(id);
     }
-    for (const auto& id : scheduler.node_ids()) {
-      for (const auto& j : scheduler.jobs(id)) {
-        if (j.end() > scheduler.present()) s.jobs().push_back(swarm_wire::placed(j, clock));
-      }
-    }
+    s.jobs(swarm_wire::upcoming_jobs(scheduler, clock));
     s.open_transactions(scheduler.open_transactions());
     status_writer->write(s);
     std::lock_guard lock(mutex);

@@ -142,4 +142,63 @@ Trajectory proposal(const swarm::Scheduler& scheduler, swarm::TransactionId tx,
   return t;
 }
 
+namespace {
+
+SwarmArea area(const swarm::Polygon& polygon) {
+  SwarmArea a;
+  for (const auto& p : swarm::vertices(polygon)) {
+    a.x().push_back(p.x());
+    a.y().push_back(p.y());
+  }
+  return a;
+}
+
+// The waypoints of `trajectory`, up to the last one before kForever.
+std::vector<SwarmWaypoint> waypoints(const swarm::Trajectory& trajectory, const Clock& clock) {
+  std::vector<SwarmWaypoint> out;
+  for (const auto& w : trajectory.points()) {
+    if (w.t >= swarm::kForever) break;
+    SwarmWaypoint p;
+    p.x(w.x);
+    p.y(w.y);
+    p.t_ns(clock.ns(w.t));
+    out.push_back(p);
+  }
+  return out;
+}
+
+}  // namespace
+
+SwarmPlan plan(const swarm::Scheduler& scheduler, const Clock& clock) {
+  SwarmPlan plan;
+  plan.now_ns(clock.ns(scheduler.present()));
+  for (const auto& o : scheduler.world().static_obstacles)
+    plan.static_obstacles().push_back(area(o));
+  for (const auto& o : scheduler.world().dynamic_obstacles) {
+    SwarmMovingObstacle m;
+    m.shape(area(o.shape));
+    m.path(waypoints(o.trajectory, clock));
+    plan.moving_obstacles().push_back(std::move(m));
+  }
+  for (const auto& id : scheduler.node_ids()) {
+    SwarmPath path;
+    path.robot(id);
+    path.radius(scheduler.node(id).radius_m);
+    path.waypoints(waypoints(scheduler.trajectory(id), clock));
+    plan.paths().push_back(std::move(path));
+  }
+  plan.jobs(upcoming_jobs(scheduler, clock));
+  return plan;
+}
+
+std::vector<SwarmPlacedJob> upcoming_jobs(const swarm::Scheduler& scheduler, const Clock& clock) {
+  std::vector<SwarmPlacedJob> out;
+  for (const auto& id : scheduler.node_ids()) {
+    for (const auto& j : scheduler.jobs(id)) {
+      if (j.end() > scheduler.present()) out.push_back(placed(j, clock));
+    }
+  }
+  return out;
+}
+
 }  // namespace oscar::coordinator::swarm_wire

@@ -34,6 +34,14 @@ SwarmPlacedJob placed(const swarm::Job& job, const Clock& clock);
 Trajectory proposal(const swarm::Scheduler& scheduler, swarm::TransactionId tx,
                     const swarm::Scheduler::NodeChange& change, const Clock& clock);
 
+/// The committed plan as `oscar swarm snapshot` draws it: the world, each robot's committed
+/// trajectory (a trajectory that stays at its end for good ends at its last move), the committed
+/// jobs that end after the present.
+SwarmPlan plan(const swarm::Scheduler& scheduler, const Clock& clock);
+
+/// The committed jobs that end after the present.
+std::vector<SwarmPlacedJob> upcoming_jobs(const swarm::Scheduler& scheduler, const Clock& clock);
+
 /// "schedule", "periodic" ... for messages.
 std::string kind_name(SwarmRequestKind kind);
 
