@@ -1,6 +1,7 @@
 #pragma once
 /// @file SwarmSetup: the system file's `coordinator: swarm:` section (docs/swarm.md, "The live
-/// swarm") as the coordinator's swarm side reads it.
+/// swarm") as the coordinator's swarm side reads it; boot reads it the same way, to refuse a bad
+/// one before it starts anything.
 
 #include <chrono>
 #include <optional>
