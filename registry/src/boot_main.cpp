@@ -20,6 +20,7 @@
 #include <oscar/command_line.hpp>
 
 #include "oscar/coordinator/applet_system.hpp"
+#include "oscar/coordinator/swarm_setup.hpp"
 #include "oscar/cue_types.hpp"
 #include "oscar/kernel_registry.hpp"
 #include "oscar/process_util.hpp"
@@ -149,6 +150,9 @@ int main(int argc, char** argv) {
     oscar::register_standard_cue_types();
     system.check_modules(oscar::plugin_search_path());
     oscar::coordinator::check_applets(system, oscar::plugin_search_path());
+    // The live swarm's section, read as the coordinator will read it: else a bad one would only
+    // fail the coordinator, again at each restart, with the rest of the system running.
+    oscar::coordinator::SwarmSetup::from(system);
     const auto& local = system.local_host();
     check_hosts(system);
     if (check) {

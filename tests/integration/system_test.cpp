@@ -282,6 +282,12 @@ struct BadSystem {
   std::string name, yaml, message;
 };
 
+// A robot and the start of a `coordinator: swarm:` section; the section's keys follow at line 4.
+constexpr const char* kFleet =
+    "modules: [ { name: fleet, kernels: [ { type: robot_sim, name: r1 } ] } ]\n"
+    "coordinator:\n"
+    "  swarm:\n";
+
 class BootRefuses : public ::testing::TestWithParam<BadSystem> {};
 
 TEST_P(BootRefuses, BadSystemFilesWithAClearErrorAndStartsNothing) {
@@ -297,6 +303,19 @@ TEST_P(BootRefuses, BadSystemFilesWithAClearErrorAndStartsNothing) {
   EXPECT_THAT(boot.output(), HasSubstr(bad.message));
   EXPECT_FALSE(std::filesystem::exists(log_dir)) << "something was started";
   EXPECT_TRUE(test::processes_mentioning(file).empty());
+}
+
+// `oscar boot --check` says no to what boot would refuse, the live swarm's section included.
+TEST(Boot, CheckRefusesABadSwarmSectionAsBootWould) {
+  const auto file = test::temp_path("bad_swarm_check") + ".yaml";
+  std::ofstream(file) << kFleet << "    lost_after_ms: soon\n";
+  test::Process check({test::bin("oscar-boot"), file, "--check"},
+                      test::temp_path("bad_swarm_check.log"));
+  EXPECT_EQ(check.wait(30s), 2);
+  EXPECT_THAT(check.output(),
+              HasSubstr("oscar boot: " + file + ":4: swarm.lost_after_ms: expected a number"));
+  EXPECT_THAT(check.output(), ::testing::Not(HasSubstr(": ok")));
+  std::filesystem::remove(file);
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -332,7 +351,17 @@ INSTANTIATE_TEST_SUITE_P(
                   "modules: [ { name: m, kernels: [ { type: relay } ] } ]\n"
                   "services: { S: { provided_by: [m] } }\ncoordinator:\n  applets:\n"
                   "    - { type: warp_applet, name: a }\n",
-                  ":5: applet 'a': unknown applet type 'warp_applet'"}),
+                  ":5: applet 'a': unknown applet type 'warp_applet'"},
+        // The live swarm's section: the coordinator reads it, boot checks it as the coordinator
+        // will (".yaml:LINE": the line of the fault right after the file's name).
+        BadSystem{"swarm_unknown_key", std::string(kFleet) + "    ack_timout_ms: 300\n",
+                  ".yaml:4: coordinator.swarm: unknown key 'ack_timout_ms'"},
+        BadSystem{"swarm_robot_of_no_kernel", std::string(kFleet) + "    robots: [r1, nobody]\n",
+                  ".yaml:4: swarm.robots: no kernel named 'nobody' in the system"},
+        BadSystem{"swarm_bow_tie_obstacle",
+                  std::string(kFleet) +
+                      "    world:\n      static:\n        - [[0, 0], [1, 1], [0, 1], [1, 0]]\n",
+                  ".yaml:6:11: world.static[0]: polygon is self-intersecting"}),
     [](const ::testing::TestParamInfo<BadSystem>& param) { return param.param.name; });
 
 }  // namespace

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "oscar/coordinator/swarm_service.hpp"
+#include "oscar/coordinator/swarm_setup.hpp"
 
 namespace oscar::coordinator {
 namespace {

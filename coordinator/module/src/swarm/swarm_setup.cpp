@@ -3,7 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "oscar/coordinator/swarm_service.hpp"
+#include "oscar/coordinator/swarm_setup.hpp"
 #include "oscar/module_spec.hpp"
 #include "oscar/swarm/problem.hpp"
 
