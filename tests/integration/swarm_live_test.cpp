@@ -1,8 +1,10 @@
 // The live swarm (docs/swarm.md, "The live swarm") on a booted system: jobs submitted over DDS
 // are placed by the coordinator, proposed to robot_sim pilots, committed on their ACKs and done
 // by the robots at their place within their window; a NAK or a silent robot aborts that part and
-// the job goes elsewhere; a robot that breaks down gives its jobs to others; bad requests are
-// refused with the reason.
+// the job goes elsewhere; a robot that breaks down gives its jobs to others, a job set's within
+// the set or, if that cannot be, the whole set is aborted; bad requests are refused with the
+// reason.
+#include <algorithm>
 #include <cmath>
 #include <condition_variable>
 #include <filesystem>
@@ -29,8 +31,10 @@ namespace {
 using namespace std::chrono_literals;
 using ::testing::HasSubstr;
 
-// Five robots: r1 and r2 do as told; rn refuses everything; rs (a module of its own) answers
-// after the coordinator stopped waiting; rb (a module of its own) breaks down when told to.
+// Nine robots: r1 and r2 do as told; rn refuses everything; rs (a module of its own) answers
+// after the coordinator stopped waiting; rb (a module of its own) breaks down when told to. Out
+// of reach of the other tests' jobs, for job sets of robots that break down: rb2 with r3 next to
+// it, rb3 with r4 29 m away.
 constexpr const char* kSystem = R"(
 system: swarm_live
 modules:
@@ -42,6 +46,10 @@ modules:
           mode: { single_step: { trigger: module } } }
       - { type: robot_sim, name: rn, params: { start_x: 20, start_y: 0, max_speed: 2, nak_probability: 1 },
           mode: { single_step: { trigger: module } } }
+      - { type: robot_sim, name: r3, params: { start_x: 304, start_y: 0, max_speed: 2 },
+          mode: { single_step: { trigger: module } } }
+      - { type: robot_sim, name: r4, params: { start_x: 340, start_y: 30, max_speed: 2 },
+          mode: { single_step: { trigger: module } } }
   - name: slow
     mode: { continuous: 50ms }
     kernels:
@@ -50,11 +58,16 @@ modules:
     mode: { continuous: 50ms }
     kernels:
       - { type: robot_sim, name: rb, params: { start_x: 40, start_y: 0, max_speed: 2 } }
+      - { type: robot_sim, name: rb2, params: { start_x: 300, start_y: 0, max_speed: 2 },
+          mode: { single_step: { trigger: module } } }
+      - { type: robot_sim, name: rb3, params: { start_x: 340, start_y: 0, max_speed: 2 },
+          mode: { single_step: { trigger: module } } }
   - name: monitor
     mode: { continuous: 50ms }
     kernels:
       - { type: safety_monitor, name: safety,
-          inputs: { r1: r1/state, r2: r2/state, rn: rn/state, rs: rs/state, rb: rb/state } }
+          inputs: { r1: r1/state, r2: r2/state, rn: rn/state, rs: rs/state, rb: rb/state,
+                    r3: r3/state, r4: r4/state, rb2: rb2/state, rb3: rb3/state } }
 coordinator:
   swarm:
     frozen_horizon_ms: 1500
@@ -74,6 +87,22 @@ SwarmJobSpec job(const std::string& id, double x, double y, double from_s, doubl
   j.latest_finish_ns(now + static_cast<Stamp>(to_s * 1e9));
   j.duration_s(duration_s);
   return j;
+}
+
+// A dependent set: job `b` waits for job `a`.
+SwarmRequest a_then_b(const SwarmJobSpec& a, const SwarmJobSpec& b) {
+  SwarmRequest r;
+  r.kind(SWARM_DEPENDENT);
+  r.jobs({a, b});
+  SwarmDependency d;
+  d.job(b.id());
+  d.after({a.id()});
+  r.depends().push_back(d);
+  return r;
+}
+
+Stamp end_ns(const SwarmPlacedJob& j) {
+  return j.start_ns() + static_cast<Stamp>(j.duration_s() * 1e9);
 }
 
 class LiveSwarm : public ::testing::Test {
@@ -192,6 +221,26 @@ class LiveSwarm : public ::testing::Test {
     }
   }
 
+  // Waits until the robot standing at (x, y) is in planning and the coordinator reaches it: its
+  // first command to a module may time out while the module's command channel is discovered
+  // (ConfigClient opens it on first use), and the job would go elsewhere. So a tiny job where
+  // the robot stands, due so soon that no other robot gets there, until it is committed.
+  static void ready(const std::string& robot, double x, double y) {
+    client_->status(
+        [&](const SwarmStatus& s) {
+          return std::find(s.robots().begin(), s.robots().end(), robot) != s.robots().end();
+        },
+        "the robot in planning");
+    std::string why;
+    for (int attempt = 0; attempt < 5; ++attempt) {
+      const auto id = robot + "_ready_" + std::to_string(attempt);
+      const auto r = client_->outcome(client_->schedule(job(id, x, y, 1.6, 2.4, 0.2)));
+      if (r.outcome() == SWARM_COMMITTED) return;
+      why = r.reason();
+    }
+    ADD_FAILURE() << "the coordinator never reached " << robot << ": " << why;
+  }
+
   // The committed jobs named `ids`, from the first status that lists them all.
   static std::vector<SwarmPlacedJob> jobs_named(const std::vector<std::string>& ids) {
     auto named = [&](const SwarmStatus& s) {
@@ -215,9 +264,9 @@ LiveSwarm::Client* LiveSwarm::client_ = nullptr;
 testing::CueWatch<SafetyViolation>* LiveSwarm::violations_ = nullptr;
 
 TEST_F(LiveSwarm, AllRobotsJoinPlanning) {
-  const auto s = client_->status([](const SwarmStatus& x) { return x.robots().size() == 5; },
-                                 "five robots in planning");
-  EXPECT_EQ(s.robots().size(), 5u);
+  const auto s = client_->status([](const SwarmStatus& x) { return x.robots().size() == 9; },
+                                 "nine robots in planning");
+  EXPECT_EQ(s.robots().size(), 9u);
 }
 
 TEST_F(LiveSwarm, AJobSubmittedOverDdsIsDoneByTheNearestRobotAtItsPlaceInItsWindow) {
@@ -312,15 +361,8 @@ TEST_F(LiveSwarm, ADependentSetStaysWholeWhenOneOfItsRobotsRefuses) {
   client_->status([](const SwarmStatus& x) { return x.robots().size() >= 4; }, "robots");
   // A is nearest rn (which refuses), B nearest r2: the first plan asks both, rn's NAK aborts the
   // whole set, and the set is planned again without rn.
-  SwarmRequest r;
-  r.kind(SWARM_DEPENDENT);
-  r.jobs().push_back(job("set_a", 21, -1, 3, 60, 2));
-  r.jobs().push_back(job("set_b", 1, 21, 3, 60, 2));
-  SwarmDependency d;
-  d.job("set_b");
-  d.after({"set_a"});
-  r.depends().push_back(d);
-  const auto id = client_->submit(r);
+  const auto id =
+      client_->submit(a_then_b(job("set_a", 21, -1, 3, 60, 2), job("set_b", 1, 21, 3, 60, 2)));
   const auto outcome = client_->outcome(id);
   ASSERT_EQ(outcome.outcome(), SWARM_COMMITTED) << outcome.reason();
   const auto replies = client_->replies(id);
@@ -333,16 +375,13 @@ TEST_F(LiveSwarm, ADependentSetStaysWholeWhenOneOfItsRobotsRefuses) {
   for (const auto& j : placed) EXPECT_NE(j.robot(), "rn") << j.id();
   const auto& a = placed[0].id() == "set_a" ? placed[0] : placed[1];
   const auto& b = placed[0].id() == "set_a" ? placed[1] : placed[0];
-  EXPECT_GE(b.start_ns(), a.start_ns() + static_cast<Stamp>(a.duration_s() * 1e9));
+  EXPECT_GE(b.start_ns(), end_ns(a));
 }
 
 // True if two placed jobs are at least `clearance` apart or do not overlap in time.
 bool clear_of(const SwarmPlacedJob& a, const SwarmPlacedJob& b, double clearance) {
-  const auto end = [](const SwarmPlacedJob& j) {
-    return j.start_ns() + static_cast<Stamp>(j.duration_s() * 1e9);
-  };
-  return std::hypot(a.x() - b.x(), a.y() - b.y()) >= clearance || end(a) <= b.start_ns() ||
-         end(b) <= a.start_ns();
+  return std::hypot(a.x() - b.x(), a.y() - b.y()) >= clearance || end_ns(a) <= b.start_ns() ||
+         end_ns(b) <= a.start_ns();
 }
 
 TEST_F(LiveSwarm, ConcurrentSubmissionsSeeEachOthersOpenTransactions) {
@@ -428,6 +467,92 @@ TEST(SwarmSnapshot, WithoutACoordinatorItSaysSoAndExits2) {
   EXPECT_EQ(s.exit_code, 2);
   EXPECT_THAT(s.output, HasSubstr("no coordinator published a swarm plan on domain"));
   EXPECT_TRUE(s.svg.empty());
+}
+
+// The placed job named `id` of a reply.
+const SwarmPlacedJob* placed_job(const SwarmReply& r, const std::string& id) {
+  for (const auto& j : r.jobs()) {
+    if (j.id() == id) return &j;
+  }
+  return nullptr;
+}
+
+TEST_F(LiveSwarm, ADependentSetKeepsItsOrderWhenOneOfItsRobotsBreaksDown) {
+  ready("rb2", 300, 0);
+  ready("r3", 304, 0);
+  // order_a goes to rb2 next to it, order_b (which waits for it) to r3; rb2 breaks down before
+  // order_a starts. Alone in its window order_a would go to r3 after order_b (the least detour);
+  // within its set it must end before order_b starts: r3 does it first.
+  const auto id = client_->submit(
+      a_then_b(job("order_a", 301, 1, 8, 60, 2), job("order_b", 304, 1, 14, 60, 2)));
+  const auto first = client_->outcome(id);
+  ASSERT_EQ(first.outcome(), SWARM_COMMITTED) << first.reason();
+  const auto* b = placed_job(first, "order_b");
+  ASSERT_TRUE(placed_job(first, "order_a") && b);
+  ASSERT_EQ(placed_job(first, "order_a")->robot(), "rb2");
+  ASSERT_EQ(b->robot(), "r3");
+  ASSERT_TRUE(system_->configure("fragile", CMD_SET_PARAM, {"rb2", "breakdown_after_s", "0"}).ok());
+  const auto again = client_->outcome(id, 1);
+  ASSERT_EQ(again.outcome(), SWARM_COMMITTED) << again.reason();
+  ASSERT_EQ(again.jobs().size(), 1u);
+  const auto& a = again.jobs()[0];
+  EXPECT_EQ(a.id(), "order_a");
+  EXPECT_EQ(a.robot(), "r3");
+  EXPECT_LE(end_ns(a), b->start_ns()) << "order_a ends after order_b, which waits for it, starts";
+  // It is still a member of its set: not unscheduled alone.
+  SwarmRequest alone;
+  alone.kind(SWARM_UNSCHEDULE);
+  alone.job_id("order_a");
+  const auto refused = client_->outcome(client_->submit(alone));
+  EXPECT_EQ(refused.outcome(), SWARM_REFUSED);
+  EXPECT_NE(refused.reason().find("belongs to the dependent set order_a, order_b"),
+            std::string::npos)
+      << refused.reason();
+  // And r3 works them in that order.
+  const auto doing_a = working("r3", "order_a", 30s);
+  ASSERT_TRUE(doing_a) << "r3 never worked order_a";
+  EXPECT_LE(doing_a->header().stamps()[0], b->start_ns());
+  const auto doing_b = working("r3", "order_b", 30s);
+  ASSERT_TRUE(doing_b) << "r3 never worked order_b";
+  EXPECT_GE(doing_b->header().stamps()[0], end_ns(a));
+}
+
+TEST_F(LiveSwarm, ADependentSetThatCannotBeWholeAgainIsAbortedWhole) {
+  ready("rb3", 340, 0);
+  ready("r4", 340, 30);
+  // whole_a goes to rb3 next to it, whole_b (which waits for it) to r4, 29 m away. rb3 breaks
+  // down before whole_a starts, and no robot gets there in time to end it before whole_b starts:
+  // the set is aborted, and whole_b leaves r4's schedule.
+  const auto id = client_->submit(
+      a_then_b(job("whole_a", 341, 1, 6, 60, 2), job("whole_b", 341, 29, 10, 60, 2)));
+  const auto first = client_->outcome(id);
+  ASSERT_EQ(first.outcome(), SWARM_COMMITTED) << first.reason();
+  const auto* b = placed_job(first, "whole_b");
+  ASSERT_TRUE(placed_job(first, "whole_a") && b);
+  ASSERT_EQ(placed_job(first, "whole_a")->robot(), "rb3");
+  ASSERT_EQ(b->robot(), "r4");
+  const Stamp b_end = end_ns(*b);
+  ASSERT_TRUE(system_->configure("fragile", CMD_SET_PARAM, {"rb3", "breakdown_after_s", "0"}).ok());
+  const auto end = client_->outcome(id, 1);
+  EXPECT_EQ(end.outcome(), SWARM_ABORTED);
+  EXPECT_NE(end.reason().find("robot 'rb3' broke down and the dependent set whole_a, whole_b "
+                              "cannot be whole again"),
+            std::string::npos)
+      << end.reason();
+  EXPECT_NE(end.reason().find("members not started are unscheduled"), std::string::npos)
+      << end.reason();
+  const auto aborted_at = wall_now();
+  client_->status(
+      [&](const SwarmStatus& s) {
+        return s.now_ns() > aborted_at &&
+               std::none_of(s.jobs().begin(), s.jobs().end(), [](const SwarmPlacedJob& j) {
+                 return j.id() == "whole_a" || j.id() == "whole_b";
+               });
+      },
+      "no job of the set");
+  // r4 does not work whole_b when it was due.
+  const auto until_b_ended = std::chrono::seconds((b_end - wall_now()) / 1'000'000'000 + 1);
+  EXPECT_FALSE(working("r4", "whole_b", until_b_ended)) << "r4 worked whole_b all the same";
 }
 
 }  // namespace

@@ -198,6 +198,11 @@ void Scheduler::validate(const JobSpec& spec, bool allow_existing) const {
   if (!allow_existing && job_exists(spec.id)) {
     throw std::invalid_argument(what + ": id is already scheduled");
   }
+  if (!allow_existing && lost_.contains(spec.id)) {
+    throw std::invalid_argument(what +
+                                ": id is in use by a set member whose node broke down (it waits "
+                                "to be placed again within its set)");
+  }
   make_polygon(vertices(spec.area), what + " area");
   check_time(spec.earliest_start, what + " earliest_start");
   check_time(spec.latest_finish, what + " latest_finish");
@@ -248,7 +253,7 @@ void Scheduler::record(TransactionId tx, NodeState& n, double lo, double hi) {
 
 TransactionId Scheduler::open_transaction(bool atomic, std::string what) {
   const TransactionId id = next_transaction_++;
-  transactions_[id] = Transaction{{}, atomic, std::move(what)};
+  transactions_[id] = Transaction{{}, atomic, std::move(what), {}};
   return id;
 }
 
@@ -263,11 +268,25 @@ const Scheduler::JobSet* Scheduler::set_of(const std::string& job_id) const {
   return it == sets_.end() ? nullptr : it->second.get();
 }
 
-void Scheduler::keep_as_set(std::string what, const std::vector<Job>& jobs) {
-  auto set = std::make_shared<JobSet>();
-  set->what = std::move(what);
-  for (const auto& j : jobs) set->ids.push_back(j.id);
-  for (const auto& j : jobs) sets_[j.id] = set;
+void Scheduler::keep_as_set(JobSet set, const std::vector<Job>& jobs) {
+  set.ids.clear();
+  for (const auto& j : jobs) set.ids.push_back(j.id);
+  const auto kept = std::make_shared<const JobSet>(std::move(set));
+  for (const auto& j : jobs) sets_[j.id] = kept;
+}
+
+std::string Scheduler::set_name(const std::string& job_id) const {
+  const JobSet* set = set_of(job_id);
+  return set ? set->what : "";
+}
+
+const Job* Scheduler::working_job(const std::string& id) const {
+  for (const auto& n : nodes_) {
+    for (const auto& j : n->working_jobs) {
+      if (j.id == id) return &j;
+    }
+  }
+  return nullptr;
 }
 
 void Scheduler::finish(TransactionId tx, const std::string& node, bool commit) {
@@ -302,6 +321,7 @@ void Scheduler::finish(TransactionId tx, const std::string& node, bool commit) {
         for (const auto& j : n.working_jobs) {
           if (j.id == id) n.committed_jobs.push_back(j);
         }
+        lost_.erase(id);  // a lost set member placed again
       }
       std::sort(n.committed_jobs.begin(), n.committed_jobs.end(), by_start);
     } else {
@@ -313,16 +333,24 @@ void Scheduler::finish(TransactionId tx, const std::string& node, bool commit) {
       std::sort(n.working_jobs.begin(), n.working_jobs.end(), by_start);
     }
     std::erase_if(n.locks, [&](const NodeState::Lock& l) { return l.tx == tx; });
-    // A job's set membership ends with the job.
+    // A job's set membership ends with the job (a lost member's when its set gives it up).
     for (const auto& id : ch.added) {
-      if (!job_exists(id)) sets_.erase(id);
+      if (!job_exists(id) && !lost_.contains(id)) sets_.erase(id);
     }
     for (const auto& r : ch.removed) {
-      if (!job_exists(r.id)) sets_.erase(r.id);
+      if (!job_exists(r.id) && !lost_.contains(r.id)) sets_.erase(r.id);
     }
     c = changes.erase(c);
   }
-  if (changes.empty() || node.empty()) transactions_.erase(it);
+  if (changes.empty() || node.empty()) {
+    if (commit) {
+      for (const auto& id : it->second.lost_given_up) {
+        lost_.erase(id);
+        sets_.erase(id);
+      }
+    }
+    transactions_.erase(it);
+  }
 }
 
 void Scheduler::remove_node(const std::string& id) {
@@ -365,7 +393,7 @@ std::vector<Job> Scheduler::break_down(const std::string& id, double t, const Po
   }
   for (const auto& j : lost) {
     std::erase_if(n.committed_jobs, [&](const Job& k) { return k.id == j.id; });
-    sets_.erase(j.id);
+    if (set_of(j.id)) lost_.emplace(j.id, j);  // stays in its set until placed again or given up
   }
   const Trajectory standing({{where.x(), where.y(), t}});
   n.committed = n.committed.spliced(standing, t, kForever);

@@ -322,7 +322,12 @@ ScheduleResult Scheduler::unschedule_set(const std::string& member_id) {
         return std::any_of(n->working_jobs.begin(), n->working_jobs.end(),
                            [&](const Job& j) { return j.id == id && j.start >= t_fh; });
       });
-      if (job == nodes_.end()) continue;  // started already, or gone with a removed node
+      if (job == nodes_.end()) {  // started already, gone with a removed node, or lost
+        if (lost_.contains(id) && !job_exists(id)) {
+          transactions_.at(tx).lost_given_up.push_back(id);
+        }
+        continue;
+      }
       if (!try_unschedule(id, tx, true, result.reason)) {
         abort(tx);
         return result;

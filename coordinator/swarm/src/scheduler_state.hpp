@@ -37,12 +37,17 @@ struct Scheduler::Transaction {
   std::map<std::string, Change> changes;  // by node id
   bool atomic = false;
   std::string what;  // for messages: "periodic set P1, P2"
+  // unschedule_set: members a broken-down node lost that leave their set when this commits
+  std::vector<std::string> lost_given_up;
 };
 
 // A periodic or dependent set (§4.2.3, §4.2.4): its members are unscheduled together or not at all.
+// What ties them together is kept, so a member a broken-down node lost is placed again within it.
 struct Scheduler::JobSet {
   std::string what;  // "periodic set P1, P2, P3"
-  std::vector<std::string> ids;
+  std::vector<std::string> ids = {};
+  std::map<std::string, std::vector<std::string>> depends = {};  // dependent: what each waits for
+  bool same_location = false;  // periodic set: every repetition at one place
 };
 
 // Precision limit of seed §5.3.1: doubles keep ~0.1 ns resolution up to this many seconds.

@@ -2,6 +2,7 @@
 // scheduling, nodes are removed only when done, locations are sampled from the free area (A.1).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -185,6 +186,125 @@ TEST(Nodes, ABrokenDownNodeGivesUpItsJobsAndStaysAnObstacle) {
               50, 100, 1});
   EXPECT_FALSE(on_top.ok);
   expect_error([&] { s.break_down(node, 3, where); }, "broke down already");
+}
+
+// A broken-down node's set members are placed again within their set (schedule_lost). Job A
+// (20 s, from 10) at (2, 0) goes to n1 next to it and B (5 s, waits for A) next to n2 at
+// (0, 10); n3 at (5, 0) is busy with X until 45, n4 at (0, y4) is free. n1 breaks down at 1,
+// before A starts.
+struct BrokenSetMember {
+  Scheduler s{{}, {}};
+  ScheduleResult set;
+  std::vector<Job> lost;
+  explicit BrokenSetMember(double y4) {
+    s.add_node({"n1", 0.1, 1, 0, 0, 0, 0});
+    s.add_node({"n2", 0.1, 1, 0, 10, 0, 0});
+    s.add_node({"n3", 0.1, 1, 5, 0, 0, 0});
+    s.add_node({"n4", 0.1, 1, 0, y4, 0, 0});
+    const auto x = s.schedule(JobSpec{"X", square(4.9, -0.1, 5.1, 0.1), 0, 45, 45});
+    EXPECT_TRUE(x.ok) << x.reason;
+    s.commit(x.transaction);
+    set = s.schedule(DependentSpec{{{"A", square(1.9, -0.1, 2.1, 0.1), 10, 100, 20},
+                                    {"B", square(0.5, 9.5, 1.5, 10.5), 0, 100, 5}},
+                                   {{"B", {"A"}}}});
+    EXPECT_TRUE(set.ok) << set.reason;
+    EXPECT_EQ(set.jobs[0].node, "n1");
+    EXPECT_EQ(set.jobs[1].node, "n2");
+    s.commit(set.transaction);
+    s.set_present(1);
+    lost = s.break_down("n1", 1, s.trajectory("n1").position_at(1));
+    EXPECT_EQ(lost.size(), 1u);
+  }
+  std::vector<std::string> job_ids() const {
+    std::vector<std::string> ids;
+    for (const auto& n : s.node_ids()) {
+      for (const auto& j : s.jobs(n)) ids.push_back(j.id);
+    }
+    std::sort(ids.begin(), ids.end());
+    return ids;
+  }
+};
+
+TEST(JobSets, ABrokenDownNodesDependentMemberIsPlacedAgainBeforeWhatWaitsForIt) {
+  BrokenSetMember w(-8);
+  const double b_start = w.set.jobs[1].start;
+  // A stays in its set, lost. Alone in its window it would take the least detour, n3 after X,
+  // and end after B has started; within its set it must end by B's start: n4 from afar.
+  EXPECT_EQ(w.s.set_name("A"), "dependent set A, B");
+  expect_error(
+      [&] {
+        w.s.schedule(JobSpec{"A", square(-1, -1, 1, 1), 50, 100, 1});
+      },
+      "waits to be placed again");
+  const auto first = w.s.schedule_lost("A");
+  ASSERT_TRUE(first.ok) << first.reason;
+  w.s.abort(first.transaction);  // e.g. a robot refused: A is still lost and goes again
+  const auto again = w.s.schedule_lost("B");
+  ASSERT_TRUE(again.ok) << again.reason;
+  ASSERT_EQ(again.jobs.size(), 1u);
+  const Job& a = again.jobs[0];
+  EXPECT_EQ(a.id, "A");
+  EXPECT_EQ(a.node, "n4");
+  EXPECT_LE(a.end(), b_start + 1e-9) << "A ends after B, which waits for it, has started";
+  EXPECT_EQ(a.spec.latest_finish, w.lost[0].spec.latest_finish);  // the window it was placed in
+  w.s.commit(again.transaction);
+  expect_error([&] { w.s.schedule_lost("A"); }, "has no lost member to place again");
+  // A is a member as before: not unscheduled alone, but with its set.
+  const auto alone = w.s.unschedule("A");
+  EXPECT_FALSE(alone.ok);
+  EXPECT_NE(alone.reason.find("belongs to the dependent set A, B"), std::string::npos)
+      << alone.reason;
+  const auto gone = w.s.unschedule_set("A");
+  ASSERT_TRUE(gone.ok) << gone.reason;
+  w.s.commit(gone.transaction);
+  EXPECT_EQ(w.job_ids(), std::vector<std::string>{"X"});
+}
+
+TEST(JobSets, ASetThatCannotBeWholeAgainStaysAsItWasUntilItIsGivenUp) {
+  // n4 is 20 m out: A must end by B's start, and only n1 could have made it in time.
+  BrokenSetMember w(-20);
+  const auto again = w.s.schedule_lost("A");
+  EXPECT_FALSE(again.ok);
+  EXPECT_EQ(again.reason.rfind("job 'A': ", 0), 0u) << again.reason;
+  EXPECT_TRUE(w.s.open_transactions().empty());
+  EXPECT_EQ(w.job_ids(), (std::vector<std::string>{"B", "X"}));
+  EXPECT_EQ(w.s.set_name("A"), "dependent set A, B");
+  // Given up: B leaves n2's schedule and A its set; both ids are free again.
+  const auto gone = w.s.unschedule_set("A");
+  ASSERT_TRUE(gone.ok) << gone.reason;
+  EXPECT_EQ(w.s.set_name("A"), "dependent set A, B") << "given up only on commit";
+  w.s.commit(gone.transaction);
+  EXPECT_EQ(w.job_ids(), std::vector<std::string>{"X"});
+  EXPECT_EQ(w.s.set_name("A"), "");
+  EXPECT_EQ(w.s.set_name("B"), "");
+  const auto single = w.s.schedule(JobSpec{"A", square(-1, 2, 1, 4), 50, 100, 1});
+  EXPECT_TRUE(single.ok) << single.reason;
+}
+
+TEST(JobSets, ABrokenDownNodesPeriodicMembersArePlacedAgainInTheirRepetitionsAtTheSetsPlace) {
+  Scheduler s = two_nodes();
+  const auto set =
+      s.schedule(PeriodicSpec{{"P0", "P1", "P2"}, square(2, -1, 4, 1), true, 0, 20, 2});
+  ASSERT_TRUE(set.ok) << set.reason;
+  s.commit(set.transaction);
+  const std::string node = set.jobs[0].node;
+  const auto lost = s.break_down(node, 1, s.trajectory(node).position_at(1));
+  ASSERT_FALSE(lost.empty());
+  const auto again = s.schedule_lost(lost[0].id);
+  ASSERT_TRUE(again.ok) << again.reason;
+  ASSERT_EQ(again.jobs.size(), lost.size());
+  for (const auto& j : again.jobs) {
+    const double i = j.id == "P0" ? 0 : j.id == "P1" ? 1 : 2;
+    EXPECT_NE(j.node, node);
+    EXPECT_TRUE(near(j.location(), set.jobs[0].x, set.jobs[0].y)) << j.id << " not at the set's";
+    EXPECT_GE(j.start, i * 20 - 1e-9) << j.id;
+    EXPECT_LE(j.end(), (i + 1) * 20 + 1e-9) << j.id;
+  }
+  s.commit(again.transaction);
+  const auto alone = s.unschedule(lost[0].id);
+  EXPECT_FALSE(alone.ok);
+  EXPECT_NE(alone.reason.find("belongs to the periodic set P0, P1, P2"), std::string::npos)
+      << alone.reason;
 }
 
 TEST(Transactions, ChangesNameTheSectionsAndJobsPerNode) {

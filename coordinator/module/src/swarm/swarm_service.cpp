@@ -1,9 +1,11 @@
 #include "oscar/coordinator/swarm_service.hpp"
 
+#include <algorithm>
 #include <condition_variable>
 #include <deque>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -30,6 +32,16 @@ struct SwarmService::Impl {
     SwarmRequest message;
     int attempts = 0;
     std::set<std::string> refused_by;
+    // Set by lose(): instead of the message, the request places again the members of a job set
+    // that a broken-down robot lost (any one of them names the set).
+    struct LostMembers {
+      std::string member;
+      std::string robot;
+    };
+    std::optional<LostMembers> lost;
+    // Set by end_set(): the message unschedules a set that cannot be whole again, and its
+    // requester hears ABORTED for this reason.
+    std::string ends_set_because;
   };
   // A transaction waiting for its robots' answers.
   struct Pending {
@@ -170,8 +182,16 @@ struct SwarmService::Impl {
 
   // ---- requests ----
 
-  void reply(const Request& r, SwarmOutcome outcome, TransactionId tx, const std::string& reason,
+  void reply(const Request& r, SwarmOutcome outcome, TransactionId tx, std::string reason,
              const std::vector<swarm::Job>& jobs = {}) {
+    if (!r.ends_set_because.empty()) {  // the set's requester hears of its end, not of the means
+      if (outcome == SWARM_PLANNED) return;
+      reason = outcome == SWARM_COMMITTED
+                   ? r.ends_set_because + "; its members not started are unscheduled"
+                   : fmt::format("{}; its members not started could not be unscheduled: {}",
+                                 r.ends_set_because, reason);
+      outcome = SWARM_ABORTED;
+    }
     SwarmReply m;
     m.sender(r.message.sender());
     m.request(r.message.id());
@@ -199,7 +219,8 @@ struct SwarmService::Impl {
     swarm::ScheduleResult result;
     scheduler.set_excluded(r->refused_by);
     try {
-      result = swarm_wire::apply(scheduler, r->message, clock);
+      result = r->lost ? scheduler.schedule_lost(r->lost->member)
+                       : swarm_wire::apply(scheduler, r->message, clock);
     } catch (const std::invalid_argument& e) {
       scheduler.set_excluded({});
       reply(*r, SWARM_REFUSED, 0, e.what());
@@ -207,10 +228,10 @@ struct SwarmService::Impl {
     }
     scheduler.set_excluded({});
     if (!result.ok) {
-      reply(*r, r->attempts == 0 ? SWARM_REFUSED : SWARM_ABORTED, 0,
-            r->attempts == 0 ? result.reason
-                             : fmt::format("planned {} times, robots refused: {}", r->attempts + 1,
-                                           result.reason));
+      give_up(*r, r->attempts == 0 ? SWARM_REFUSED : SWARM_ABORTED, 0,
+              r->attempts == 0 ? result.reason
+                               : fmt::format("planned {} times, robots refused: {}",
+                                             r->attempts + 1, result.reason));
       return;
     }
     const TransactionId tx = result.transaction;
@@ -259,9 +280,9 @@ struct SwarmService::Impl {
     auto& r = failed.request;
     r->refused_by.insert(a.robot);
     if (r->attempts >= setup.replan_attempts) {
-      reply(*r, SWARM_ABORTED, a.transaction,
-            fmt::format("robot '{}' {}: {} (planned {} times)", a.robot,
-                        a.silent ? "did not answer" : "refused", a.reason, r->attempts + 1));
+      give_up(*r, SWARM_ABORTED, a.transaction,
+              fmt::format("robot '{}' {}: {} (planned {} times)", a.robot,
+                          a.silent ? "did not answer" : "refused", a.reason, r->attempts + 1));
       return;
     }
     ++r->attempts;
@@ -336,6 +357,17 @@ struct SwarmService::Impl {
     for (const auto& j : jobs) {
       auto from = origin.find(j.id);
       if (from == origin.end()) continue;
+      if (const std::string set = scheduler.set_name(j.id); !set.empty()) {
+        // A set member: the set's lost members are placed again together, within the set.
+        if (!handles_set(again, set)) {
+          auto r = std::make_shared<Request>(*from->second);
+          r->attempts = 0;
+          r->lost = Request::LostMembers{j.id, id};
+          again.push_back(r);
+        }
+        origin.erase(from);
+        continue;
+      }
       // The job alone, in its original window: what is left of it is planned again.
       auto r = std::make_shared<Request>(*from->second);
       r->message.kind(SWARM_SCHEDULE);
@@ -358,6 +390,43 @@ struct SwarmService::Impl {
       counters.replans(counters.replans() + 1);
       plan(r);
     }
+  }
+
+  // True if one of `planned` places the lost members of `set` again or ends the set.
+  bool handles_set(const std::vector<std::shared_ptr<Request>>& planned,
+                   const std::string& set) const {
+    return std::any_of(planned.begin(), planned.end(), [&](const auto& r) {
+      const std::string member = r->lost                       ? r->lost->member
+                                 : r->ends_set_because.empty() ? std::string()
+                                                               : r->message.job_id();
+      return !member.empty() && scheduler.set_name(member) == set;
+    });
+  }
+
+  // A request that cannot be planned (any more): its requester hears why; a set that a
+  // broken-down robot left short and that cannot be whole again ends.
+  void give_up(const Request& r, SwarmOutcome outcome, TransactionId tx,
+               const std::string& reason) {
+    if (r.lost) {
+      end_set(r, reason);
+    } else {
+      reply(r, outcome, tx, reason);
+    }
+  }
+
+  // All or nothing for a set whose lost members cannot be placed again: its members not started
+  // are unscheduled (a transaction the robots holding them are asked for, as any), and then its
+  // requester hears ABORTED, naming the robot and the set.
+  void end_set(const Request& r, const std::string& why) {
+    auto end = std::make_shared<Request>();
+    end->message = r.message;
+    end->message.kind(SWARM_UNSCHEDULE_SET);
+    end->message.job_id(r.lost->member);
+    end->ends_set_because =
+        fmt::format("robot '{}' broke down and the {} cannot be whole again: {}", r.lost->robot,
+                    scheduler.set_name(r.lost->member), why);
+    spdlog::warn("swarm: {}", end->ends_set_because);
+    plan(end);
   }
 
   // What ended more than a minute ago is history: the planner and the origins forget it.

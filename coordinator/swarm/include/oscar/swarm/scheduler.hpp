@@ -90,9 +90,24 @@ class Scheduler {
   /// @throws std::invalid_argument on an unknown id.
   ScheduleResult unschedule(const std::string& job_id);
   /// Unschedules the members of the set `member_id` belongs to that start after the frozen
-  /// horizon, in one atomic transaction; members already started stay (§4.2.5 for a set).
+  /// horizon, in one atomic transaction; members already started stay (§4.2.5 for a set). Members
+  /// a broken-down node lost (see break_down) leave the set when the transaction commits.
   /// @throws std::invalid_argument on an unknown id or a job that belongs to no set.
   ScheduleResult unschedule_set(const std::string& member_id);
+  /// Places again, in one atomic transaction, the members of the set `member_id` belongs to that
+  /// a broken-down node lost (those no open transaction places already), so that the set keeps
+  /// its guarantee with its other members as they are placed now: a dependent member within its
+  /// implicit window given their starts (eq. 4.10/4.11: after the members it waits for have ended,
+  /// before those waiting for it start, margin included), a periodic one within its repetition's
+  /// window and, for a same-location set, at the set's place; dependencies first, the earliest
+  /// implicit deadline first (A.3). Once committed they are members as before. All or nothing: on
+  /// failure the reason names the member that fits nowhere, the schedule is unchanged and the
+  /// members stay lost (give the set up with unschedule_set).
+  /// @throws std::invalid_argument on an id of no set, or a set with no lost member to place.
+  ScheduleResult schedule_lost(const std::string& member_id);
+  /// The set a job belongs to, as messages name it ("dependent set A, B"); empty for a job of no
+  /// set or an unknown id.
+  std::string set_name(const std::string& job_id) const;
   /// Removes a job without re-planning (§4.2.5).
   /// @throws std::invalid_argument on an unknown id.
   ScheduleResult remove_job(const std::string& job_id);
@@ -122,8 +137,10 @@ class Scheduler {
   void remove_node(const std::string& id);
   /// A node that broke down at time `t` at `where` (beyond seed §4.1, whose robots never fail):
   /// it stands there for good and takes no more jobs, but stays an obstacle to the others. Its
-  /// jobs that do not end by `t` are removed and returned, to be scheduled elsewhere; their set
-  /// memberships end.
+  /// jobs that do not end by `t` are removed and returned, to be scheduled elsewhere: a single job
+  /// with schedule, a member of a periodic or dependent set with schedule_lost. Such a member
+  /// stays in its set, lost, until schedule_lost places it again or unschedule_set gives the set
+  /// up; meanwhile its id stays in use.
   /// @throws std::invalid_argument on an unknown node, one already broken down, `t` before the
   /// present, or an open transaction that changes the node (abort it first).
   std::vector<Job> break_down(const std::string& id, double t, const Point& where);
@@ -183,7 +200,12 @@ class Scheduler {
   const NodeState& state(const std::string& id) const;
   TransactionId open_transaction(bool atomic = false, std::string what = "");
   const JobSet* set_of(const std::string& job_id) const;
-  void keep_as_set(std::string what, const std::vector<Job>& jobs);
+  void keep_as_set(JobSet set, const std::vector<Job>& jobs);
+  const Job* working_job(const std::string& id) const;
+  bool place_dependent(const std::vector<JobSpec>& jobs,
+                       const std::map<std::string, std::vector<std::string>>& depends,
+                       std::map<std::string, double> placed, const std::optional<Point>& at,
+                       TransactionId tx, ScheduleResult& result);
   bool try_schedule(const JobSpec& spec, TransactionId tx, const std::optional<Point>& at,
                     std::string& reason, Job& scheduled);
   bool try_candidate(const Slot& c, const JobSpec& spec, TransactionId tx, Job& scheduled);
@@ -208,6 +230,7 @@ class Scheduler {
   mutable std::map<std::pair<double, double>, std::unique_ptr<DubinsPathFinder>> dubins_finders_;
   std::map<TransactionId, Transaction> transactions_;
   std::map<std::string, std::shared_ptr<const JobSet>> sets_;  // by member job id
+  std::map<std::string, Job> lost_;  // set members of broken-down nodes, as they were, by id
   std::set<std::string> excluded_;
   TransactionId next_transaction_ = 1;
 };
