@@ -92,6 +92,8 @@ struct Submitted {
   Clock::time_point at;
   SwarmJobSpec spec;
   std::optional<double> commit_ms;
+  bool final_outcome = false;  // COMMITTED, REFUSED or ABORTED came
+  bool planned = false;        // PLANNED came
   bool done = false, done_in_window = true;
 };
 
@@ -122,8 +124,13 @@ nlohmann::json run_live(int robots, double seconds, double rate) {
         std::lock_guard lock(mutex);
         auto it = jobs.find(r.request());
         if (r.sender() != sender || it == jobs.end()) return;
+        if (r.outcome() == SWARM_PLANNED) it->second.planned = true;
+        if (r.outcome() != SWARM_PLANNED) it->second.final_outcome = true;
         if (r.outcome() == SWARM_REFUSED || r.outcome() == SWARM_ABORTED) {
           const auto colon = r.reason().find(": ");  // the reason without the job's id
+          fmt::print(stderr, "request {} ({} at {:.1f}, {:.1f}): {}\n", r.request(),
+                     it->second.spec.id(), it->second.spec.area().x()[0] + 0.5,
+                     it->second.spec.area().y()[0] + 0.5, r.reason());
           ++not_committed[colon == std::string::npos ? r.reason() : r.reason().substr(colon + 2)];
         }
         if (r.outcome() == SWARM_COMMITTED && !it->second.commit_ms) {
@@ -229,7 +236,11 @@ nlohmann::json run_live(int robots, double seconds, double rate) {
   std::lock_guard lock(mutex);
   std::vector<double> latencies;
   int committed = 0, done_in_window = 0;
+  std::vector<std::string> unanswered;  // requests without a final outcome, and what came
   for (const auto& [rid, j] : jobs) {
+    if (!j.final_outcome) {
+      unanswered.push_back(fmt::format("{} ({})", rid, j.planned ? "planned" : "no reply"));
+    }
     if (j.commit_ms) {
       ++committed;
       latencies.push_back(*j.commit_ms);
@@ -250,6 +261,7 @@ nlohmann::json run_live(int robots, double seconds, double rate) {
           {"replans", last.replans()},
           {"timeouts", last.timeouts()},
           {"not_committed", not_committed},
+          {"unanswered", unanswered},
           {"coordinator_cpu_percent",
            cpu0 < 0 || cpu1 < 0 ? -1.0 : 100 * (cpu1 - cpu0) / busy_seconds}};
 }
