@@ -22,6 +22,11 @@ class ConfigClient {
   ConfigClient(DdsParticipant& participant, std::string sender);
   ~ConfigClient();
 
+  /// Opens the channel to `module` now: its endpoints find the module's in the background, so
+  /// the first command does not wait for discovery (a caller with a short timeout, such as the
+  /// coordinator's proposals to robots, opens its channels when it starts).
+  void connect(const std::string& module);
+
   /// Sends a command and waits for the module's reply.
   /// @throws std::runtime_error "no module named 'x' is running" if no module reads
   ///         oscar/config/<module> within `timeout`, or if the reply does not come in time.

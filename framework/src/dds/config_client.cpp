@@ -59,6 +59,11 @@ ConfigClient::Channel& ConfigClient::channel(const std::string& module) {
   return *(channels_[module] = std::move(c));
 }
 
+void ConfigClient::connect(const std::string& module) {
+  std::lock_guard lock(mutex_);
+  channel(module);
+}
+
 ConfigReply ConfigClient::send(const std::string& module, CommandKind kind,
                                std::vector<std::string> args, std::chrono::milliseconds timeout) {
   ConfigCommand cmd;

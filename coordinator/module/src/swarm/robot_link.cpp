@@ -12,7 +12,9 @@ RobotLink::RobotLink(ConfigClient& client, std::string module, std::chrono::mill
       module_(std::move(module)),
       timeout_(timeout),
       on_answer_(std::move(on_answer)),
-      thread_([this] { run(); }) {}
+      thread_([this] { run(); }) {
+  client_.connect(module_);  // discovered by the first proposal, which has only the ACK timeout
+}
 
 RobotLink::~RobotLink() {
   {
