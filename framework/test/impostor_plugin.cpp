@@ -2,6 +2,8 @@
 // what the retired sequencer did, configuring another module under the coordinator's name from a
 // DDS participant of its own inside its module's process. Each cycle it asks `target` to activate
 // all its kernels and logs the module's verdict ("impostor: accepted" or "impostor: refused: ...").
+// With `ask: shutdown` it asks the registry to shut the system down instead, under the name it
+// claims (the registry's verdict is in its own log).
 #include <memory>
 #include <string>
 
@@ -10,6 +12,8 @@
 #include "oscar/kernel.hpp"
 #include "oscar/kernel_registry.hpp"
 #include "oscar/network.hpp"
+#include "oscar/topic_io.hpp"
+#include "oscar/topics.hpp"
 
 namespace oscar::test {
 
@@ -18,9 +22,11 @@ class Impostor final : public Kernel {
   struct Params {
     std::string target;
     std::string claim = "coordinator";
+    std::string ask = "activate";
     void describe(ParamSpec& spec) {
       spec.field("target", target, "the module it tries to configure");
       spec.field("claim", claim, "the sender name it claims");
+      spec.field("ask", ask, "activate (the target) or shutdown (the system, of the registry)");
     }
   };
   explicit Impostor(KernelSetup& setup) { setup.params(params_); }
@@ -30,6 +36,17 @@ class Impostor final : public Kernel {
       // The domain oscar-run exports, the default network (loopback).
       participant_ = std::make_unique<DdsParticipant>(domain_from_env(0), "oscar-tool");
       client_ = std::make_unique<ConfigClient>(*participant_, params_.claim);
+      registry_ = std::make_unique<TopicWriter<RegistryRequest, RegistryRequestPubSubType>>(
+          *participant_, topics::registry_request());
+    }
+    if (params_.ask == "shutdown") {
+      RegistryRequest q;
+      q.id(++requests_);
+      q.sender(params_.claim);
+      q.kind(REG_SHUTDOWN);
+      registry_->write(q);
+      cycle.log().info("impostor: asked the registry to shut the system down");
+      return;
     }
     try {
       const auto reply = client_->send(params_.target, CMD_ACTIVATE, {"*"});
@@ -48,6 +65,8 @@ class Impostor final : public Kernel {
   Params params_;
   std::unique_ptr<DdsParticipant> participant_;
   std::unique_ptr<ConfigClient> client_;
+  std::unique_ptr<TopicWriter<RegistryRequest, RegistryRequestPubSubType>> registry_;
+  unsigned long long requests_ = 0;
 };
 
 }  // namespace oscar::test

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <stdexcept>
+
 namespace oscar {
 
 std::string shell_quote(const std::string& word) {
@@ -36,7 +39,7 @@ std::vector<std::string> on_host(const HostSpec& host, const std::vector<std::st
 }
 
 std::vector<std::string> module_command(const SystemSpec& system, const SystemModule& module,
-                                        unsigned incarnation, const std::string& oscar_run,
+                                        unsigned incarnation, const ProgramPath& program_path,
                                         const std::string& log_dir) {
   std::vector<std::string> argv;
   if (module.debug.gdbserver_port > 0) {
@@ -46,11 +49,31 @@ std::vector<std::string> module_command(const SystemSpec& system, const SystemMo
                                     incarnation)};
     argv.insert(argv.end(), module.debug.valgrind_args.begin(), module.debug.valgrind_args.end());
   }
-  // The monitor maps the program's bare name to its own copy next to it.
-  const auto& program = module.program == "oscar-run" ? oscar_run : module.program;
-  argv.insert(argv.end(), {program, system.file, "--module", module.spec.name, "--incarnation",
-                           std::to_string(incarnation), "--domain",
+  argv.insert(argv.end(), {program_path(module.program), system.file, "--module", module.spec.name,
+                           "--incarnation", std::to_string(incarnation), "--domain",
                            std::to_string(module.spec.domain.value_or(system.domain))});
+  return argv;
+}
+
+std::vector<std::string> launch_command(const SystemSpec& system, const std::string& host,
+                                        const std::string& module, unsigned incarnation,
+                                        const std::string& restore, const std::string& log_dir,
+                                        const ProgramPath& program_path) {
+  const auto found = std::find_if(system.modules.begin(), system.modules.end(),
+                                  [&](const SystemModule& m) { return m.spec.name == module; });
+  if (found == system.modules.end()) {
+    throw std::invalid_argument(fmt::format(
+        "refused to start '{}': {} has no module of that name (a monitor starts only the "
+        "modules of its system file)",
+        module, system.file));
+  }
+  if (found->spec.host != host) {
+    throw std::invalid_argument(
+        fmt::format("refused to start '{}': {} puts it on host '{}', this monitor watches '{}'",
+                    module, system.file, found->spec.host, host));
+  }
+  auto argv = module_command(system, *found, incarnation, program_path, log_dir);
+  if (!restore.empty()) argv.insert(argv.end(), {"--restore", restore});
   return argv;
 }
 

@@ -18,6 +18,7 @@
 
 #include "janitor.hpp"
 #include "oscar/process_util.hpp"
+#include "oscar/registry/launch_command.hpp"
 #include "oscar/registry/supervisor.hpp"
 #include "oscar/registry/system_spec.hpp"
 #include "oscar/topic_io.hpp"
@@ -109,15 +110,14 @@ int main(int argc, char** argv) {
       for (const auto& q : batch) {
         switch (q.kind()) {
           case oscar::LAUNCH_START: {
-            auto args = q.argv();
-            for (auto& a : args) {
-              // Only OSCAR's own programs, found next to the monitor.
-              if (a == "oscar-run" || a == "oscar-coordinator" || a == "oscar-applet") {
-                a = oscar::sibling_program(a);
-              }
-            }
             try {
-              const auto pid = supervisor.start(q.module_name(), q.incarnation(), args, q.env());
+              // The command comes from this monitor's own system file: a request names only the
+              // module, its incarnation and the configuration it restores.
+              const auto args =
+                  oscar::launch_command(system, host, q.module_name(), q.incarnation(), q.restore(),
+                                        log_dir, oscar::sibling_program);
+              const auto pid = supervisor.start(q.module_name(), q.incarnation(), args,
+                                                {"OSCAR_RUN_DIR=" + log_dir});
               spdlog::info("started {} (incarnation {}, pid {})", q.module_name(), q.incarnation(),
                            pid);
               events.write(event(host, q.module_name(), q.incarnation(), oscar::PROC_STARTED, pid));

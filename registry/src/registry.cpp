@@ -96,7 +96,7 @@ void Registry::on_monitor_beat(const MonitorBeat& beat) {
     if (m->launched_by == beat.pid()) {
       // The monitor was only slow: a failed module of it may still run. Kill it; the restart
       // follows its reported exit.
-      io_->send(LAUNCH_KILL, beat.host(), beat.pid(), m->spec->spec.name, m->incarnation, {}, {});
+      io_->send(LAUNCH_KILL, beat.host(), beat.pid(), m->spec->spec.name, m->incarnation);
     } else {
       m->process_gone = true;  // it died with its monitor (PR_SET_PDEATHSIG)
     }
@@ -235,7 +235,7 @@ void Registry::take_down(Tracked& m, bool process_gone) {
   if (m.has_state) m.config = m.state;  // what the next incarnation gets back
   publish();  // what happened is known now; suspending the others comes next
   if (!m.process_gone && mon.alive) {
-    io_->send(LAUNCH_KILL, m.spec->spec.host, mon.pid, m.spec->spec.name, m.incarnation, {}, {});
+    io_->send(LAUNCH_KILL, m.spec->spec.host, mon.pid, m.spec->spec.name, m.incarnation);
   }
   suspend_all();
 }
@@ -288,9 +288,23 @@ void Registry::fail(Tracked& m, const std::string& reason, bool process_gone) {
   publish();
 }
 
-void Registry::on_request(const RegistryRequest& r) {
+void Registry::on_request(const RegistryRequest& r, const std::vector<std::string>& writer) {
+  std::vector<std::string> origin;  // the modules of this system (not a test's own) among them
+  for (const auto& m : writer) {
+    if (find(m) && std::find(origin.begin(), origin.end(), m) == origin.end()) origin.push_back(m);
+  }
   std::string error;
-  if (r.kind() == REG_SHUTDOWN) {
+  if (!origin.empty()) {
+    // Without DDS Security the sender's name is a claim; the writer's process is not.
+    error = fmt::format(
+        "refused: '{}' may not {}: the request comes from the process of module '{}', and only "
+        "boot and operator tools (processes hosting no module of the system) may restart modules "
+        "or shut the system down",
+        r.sender(),
+        r.kind() == REG_SHUTDOWN ? "shut the system down" : "restart '" + r.module_name() + "'",
+        fmt::join(origin, "', '"));
+    spdlog::warn("registry: {}", error);
+  } else if (r.kind() == REG_SHUTDOWN) {
     shutting_down_ = true;
   } else if (auto* m = find(r.module_name()); !m) {
     std::vector<std::string> names;

@@ -29,10 +29,8 @@ void Registry::launch(Tracked& m, unsigned incarnation) {
   m.process_gone = false;
   m.has_state = false;
   m.held = false;
-  auto argv = module_command(system_, *m.spec, incarnation, "oscar-run", mon.log_dir);
-  if (m.config) argv.insert(argv.end(), {"--restore", restore_text(*m.config)});
-  io_->send(LAUNCH_START, host, mon.pid, m.spec->spec.name, incarnation, argv,
-            {"OSCAR_RUN_DIR=" + mon.log_dir});
+  io_->send(LAUNCH_START, host, mon.pid, m.spec->spec.name, incarnation,
+            m.config ? restore_text(*m.config) : std::string());
   spdlog::info("registry: starting '{}' on '{}' (incarnation {})", m.spec->spec.name, host,
                incarnation);
 }
@@ -205,7 +203,7 @@ void Registry::shutdown() {
     if (m.process_gone || m.incarnation == 0) continue;
     const auto& mon = monitors_[m.spec->spec.host];
     if (mon.alive)
-      io_->send(LAUNCH_STOP, m.spec->spec.host, mon.pid, m.spec->spec.name, m.incarnation, {}, {});
+      io_->send(LAUNCH_STOP, m.spec->spec.host, mon.pid, m.spec->spec.name, m.incarnation);
     // In order: wait for this one to end before stopping the next.
     const auto until = Clock::now() + std::chrono::seconds(6);
     std::unique_lock lock(mutex_);
@@ -216,7 +214,7 @@ void Registry::shutdown() {
     m.status = "stopped";
   }
   for (const auto& [host, mon] : monitors_) {
-    if (mon.alive) io_->send(LAUNCH_EXIT, host, mon.pid, "", 0, {}, {});
+    if (mon.alive) io_->send(LAUNCH_EXIT, host, mon.pid, "", 0);
   }
   set_system("stopped", "all modules stopped");
 }

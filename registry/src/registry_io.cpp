@@ -50,13 +50,16 @@ Registry::Io::Io(Registry& r)
             r_.post([this, module, incarnation] { r_.on_module_lost(module, incarnation); });
           }),
       requests_(r.participant_, topics::registry_request(),
-                [this](const RegistryRequest& q, const auto&) {
-                  r_.post([this, q] { r_.on_request(q); });
+                [this](const RegistryRequest& q, const auto& info) {
+                  // Where it really comes from: the modules living in the writer's process.
+                  auto origin =
+                      r_.participant_.modules_in_process_of(info.sample_identity.writer_guid());
+                  r_.post([this, q, origin] { r_.on_request(q, origin); });
                 }) {}
 
 void Registry::Io::send(LaunchKind kind, const std::string& host, long monitor_pid,
                         const std::string& module, unsigned incarnation,
-                        const std::vector<std::string>& argv, const std::vector<std::string>& env) {
+                        const std::string& restore) {
   LaunchRequest q;
   q.id(next_id_++);
   q.host(host);
@@ -64,8 +67,7 @@ void Registry::Io::send(LaunchKind kind, const std::string& host, long monitor_p
   q.kind(kind);
   q.module_name(module);
   q.incarnation(incarnation);
-  q.argv(argv);
-  q.env(env);
+  q.restore(restore);
   launch_.write(q);
 }
 

@@ -17,9 +17,9 @@ class Registry::Io {
  public:
   explicit Io(Registry& r);
 
+  /// A request to the monitor of `host`; `restore` is the configuration a start restores.
   void send(LaunchKind kind, const std::string& host, long monitor_pid, const std::string& module,
-            unsigned incarnation, const std::vector<std::string>& argv,
-            const std::vector<std::string>& env);
+            unsigned incarnation, const std::string& restore = "");
   void reply(unsigned long long id, const std::string& error);
   void publish(const SystemState& state) { system_.write(state); }
   /// When the last heartbeat of that incarnation arrived (epoch if none did).

@@ -1,11 +1,13 @@
 #include "oscar/registry/launch_command.hpp"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 namespace oscar {
 namespace {
 
 using Argv = std::vector<std::string>;
+using ::testing::HasSubstr;
 
 TEST(LaunchCommand, LocalHostsRunTheCommandAsItIs) {
   HostSpec h;
@@ -29,6 +31,9 @@ TEST(LaunchCommand, SshHostsGetOneQuotedRemoteCommand) {
                   "/opt/oscar/bin/oscar-monitor --system 'my system.yaml' 'it'\\''s'"}));
 }
 
+// Program names as they are (a monitor maps them to its own copies).
+std::string as_is(const std::string& program) { return program; }
+
 SystemSpec one_module(const std::string& debug) {
   return SystemSpec::parse(
       YAML::Load("system: s\ndomain: 9\nmodules: [ { name: cam, kernels: [ { type: relay } ]" +
@@ -39,7 +44,7 @@ SystemSpec one_module(const std::string& debug) {
 TEST(LaunchCommand, ModuleCommandNamesFileModuleIncarnationAndDomain) {
   const auto s = one_module("");
   EXPECT_EQ(
-      module_command(s, s.modules[0], 3, "oscar-run", "/logs"),
+      module_command(s, s.modules[0], 3, as_is, "/logs"),
       (Argv{"oscar-run", "sys.yaml", "--module", "cam", "--incarnation", "3", "--domain", "9"}));
 }
 
@@ -49,14 +54,14 @@ TEST(LaunchCommand, TheCoordinatorSectionStartsOscarCoordinatorAsAModule) {
                  "coordinator: { applets: [] }"),
       "sys.yaml");
   ASSERT_EQ(s.modules.size(), 2u);
-  EXPECT_EQ(module_command(s, s.modules[1], 1, "oscar-run", "/logs"),
+  EXPECT_EQ(module_command(s, s.modules[1], 1, as_is, "/logs"),
             (Argv{"oscar-coordinator", "sys.yaml", "--module", "coordinator", "--incarnation", "1",
                   "--domain", "9"}));
 }
 
 TEST(LaunchCommand, GdbserverListensOnLoopbackOnly) {
   const auto s = one_module(", debug: { gdbserver: 2345 }");
-  const auto argv = module_command(s, s.modules[0], 1, "oscar-run", "/logs");
+  const auto argv = module_command(s, s.modules[0], 1, as_is, "/logs");
   ASSERT_GE(argv.size(), 3u);
   EXPECT_EQ(argv[0], "gdbserver");
   EXPECT_EQ(argv[1], "127.0.0.1:2345");
@@ -65,7 +70,7 @@ TEST(LaunchCommand, GdbserverListensOnLoopbackOnly) {
 
 TEST(LaunchCommand, ValgrindWritesItsLogBesideTheModules) {
   const auto s = one_module(", debug: { valgrind: [--leak-check=full] }");
-  const auto argv = module_command(s, s.modules[0], 2, "oscar-run", "/logs");
+  const auto argv = module_command(s, s.modules[0], 2, as_is, "/logs");
   EXPECT_EQ(
       Argv(argv.begin(), argv.begin() + 4),
       (Argv{"valgrind", "--log-file=/logs/cam.2.valgrind.log", "--leak-check=full", "oscar-run"}));
@@ -83,6 +88,36 @@ TEST(LaunchCommand, OnlyGdbserverHoldsTheProcessAndEachWrapperIsNamedForPs) {
   const auto plain = one_module("").modules[0].debug;
   EXPECT_FALSE(plain.holds_process());
   EXPECT_EQ(plain.describe(), "");
+}
+
+// A monitor builds the command of a start request from its own system file: the module must be
+// one of the file's, on the monitor's host; the programs are the monitor's; a configuration to
+// restore is the one argument that comes from the request.
+TEST(LaunchCommand, AMonitorStartsOnlyModulesOfItsFileOnItsHost) {
+  const auto s = SystemSpec::parse(
+      YAML::Load("system: s\ndomain: 9\nhosts: { pc1: { local: true }, pc2: { netns: n2 } }\n"
+                 "modules: [ { name: cam, host: pc1, kernels: [ { type: relay, name: r1 } ] },\n"
+                 "           { name: far, host: pc2, kernels: [ { type: relay, name: r2 } ] } ]"),
+      "sys.yaml");
+  const auto mine = [](const std::string& p) { return "/opt/oscar/bin/" + p; };
+  EXPECT_EQ(launch_command(s, "pc1", "cam", 2, "", "/logs", mine),
+            (Argv{"/opt/oscar/bin/oscar-run", "sys.yaml", "--module", "cam", "--incarnation", "2",
+                  "--domain", "9"}));
+  EXPECT_EQ(launch_command(s, "pc1", "cam", 3, "rate: 5", "/logs", mine).back(), "rate: 5");
+  try {
+    launch_command(s, "pc1", "sh -c 'touch /tmp/x'", 1, "", "/logs", mine);
+    ADD_FAILURE() << "a name that is no module was started";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("refused to start 'sh -c 'touch /tmp/x'': sys.yaml has no "
+                                    "module of that name"));
+  }
+  try {
+    launch_command(s, "pc1", "far", 1, "", "/logs", mine);
+    ADD_FAILURE() << "another host's module was started";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("refused to start 'far': sys.yaml puts it on host 'pc2', "
+                                    "this monitor watches 'pc1'"));
+  }
 }
 
 }  // namespace

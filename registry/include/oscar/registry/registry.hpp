@@ -53,7 +53,9 @@ class Registry {
   void on_process_event(const ProcessEvent& event);
   void on_module_state(const ModuleState& state);
   void on_module_lost(const std::string& module, unsigned incarnation);
-  void on_request(const RegistryRequest& request);
+  /// `writer`: the modules living in the process that wrote the request. Only a process hosting
+  /// none of this system's (boot, an operator's tool) may restart modules and shut it down.
+  void on_request(const RegistryRequest& request, const std::vector<std::string>& writer);
   void tick();
   /// Runs the queued events, each without holding `lock` (on mutex_).
   void run_events(std::unique_lock<std::mutex>& lock);
