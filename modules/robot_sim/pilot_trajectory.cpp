@@ -101,6 +101,15 @@ void PilotTrajectory::splice(const std::vector<TimedPoint>& points, Stamp lo, St
   spans_ = std::move(spans);
 }
 
+std::vector<TimedPoint> PilotTrajectory::from(Stamp t) const {
+  const Place p = place_at(points_, t);
+  std::vector<TimedPoint> result{{p.x, p.y, t}};
+  for (const auto& q : points_) {
+    if (q.t > t) add(result, q);
+  }
+  return result;
+}
+
 void PilotTrajectory::forget_before(Stamp t) {
   const auto after = std::upper_bound(points_.begin(), points_.end(), t,
                                       [](Stamp v, const TimedPoint& q) { return v < q.t; });

@@ -57,6 +57,10 @@ class PilotTrajectory {
   void splice(const std::vector<TimedPoint>& points, Stamp lo, Stamp hi, bool open_end,
               std::uint64_t transaction);
 
+  /// The trajectory from t on: its place at t, then its points after t (the robot stays at the
+  /// last one for good).
+  std::vector<TimedPoint> from(Stamp t) const;
+
   /// Forgets what lies wholly before t (the trajectory stays the same from t on).
   void forget_before(Stamp t);
 

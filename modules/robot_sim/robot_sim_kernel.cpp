@@ -11,6 +11,7 @@
 #include <fmt/ranges.h>
 
 #include <oscar/kernel_registry.hpp>
+#include <oscar/swarm_yaml.hpp>
 
 namespace oscar::modules {
 namespace {
@@ -75,6 +76,8 @@ RobotSim::RobotSim(KernelSetup& setup)
                                      [this](const TransactionDecision& d) { return commit(d); });
   setup.command<TransactionDecision>("abort",
                                      [this](const TransactionDecision& d) { return abort(d); });
+  setup.command<CommittedPlanQuery>(
+      "committed", [this](const CommittedPlanQuery& q) { return committed_plan(q); });
   committed_ = PilotTrajectory(params_.start_x, params_.start_y, params_.start_heading);
   random_.seed(static_cast<std::uint64_t>(params_.seed));
 }
@@ -316,6 +319,41 @@ CommandAnswer RobotSim::abort(const TransactionDecision& decision) {
   pending_.erase(decision.transaction());
   return CommandAnswer::accept(
       fmt::format("transaction {} aborted: its proposal is dropped", decision.transaction()));
+}
+
+// What the robot has committed from now on, as a Trajectory in YAML: one open-ended section from
+// now (its place now, then the committed waypoints after now) and the jobs not yet done. Pending
+// proposals are not part of it. A broken robot stands and works nothing.
+CommandAnswer RobotSim::committed_plan(const CommittedPlanQuery& query) {
+  const Stamp now = command_time();
+  break_down_if_due(now);
+  if (query.robot() != name_) {
+    return CommandAnswer::refuse(
+        fmt::format("the query is for robot '{}', not '{}'", query.robot(), name_));
+  }
+  Trajectory plan;
+  plan.robot(name_);
+  TrajectorySection s;
+  s.from_ns(now);
+  s.open_end(true);
+  for (const auto& p : committed_.from(now)) {
+    SwarmWaypoint w;
+    w.x(p.x);
+    w.y(p.y);
+    w.t_ns(p.t);
+    s.waypoints().push_back(w);
+  }
+  s.to_ns(s.waypoints().back().t_ns());
+  plan.sections().push_back(std::move(s));
+  if (!broken_) {
+    for (const auto& [id, job] : jobs_) {
+      if (job.end_ns() > now) plan.jobs_added().push_back(job);
+    }
+    std::stable_sort(
+        plan.jobs_added().begin(), plan.jobs_added().end(),
+        [](const RobotJob& a, const RobotJob& b) { return a.start_ns() < b.start_ns(); });
+  }
+  return CommandAnswer::accept(to_yaml(plan));
 }
 
 }  // namespace oscar::modules

@@ -17,7 +17,8 @@ namespace oscar::modules {
 /// A simulated disc robot's pilot (the live swarm, docs in README.md): it drives its committed
 /// trajectory in real time and publishes its RobotState every cycle; command `propose` takes a
 /// transaction's trajectory sections (ACK or NAK), `commit` splices them in and `abort` drops
-/// them. Faults are injected by parameters: random NAKs, a breakdown, slow acknowledgements.
+/// them; `committed` tells what it has committed from now on (for a coordinator that restarted).
+/// Faults are injected by parameters: random NAKs, a breakdown, slow acknowledgements.
 class RobotSim final : public Kernel {
  public:
   struct Params {
@@ -42,6 +43,7 @@ class RobotSim final : public Kernel {
   CommandAnswer propose(const Trajectory& request);
   CommandAnswer commit(const TransactionDecision& decision);
   CommandAnswer abort(const TransactionDecision& decision);
+  CommandAnswer committed_plan(const CommittedPlanQuery& query);
   std::string refusal(const Trajectory& request, Stamp now) const;
   std::string decision_refusal(const TransactionDecision& decision) const;
   Stamp command_time() const;

@@ -6,12 +6,8 @@
 // reason.
 #include <algorithm>
 #include <cmath>
-#include <condition_variable>
 #include <filesystem>
 #include <fstream>
-#include <map>
-#include <mutex>
-#include <optional>
 
 #include <fmt/format.h>
 #include <gmock/gmock.h>
@@ -24,12 +20,15 @@
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
 #include "process.hpp"  // tests/common
+#include "swarm_client.hpp"
 
 namespace oscar {
 namespace {
 
 using namespace std::chrono_literals;
+using test::job;
 using ::testing::HasSubstr;
+using Client = test::SwarmClient;
 
 // Nine robots: r1 and r2 do as told; rn refuses everything; rs (a module of its own) answers
 // after the coordinator stopped waiting; rb (a module of its own) breaks down when told to. Out
@@ -75,20 +74,6 @@ coordinator:
     replan_attempts: 3
 )";
 
-// A square job area of side 0.2 m around (x, y), in the window [now + from_s, now + to_s].
-SwarmJobSpec job(const std::string& id, double x, double y, double from_s, double to_s,
-                 double duration_s) {
-  SwarmJobSpec j;
-  j.id(id);
-  j.area().x({x - 0.1, x + 0.1, x + 0.1, x - 0.1});
-  j.area().y({y - 0.1, y - 0.1, y + 0.1, y + 0.1});
-  const auto now = wall_now();
-  j.earliest_start_ns(now + static_cast<Stamp>(from_s * 1e9));
-  j.latest_finish_ns(now + static_cast<Stamp>(to_s * 1e9));
-  j.duration_s(duration_s);
-  return j;
-}
-
 // A dependent set: job `b` waits for job `a`.
 SwarmRequest a_then_b(const SwarmJobSpec& a, const SwarmJobSpec& b) {
   SwarmRequest r;
@@ -110,106 +95,13 @@ class LiveSwarm : public ::testing::Test {
   static void SetUpTestSuite() {
     system_ = new test::BootedSystem("swarm_live", kSystem);
     system_->running();
-    client_ = new Client(system_->participant());
+    client_ = new Client(system_->participant(), "swarm_live_test");
     violations_ = system_->watch<SafetyViolation>("safety/violations").release();
   }
   static void TearDownTestSuite() {
     delete violations_;
     delete client_;
     delete system_;
-  }
-
-  // Submits requests and reads the coordinator's replies, status and the robots' states.
-  class Client {
-   public:
-    explicit Client(DdsParticipant& p)
-        : participant_(p),
-          writer_(p, topics::swarm_request()),
-          replies_(p, topics::swarm_reply(),
-                   [this](const SwarmReply& r, const auto&) {
-                     std::lock_guard lock(mutex_);
-                     replies_seen_[r.request()].push_back(r);
-                     changed_.notify_all();
-                   }),
-          status_(p, topics::swarm_status(), [this](const SwarmStatus& s, const auto&) {
-            std::lock_guard lock(mutex_);
-            status_seen_ = s;
-            changed_.notify_all();
-          }) {}
-
-    unsigned long long submit(SwarmRequest r) {
-      r.sender("swarm_live_test");
-      r.id(++next_id_);
-      writer_.write(r);
-      return r.id();
-    }
-    unsigned long long schedule(const SwarmJobSpec& j) {
-      SwarmRequest r;
-      r.kind(SWARM_SCHEDULE);
-      r.jobs().push_back(j);
-      return submit(r);
-    }
-
-    // The first reply to `request` with an outcome other than PLANNED, after `skip` such ones.
-    SwarmReply outcome(unsigned long long request, std::size_t skip = 0) {
-      std::unique_lock lock(mutex_);
-      SwarmReply found;
-      const bool ok = changed_.wait_for(lock, 30s, [&] {
-        std::size_t n = 0;
-        for (const auto& r : replies_seen_[request]) {
-          if (r.outcome() != SWARM_PLANNED && n++ == skip) {
-            found = r;
-            return true;
-          }
-        }
-        return false;
-      });
-      if (!ok) ADD_FAILURE() << "no outcome of request " << request;
-      return found;
-    }
-    std::vector<SwarmReply> replies(unsigned long long request) {
-      std::lock_guard lock(mutex_);
-      return replies_seen_[request];
-    }
-
-    SwarmStatus status(const std::function<bool(const SwarmStatus&)>& pred, const char* what) {
-      std::unique_lock lock(mutex_);
-      if (!changed_.wait_for(lock, 30s, [&] { return status_seen_ && pred(*status_seen_); })) {
-        ADD_FAILURE() << "the swarm status never showed " << what;
-      }
-      return status_seen_.value_or(SwarmStatus{});
-    }
-
-    coordinator::CueFeed<RobotState>& state(const std::string& robot) {
-      auto& f = states_[robot];
-      if (!f)
-        f = std::make_unique<coordinator::CueFeed<RobotState>>(participant_, robot + "/state");
-      return *f;
-    }
-
-   private:
-    DdsParticipant& participant_;
-    TopicWriter<SwarmRequest, SwarmRequestPubSubType> writer_;
-    std::mutex mutex_;
-    std::condition_variable changed_;
-    std::map<unsigned long long, std::vector<SwarmReply>> replies_seen_;
-    std::optional<SwarmStatus> status_seen_;
-    unsigned long long next_id_ = 0;
-    std::map<std::string, std::unique_ptr<coordinator::CueFeed<RobotState>>> states_;
-    TopicReader<SwarmReply, SwarmReplyPubSubType> replies_;
-    TopicReader<SwarmStatus, SwarmStatusPubSubType> status_;
-  };
-
-  // Waits until the robot reports working `job`; its state then.
-  static std::optional<RobotState> working(const std::string& robot, const std::string& job,
-                                           std::chrono::seconds within) {
-    auto& feed = client_->state(robot);
-    const auto until = std::chrono::steady_clock::now() + within;
-    while (std::chrono::steady_clock::now() < until) {
-      if (auto s = feed.latest(); s && s->job().id() == job) return s;
-      std::this_thread::sleep_for(20ms);
-    }
-    return std::nullopt;
   }
 
   // After each test: nothing it did brought robots too close, into an obstacle or off their
@@ -260,7 +152,7 @@ class LiveSwarm : public ::testing::Test {
 };
 
 test::BootedSystem* LiveSwarm::system_ = nullptr;
-LiveSwarm::Client* LiveSwarm::client_ = nullptr;
+Client* LiveSwarm::client_ = nullptr;
 testing::CueWatch<SafetyViolation>* LiveSwarm::violations_ = nullptr;
 
 TEST_F(LiveSwarm, AllRobotsJoinPlanning) {
@@ -276,7 +168,7 @@ TEST_F(LiveSwarm, AJobSubmittedOverDdsIsDoneByTheNearestRobotAtItsPlaceInItsWind
   ASSERT_EQ(r.outcome(), SWARM_COMMITTED) << r.reason();
   ASSERT_EQ(r.jobs().size(), 1u);
   EXPECT_EQ(r.jobs()[0].robot(), "r1");
-  const auto s = working("r1", "near_r1", 40s);
+  const auto s = client_->working("r1", "near_r1", 40s);
   ASSERT_TRUE(s) << "r1 never worked the job";
   EXPECT_NEAR(s->x(), r.jobs()[0].x(), 0.01);
   EXPECT_NEAR(s->y(), r.jobs()[0].y(), 0.01);
@@ -509,10 +401,10 @@ TEST_F(LiveSwarm, ADependentSetKeepsItsOrderWhenOneOfItsRobotsBreaksDown) {
             std::string::npos)
       << refused.reason();
   // And r3 works them in that order.
-  const auto doing_a = working("r3", "order_a", 30s);
+  const auto doing_a = client_->working("r3", "order_a", 30s);
   ASSERT_TRUE(doing_a) << "r3 never worked order_a";
   EXPECT_LE(doing_a->header().stamps()[0], b->start_ns());
-  const auto doing_b = working("r3", "order_b", 30s);
+  const auto doing_b = client_->working("r3", "order_b", 30s);
   ASSERT_TRUE(doing_b) << "r3 never worked order_b";
   EXPECT_GE(doing_b->header().stamps()[0], end_ns(a));
 }
@@ -552,7 +444,8 @@ TEST_F(LiveSwarm, ADependentSetThatCannotBeWholeAgainIsAbortedWhole) {
       "no job of the set");
   // r4 does not work whole_b when it was due.
   const auto until_b_ended = std::chrono::seconds((b_end - wall_now()) / 1'000'000'000 + 1);
-  EXPECT_FALSE(working("r4", "whole_b", until_b_ended)) << "r4 worked whole_b all the same";
+  EXPECT_FALSE(client_->working("r4", "whole_b", until_b_ended))
+      << "r4 worked whole_b all the same";
 }
 
 }  // namespace

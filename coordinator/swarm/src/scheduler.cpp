@@ -142,7 +142,7 @@ std::vector<MovingObstacle> Scheduler::obstacles_for(const NodeState& n) const {
   return result;
 }
 
-void Scheduler::add_node(const NodeSpec& spec) {
+void Scheduler::check_node_spec(const NodeSpec& spec) const {
   const std::string what = fmt::format("node '{}'", spec.id);
   if (spec.id.empty()) throw std::invalid_argument("node: id must not be empty");
   for (const auto& n : nodes_) {
@@ -161,6 +161,11 @@ void Scheduler::add_node(const NodeSpec& spec) {
   if (!std::isfinite(spec.turning_radius_m) || spec.turning_radius_m < 0) {
     throw std::invalid_argument(what + ": turning_radius must be finite and >= 0");
   }
+}
+
+void Scheduler::add_node(const NodeSpec& spec) {
+  const std::string what = fmt::format("node '{}'", spec.id);
+  check_node_spec(spec);
   auto n = std::make_unique<NodeState>();
   n->spec = spec;
   n->committed = Trajectory({{spec.x, spec.y, spec.t}});
@@ -179,6 +184,106 @@ void Scheduler::add_node(const NodeSpec& spec) {
   n->committed = *tail;
   n->working = n->committed;
   nodes_.push_back(std::move(n));
+}
+
+namespace {
+// A committed plan crossed the wire: places agree to the robots' own tolerance, times to what ns
+// on the wire and seconds from another epoch keep.
+constexpr double kCommittedPlaceTolerance = 0.01;  // m
+constexpr double kCommittedTimeTolerance = 1e-6;   // s
+
+std::string place_text(const Point& p) { return fmt::format("({:.3f}, {:.3f})", p.x(), p.y()); }
+}  // namespace
+
+void Scheduler::add_node(const NodeSpec& spec, const Trajectory& committed, std::vector<Job> jobs) {
+  check_node_spec(spec);
+  check_committed(spec, committed, jobs);
+  auto n = std::make_unique<NodeState>();
+  n->spec = spec;
+  if (!finder(*n).is_free(Point(spec.x, spec.y))) {
+    throw std::invalid_argument(
+        fmt::format("node '{}': where it is lies within radius of a static obstacle", spec.id));
+  }
+  n->committed = committed;
+  n->working = committed;
+  n->committed_jobs = std::move(jobs);
+  n->working_jobs = n->committed_jobs;
+  nodes_.push_back(std::move(n));
+}
+
+// The rules of add_node with a committed plan; sorts the jobs by start and sets their node.
+void Scheduler::check_committed(const NodeSpec& spec, const Trajectory& committed,
+                                std::vector<Job>& jobs) const {
+  const std::string what = fmt::format("node '{}'", spec.id);
+  if (committed.empty()) throw std::invalid_argument(what + ": its committed trajectory is empty");
+  for (const auto& w : committed.points()) check_time(w.t, what + " committed trajectory time");
+  if (committed.start_time() > spec.t) {
+    throw std::invalid_argument(
+        fmt::format("{}: its committed trajectory starts at {}, after the node's time {}: it must "
+                    "hold where the node is then",
+                    what, committed.start_time(), spec.t));
+  }
+  const Point here(spec.x, spec.y);
+  if (const Point p = committed.position_at(spec.t); distance(p, here) > kCommittedPlaceTolerance) {
+    throw std::invalid_argument(fmt::format(
+        "{}: its committed trajectory has it at {} at {}, not where it is, {} (tolerance {} m)",
+        what, place_text(p), spec.t, place_text(here), kCommittedPlaceTolerance));
+  }
+  std::sort(jobs.begin(), jobs.end(), [](const Job& a, const Job& b) { return a.start < b.start; });
+  for (std::size_t i = 0; i < jobs.size(); ++i) {
+    Job& j = jobs[i];
+    const std::string job_what = fmt::format("{}: committed job '{}'", what, j.id);
+    if (j.spec.id != j.id) {
+      throw std::invalid_argument(fmt::format("{}: its spec names job '{}'", job_what, j.spec.id));
+    }
+    if (!j.node.empty() && j.node != spec.id) {
+      throw std::invalid_argument(fmt::format("{} is scheduled on node '{}'", job_what, j.node));
+    }
+    j.node = spec.id;
+    validate(j.spec, false);
+    if (!std::isfinite(j.x) || !std::isfinite(j.y)) {
+      throw std::invalid_argument(job_what + ": its place must be finite");
+    }
+    check_time(j.start, job_what + " start");
+    if (!std::isfinite(j.duration) || j.duration <= 0) {
+      throw std::invalid_argument(job_what + ": duration must be finite and > 0");
+    }
+    if (j.end() < spec.t) {
+      throw std::invalid_argument(fmt::format(
+          "{}: it ended at {}, before the node's time {}: only jobs not yet done are committed",
+          job_what, j.end(), spec.t));
+    }
+    if (j.start < j.spec.earliest_start - kCommittedTimeTolerance ||
+        j.end() > j.spec.latest_finish + kCommittedTimeTolerance) {
+      throw std::invalid_argument(fmt::format("{}: [{}, {}] lies outside its window [{}, {}]",
+                                              job_what, j.start, j.end(), j.spec.earliest_start,
+                                              j.spec.latest_finish));
+    }
+    if (i > 0 && j.start < jobs[i - 1].end() - kCommittedTimeTolerance) {
+      throw std::invalid_argument(fmt::format("{}: it starts at {}, before job '{}' ends at {}",
+                                              job_what, j.start, jobs[i - 1].id,
+                                              jobs[i - 1].end()));
+    }
+    for (std::size_t k = 0; k < i; ++k) {
+      if (jobs[k].id == j.id) throw std::invalid_argument(job_what + ": duplicate job id");
+    }
+    // The node stands at the job's place while the job lasts: at its start, its end and every
+    // waypoint between (the trajectory is piecewise linear).
+    std::vector<double> times{j.start, j.end()};
+    for (const auto& w : committed.points()) {
+      if (w.t > j.start && w.t < j.end()) times.push_back(w.t);
+    }
+    for (const double t : times) {
+      if (const Point p = committed.position_at(t);
+          distance(p, j.location()) > kCommittedPlaceTolerance) {
+        throw std::invalid_argument(fmt::format(
+            "{}: the committed trajectory has the node at {} at {}, not at the job's place {} "
+            "while the job lasts [{}, {}] (tolerance {} m)",
+            job_what, place_text(p), t, place_text(j.location()), j.start, j.end(),
+            kCommittedPlaceTolerance));
+      }
+    }
+  }
 }
 
 bool Scheduler::job_exists(const std::string& id) const {

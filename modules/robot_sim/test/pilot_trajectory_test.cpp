@@ -95,6 +95,19 @@ TEST(PilotTrajectory, ForgettingThePastChangesNothingFromThenOn) {
   EXPECT_DOUBLE_EQ(standing.at(3 * kS + kS / 2).heading, M_PI / 2);
 }
 
+TEST(PilotTrajectory, FromATimeOnIsItsPlaceThenAndTheWaypointsAfter) {
+  PilotTrajectory t(0, 0, 0);
+  t.splice({{0, 0, 1 * kS}, {0, 2, 3 * kS}, {-1, 2, 4 * kS}}, 1 * kS, 0, true, 1);
+  const std::vector<TimedPoint> rest{{0, 1, 2 * kS}, {0, 2, 3 * kS}, {-1, 2, 4 * kS}};
+  EXPECT_EQ(t.from(2 * kS), rest);
+  const std::vector<TimedPoint> at_vertex{{0, 2, 3 * kS}, {-1, 2, 4 * kS}};
+  EXPECT_EQ(t.from(3 * kS), at_vertex);
+  const std::vector<TimedPoint> standing{{-1, 2, 9 * kS}};
+  EXPECT_EQ(t.from(9 * kS), standing);
+  const std::vector<TimedPoint> before{{0, 0, 0}, {0, 0, 1 * kS}, {0, 2, 3 * kS}, {-1, 2, 4 * kS}};
+  EXPECT_EQ(t.from(0), before);
+}
+
 TEST(PilotTrajectory, StoppingFreezesPlaceAndHeading) {
   PilotTrajectory t(0, 0, 0);
   t.splice({{0, 0, 1 * kS}, {0, 2, 3 * kS}}, 1 * kS, 0, true, 1);

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <oscar/harness.hpp>
 #include <oscar/module.hpp>
+#include <oscar/swarm_yaml.hpp>
 #include <oscar/testing/conformance.hpp>
 #include <oscar/testing/eventually.hpp>
 
@@ -95,6 +96,17 @@ struct Robot {
     EXPECT_EQ(out.size(), 1u);
     return out.empty() ? RobotState{} : *out.back();
   }
+  CommandAnswer ask_committed(const std::string& robot = "r1") {
+    CommittedPlanQuery q;
+    q.robot(robot);
+    return h.command("committed", q);
+  }
+  /// The committed plan the robot tells now.
+  Trajectory committed() {
+    const auto a = ask_committed();
+    EXPECT_TRUE(a.accepted) << a.text;
+    return trajectory_from_yaml(a.text);
+  }
   std::string nak(const Trajectory& t) {
     const auto a = propose(t);
     EXPECT_FALSE(a.accepted) << a.text;
@@ -174,6 +186,80 @@ TEST(RobotSim, FollowsACommittedTrajectoryWithItsJobAndTransaction) {
   EXPECT_EQ(st.job().id(), "") << "the job's window has passed";
   EXPECT_DOUBLE_EQ(st.y(), 1);
   EXPECT_FALSE(st.broken());
+}
+
+// Command `committed`: a coordinator that restarted reads what the robot drives and works.
+TEST(RobotSim, CommittedTellsItsTrajectoryFromNowAndItsJobsNotYetDone) {
+  Robot r;
+  ASSERT_TRUE(
+      r.propose(proposal("r1", 7,
+                         {open(at_s(1), {wp(0, 0, at_s(1)), wp(2, 0, at_s(3)), wp(2, 1, at_s(4))})},
+                         {job("j2", 2, 1, at_s(8), at_s(9)), job("j1", 2, 1, at_s(5), at_s(7))}))
+          .accepted);
+  ASSERT_TRUE(r.commit(7).accepted);
+  // Pending proposals are not committed: they are not told.
+  ASSERT_TRUE(
+      r.propose(proposal("r1", 8, {open(at_s(10), {wp(2, 1, at_s(10)), wp(0, 1, at_s(12))})},
+                         {job("j3", 0, 1, at_s(12), at_s(13))}))
+          .accepted);
+  r.at(2);
+  auto plan = r.committed();
+  EXPECT_EQ(plan.robot(), "r1");
+  EXPECT_EQ(plan.transaction(), 0u);
+  ASSERT_EQ(plan.sections().size(), 1u);
+  const auto& s = plan.sections()[0];
+  EXPECT_TRUE(s.open_end());
+  // From the command's time (the last cycle's plus the time since) on: its place then, then the
+  // committed waypoints after it.
+  EXPECT_GE(s.from_ns(), at_s(2));
+  EXPECT_LT(s.from_ns(), at_s(2.5));
+  ASSERT_EQ(s.waypoints().size(), 3u);
+  EXPECT_EQ(s.waypoints()[0].t_ns(), s.from_ns());
+  EXPECT_NEAR(s.waypoints()[0].x(), 1 + static_cast<double>(s.from_ns() - at_s(2)) * 1e-9, 1e-9);
+  EXPECT_EQ(s.waypoints()[0].y(), 0);
+  EXPECT_EQ(s.waypoints()[1], wp(2, 0, at_s(3)));
+  EXPECT_EQ(s.waypoints()[2], wp(2, 1, at_s(4)));
+  EXPECT_EQ(s.to_ns(), at_s(4)) << "its last waypoint";
+  ASSERT_EQ(plan.jobs_added().size(), 2u);
+  EXPECT_EQ(plan.jobs_added()[0], job("j1", 2, 1, at_s(5), at_s(7))) << "by start, as committed";
+  EXPECT_EQ(plan.jobs_added()[1], job("j2", 2, 1, at_s(8), at_s(9)));
+  EXPECT_TRUE(plan.jobs_removed().empty());
+
+  r.at(7.5);  // j1 is done; it stands at (2, 1) for good
+  plan = r.committed();
+  ASSERT_EQ(plan.sections().size(), 1u);
+  ASSERT_EQ(plan.sections()[0].waypoints().size(), 1u);
+  EXPECT_EQ(plan.sections()[0].waypoints()[0].x(), 2);
+  EXPECT_EQ(plan.sections()[0].waypoints()[0].y(), 1);
+  EXPECT_EQ(plan.sections()[0].to_ns(), plan.sections()[0].from_ns());
+  ASSERT_EQ(plan.jobs_added().size(), 1u);
+  EXPECT_EQ(plan.jobs_added()[0].id(), "j2");
+}
+
+TEST(RobotSim, CommittedOfAnIdleRobotIsWhereItStandsAndNoJob) {
+  Robot r("{start_x: 3, start_y: -2}");
+  const auto plan = r.committed();
+  ASSERT_EQ(plan.sections().size(), 1u);
+  ASSERT_EQ(plan.sections()[0].waypoints().size(), 1u);
+  EXPECT_EQ(plan.sections()[0].waypoints()[0].x(), 3);
+  EXPECT_EQ(plan.sections()[0].waypoints()[0].y(), -2);
+  EXPECT_TRUE(plan.jobs_added().empty());
+  const auto refused = r.ask_committed("r2");
+  EXPECT_FALSE(refused.accepted);
+  EXPECT_EQ(refused.text, "the query is for robot 'r2', not 'r1'");
+}
+
+TEST(RobotSim, CommittedOfABrokenRobotIsWhereItStoppedAndNoJob) {
+  Robot r("{breakdown_after_s: 2}");
+  ASSERT_TRUE(r.propose(proposal("r1", 1, {open(at_s(1), {wp(0, 0, at_s(1)), wp(3, 0, at_s(4))})},
+                                 {job("j1", 3, 0, at_s(4), at_s(9))}))
+                  .accepted);
+  ASSERT_TRUE(r.commit(1).accepted);
+  r.at(2.5);
+  const auto plan = r.committed();
+  ASSERT_EQ(plan.sections()[0].waypoints().size(), 1u);
+  EXPECT_DOUBLE_EQ(plan.sections()[0].waypoints()[0].x(), 1.5);
+  EXPECT_TRUE(plan.jobs_added().empty());
 }
 
 TEST(RobotSim, AnUncommittedProposalChangesNothing) {

@@ -1,5 +1,7 @@
 #include "robot_link.hpp"
 
+#include <stdexcept>
+
 #include <spdlog/spdlog.h>
 
 #include "oscar/swarm_types.hpp"
@@ -47,6 +49,14 @@ void RobotLink::abort(const std::string& robot, unsigned long long transaction) 
   d.robot(robot);
   d.transaction(transaction);
   post(Decision{"abort", d});
+}
+
+std::string RobotLink::committed(const std::string& robot) {
+  CommittedPlanQuery q;
+  q.robot(robot);
+  const auto reply = client_.command(module_, robot, "committed", q, timeout_);
+  if (!reply.ok()) throw std::invalid_argument(reply.error());
+  return reply.answer();
 }
 
 void RobotLink::run() {

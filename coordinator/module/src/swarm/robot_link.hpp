@@ -40,6 +40,12 @@ class RobotLink {
   void commit(const std::string& robot, unsigned long long transaction);
   void abort(const std::string& robot, unsigned long long transaction);
 
+  /// Asks the robot now, on the caller's thread, what it has committed (command `committed`):
+  /// the answer's text, a Trajectory in YAML (oscar/swarm_yaml.hpp).
+  /// @throws std::invalid_argument when the robot or its module refuses the command;
+  ///         std::runtime_error when no answer comes within the timeout.
+  std::string committed(const std::string& robot);
+
  private:
   struct Decision {
     std::string name;  // "commit" or "abort"

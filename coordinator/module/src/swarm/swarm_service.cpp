@@ -57,6 +57,7 @@ struct SwarmService::Impl {
     bool lost = false;     // broke down or fell silent: out of planning
     std::int64_t last_heard_ns = 0;
     std::uint64_t states_seen = 0;
+    std::int64_t ask_again_ns = 0;  // it did not tell its committed plan: not before then
   };
   using Event = std::variant<SwarmRequest, RobotLink::Answer>;
 
@@ -311,7 +312,7 @@ struct SwarmService::Impl {
       }
       if (!state) continue;
       if (!robot.planned && !state->broken()) {
-        add(robot, *state);
+        if (now >= robot.ask_again_ns) add(robot, *state, now);
       } else if (robot.planned && state->broken()) {
         lose(robot, *state, "broke down: " + state->fault());
       } else if (robot.planned &&
@@ -322,18 +323,76 @@ struct SwarmService::Impl {
     }
   }
 
-  void add(Robot& robot, const RobotState& s) {
-    swarm::NodeSpec spec{robot.setup.kernel,  s.radius(),        s.max_speed(), s.x(), s.y(),
-                         scheduler.present(), s.turning_radius()};
+  // A robot joins planning with what it has committed: idle where it stands, or (after this
+  // coordinator restarted) driving the trajectory and working the jobs its predecessor
+  // committed, which the planner takes over as they are.
+  void add(Robot& robot, const RobotState& s, std::int64_t now) {
+    const std::string& id = robot.setup.kernel;
+    std::string answer;
     try {
-      scheduler.add_node(spec);
-      robot.planned = true;
-      plan_changed = true;
-      spdlog::info("swarm: robot '{}' joins planning at ({:.2f}, {:.2f})", spec.id, spec.x, spec.y);
+      answer = robot.link->committed(id);
     } catch (const std::invalid_argument& e) {
       robot.lost = true;
-      spdlog::error("swarm: robot '{}' cannot be planned: {}", spec.id, e.what());
+      spdlog::error("swarm: robot '{}' cannot be planned: it does not tell its committed plan: {}",
+                    id, e.what());
+      return;
+    } catch (const std::runtime_error& e) {
+      robot.ask_again_ns = now + std::chrono::nanoseconds(1s).count();
+      spdlog::warn("swarm: robot '{}' did not tell its committed plan ({}); asked again in 1 s", id,
+                   e.what());
+      return;
     }
+    try {
+      // It drove on while it answered: its plan holds from its time of answering.
+      const auto plan = take_over(id, answer);
+      const swarm::Point here = plan.trajectory.position_at(scheduler.present());
+      swarm::NodeSpec spec{id,       s.radius(),          s.max_speed(),     here.x(),
+                           here.y(), scheduler.present(), s.turning_radius()};
+      if (plan.idle()) {
+        scheduler.add_node(spec);
+        spdlog::info("swarm: robot '{}' joins planning at ({:.2f}, {:.2f})", id, spec.x, spec.y);
+      } else {
+        scheduler.add_node(spec, plan.trajectory, plan.jobs);
+        for (const auto& j : plan.jobs) origin[j.id] = taken_over_request(j);
+        spdlog::info(
+            "swarm: robot '{}' joins planning at ({:.2f}, {:.2f}) with its committed plan: a "
+            "trajectory until {:.1f} s from now and {} job(s){}",
+            id, spec.x, spec.y, std::max(0.0, plan.trajectory.end_time() - spec.t),
+            plan.jobs.size(), plan.jobs.empty() ? "" : ": " + job_ids(plan.jobs));
+      }
+      robot.planned = true;
+      plan_changed = true;
+    } catch (const std::invalid_argument& e) {
+      robot.lost = true;
+      spdlog::error("swarm: robot '{}' cannot be planned: {}", id, e.what());
+    }
+  }
+
+  // A robot's answer to `committed` in the planner's terms; the present moves on to the
+  // robot's time of answering if that is later.
+  swarm_wire::CommittedPlan take_over(const std::string& id, const std::string& answer) {
+    auto plan = swarm_wire::committed_plan(id, answer, clock);
+    const double t =
+        std::max({scheduler.present(), clock.seconds(wall_now()), plan.trajectory.start_time()});
+    scheduler.set_present(t);
+    std::erase_if(plan.jobs, [&](const swarm::Job& j) { return j.end() < t; });  // done
+    return plan;
+  }
+
+  // Where a job taken over from a robot's committed plan came from, to place it again when the
+  // robot breaks down: its requester is not known, so the coordinator stands in for it.
+  std::shared_ptr<Request> taken_over_request(const swarm::Job& j) const {
+    auto r = std::make_shared<Request>();
+    r->message.sender("coordinator");
+    r->message.kind(SWARM_SCHEDULE);
+    r->message.jobs().push_back(swarm_wire::wire_job_spec(j.spec, clock));
+    return r;
+  }
+
+  static std::string job_ids(const std::vector<swarm::Job>& jobs) {
+    std::string ids;
+    for (const auto& j : jobs) ids += (ids.empty() ? "" : ", ") + j.id;
+    return ids;
   }
 
   void lose(Robot& robot, const RobotState& s, const std::string& why) {

@@ -1,8 +1,11 @@
 #include "swarm_wire.hpp"
 
 #include <fmt/format.h>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
+
+#include <oscar/swarm_yaml.hpp>
 
 namespace oscar::coordinator::swarm_wire {
 
@@ -45,6 +48,78 @@ swarm::JobSpec job_spec(const SwarmJobSpec& wire, const Clock& clock) {
   spec.latest_finish = clock.seconds(wire.latest_finish_ns());
   spec.duration = wire.duration_s();
   return spec;
+}
+
+namespace {
+
+SwarmArea area(const swarm::Polygon& polygon) {
+  SwarmArea a;
+  for (const auto& p : swarm::vertices(polygon)) {
+    a.x().push_back(p.x());
+    a.y().push_back(p.y());
+  }
+  return a;
+}
+
+}  // namespace
+
+SwarmJobSpec wire_job_spec(const swarm::JobSpec& spec, const Clock& clock) {
+  SwarmJobSpec wire;
+  wire.id(spec.id);
+  wire.area(area(spec.area));
+  wire.earliest_start_ns(clock.ns(spec.earliest_start));
+  wire.latest_finish_ns(clock.ns(spec.latest_finish));
+  wire.duration_s(spec.duration);
+  return wire;
+}
+
+bool CommittedPlan::idle() const {
+  if (!jobs.empty()) return false;
+  const auto& points = trajectory.points();
+  return std::all_of(points.begin(), points.end(), [&](const swarm::Waypoint& w) {
+    return w.x == points.front().x && w.y == points.front().y;
+  });
+}
+
+CommittedPlan committed_plan(const std::string& robot, const std::string& answer,
+                             const Clock& clock) {
+  const Trajectory t = trajectory_from_yaml(answer);
+  if (t.robot() != robot) {
+    throw std::invalid_argument(
+        fmt::format("the committed plan names robot '{}', not '{}'", t.robot(), robot));
+  }
+  if (t.sections().size() != 1 || !t.sections()[0].open_end() ||
+      t.sections()[0].waypoints().empty()) {
+    throw std::invalid_argument(
+        "a committed plan is one open-ended section with waypoints, from the robot's now on");
+  }
+  CommittedPlan plan;
+  std::vector<swarm::Waypoint> points;
+  for (const auto& w : t.sections()[0].waypoints()) {
+    points.push_back({w.x(), w.y(), clock.seconds(w.t_ns())});
+  }
+  plan.trajectory = swarm::Trajectory(std::move(points));
+  for (const auto& j : t.jobs_added()) {
+    if (j.end_ns() < j.start_ns()) {
+      throw std::invalid_argument(fmt::format("job '{}' ends at {} ns, before it starts at {} ns",
+                                              j.id(), j.end_ns(), j.start_ns()));
+    }
+    const double start = clock.seconds(j.start_ns());
+    const double duration = clock.seconds(j.end_ns()) - start;
+    const double h = kTakenOverJobArea / 2;
+    swarm::JobSpec spec{j.id(),
+                        swarm::make_polygon({{j.x() - h, j.y() - h},
+                                             {j.x() + h, j.y() - h},
+                                             {j.x() + h, j.y() + h},
+                                             {j.x() - h, j.y() + h}},
+                                            fmt::format("job '{}' area", j.id())),
+                        clock.seconds(j.earliest_start_ns()), clock.seconds(j.latest_finish_ns()),
+                        duration};
+    plan.jobs.push_back({j.id(), robot, j.x(), j.y(), start, duration, std::move(spec)});
+  }
+  std::sort(plan.jobs.begin(), plan.jobs.end(),
+            [](const swarm::Job& a, const swarm::Job& b) { return a.start < b.start; });
+  return plan;
 }
 
 namespace {
@@ -143,15 +218,6 @@ Trajectory proposal(const swarm::Scheduler& scheduler, swarm::TransactionId tx,
 }
 
 namespace {
-
-SwarmArea area(const swarm::Polygon& polygon) {
-  SwarmArea a;
-  for (const auto& p : swarm::vertices(polygon)) {
-    a.x().push_back(p.x());
-    a.y().push_back(p.y());
-  }
-  return a;
-}
 
 // The waypoints of `trajectory`, up to the last one before kForever.
 std::vector<SwarmWaypoint> waypoints(const swarm::Trajectory& trajectory, const Clock& clock) {

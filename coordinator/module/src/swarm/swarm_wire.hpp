@@ -22,6 +22,8 @@ struct Clock {
 
 /// @throws std::invalid_argument naming the job and the rule (area, window, duration).
 swarm::JobSpec job_spec(const SwarmJobSpec& wire, const Clock& clock);
+/// The other way round: a job's specification as a request carries it.
+SwarmJobSpec wire_job_spec(const swarm::JobSpec& spec, const Clock& clock);
 
 /// What a request asks the planner, as a call on `scheduler`.
 /// @throws std::invalid_argument on a request that is not well-formed, or as the planner throws.
@@ -41,6 +43,29 @@ SwarmPlan plan(const swarm::Scheduler& scheduler, const Clock& clock);
 
 /// The committed jobs that end after the present.
 std::vector<SwarmPlacedJob> upcoming_jobs(const swarm::Scheduler& scheduler, const Clock& clock);
+
+/// What a robot has committed, as a coordinator that restarted takes it over
+/// (Scheduler::add_node with a committed plan).
+struct CommittedPlan {
+  swarm::Trajectory trajectory;  ///< from the robot's time of answering on
+  std::vector<swarm::Job> jobs;  ///< by start
+  /// Nothing to take over: it stands for good and has no job (an idle robot).
+  bool idle() const;
+};
+
+/// The side of the square a job taken over is specified in, around its place (m): a robot tells
+/// where it works a job, not the area it was asked for.
+inline constexpr double kTakenOverJobArea = 0.1;
+
+/// A robot's answer to command `committed` (oscar/swarm_yaml.hpp: a Trajectory with one
+/// open-ended section from the robot's now, and its jobs not yet done in jobs_added) in the
+/// planner's terms. Each job's spec is its place as a square of kTakenOverJobArea, its window
+/// and its duration.
+/// @throws std::invalid_argument naming the rule: text that is no Trajectory, an answer for
+/// another robot, not exactly one open-ended section with waypoints, times that decrease, a job
+/// that ends before it starts.
+CommittedPlan committed_plan(const std::string& robot, const std::string& answer,
+                             const Clock& clock);
 
 /// "schedule", "periodic" ... for messages.
 std::string kind_name(SwarmRequestKind kind);

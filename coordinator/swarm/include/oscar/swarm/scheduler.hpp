@@ -76,6 +76,19 @@ class Scheduler {
   /// @throws std::invalid_argument on a duplicate id, bad numbers, a start inside an obstacle or
   /// too close to another node, or no free place to step aside to.
   void add_node(const NodeSpec& spec);
+  /// Adds a node that already drives a committed trajectory and works committed jobs (a
+  /// coordinator that restarted takes over what its predecessor committed): they become the
+  /// node's committed schedule as they are, so other nodes avoid them and new jobs of the node go
+  /// into its pauses like into any committed schedule. The node is at (spec.x, spec.y) at spec.t
+  /// (its first pause starts there); after the trajectory's last waypoint it stays there for good.
+  /// The jobs are single jobs (set memberships are not known); each carries its spec for a later
+  /// re-placement (break_down).
+  /// @throws std::invalid_argument as add_node(spec), or naming the node, the job and the rule:
+  /// the trajectory must hold spec.t (start at or before it) and have the node within 1 cm of
+  /// (spec.x, spec.y) then; each job must be valid as a new job (its id unused), not end before
+  /// spec.t, lie within its window, keep the node within 1 cm of its place while it lasts, and
+  /// not overlap another.
+  void add_node(const NodeSpec& spec, const Trajectory& committed, std::vector<Job> jobs);
 
   /// Schedules one job in a new transaction (seed §4.2.1, A.4).
   /// @throws std::invalid_argument on an invalid spec or an id already in use.
@@ -199,6 +212,9 @@ class Scheduler {
   NodeState& state(const std::string& id);
   const NodeState& state(const std::string& id) const;
   TransactionId open_transaction(bool atomic = false, std::string what = "");
+  void check_node_spec(const NodeSpec& spec) const;
+  void check_committed(const NodeSpec& spec, const Trajectory& committed,
+                       std::vector<Job>& jobs) const;
   const JobSet* set_of(const std::string& job_id) const;
   void keep_as_set(JobSet set, const std::vector<Job>& jobs);
   const Job* working_job(const std::string& id) const;
