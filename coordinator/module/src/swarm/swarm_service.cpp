@@ -431,15 +431,8 @@ struct SwarmService::Impl {
       auto r = std::make_shared<Request>(*from->second);
       r->message.kind(SWARM_SCHEDULE);
       r->message.jobs().clear();
-      SwarmJobSpec spec;
+      auto spec = swarm_wire::wire_job_spec(j.spec, clock);
       spec.id(j.id);
-      for (const auto& p : swarm::vertices(j.spec.area)) {
-        spec.area().x().push_back(p.x());
-        spec.area().y().push_back(p.y());
-      }
-      spec.earliest_start_ns(clock.ns(j.spec.earliest_start));
-      spec.latest_finish_ns(clock.ns(j.spec.latest_finish));
-      spec.duration_s(j.spec.duration);
       r->message.jobs().push_back(spec);
       r->attempts = 0;
       origin.erase(from);
