@@ -404,7 +404,8 @@ std::string snapshot_svg(const SnapshotOptions& o) {
       if (w.t_ns() > now) r.path.emplace_back(w.x(), w.y());
     }
     for (const auto& j : plan->jobs()) {
-      if (j.robot() != path.robot()) continue;
+      const auto end = j.start_ns() + static_cast<std::int64_t>(j.duration_s() * 1e9);
+      if (j.robot() != path.robot() || end <= now) continue;  // done since the plan came
       r.jobs.push_back(
           {Point(j.x(), j.y()),
            fmt::format("{} @{:+.1f}", j.id(), static_cast<double>(j.start_ns() - now) * 1e-9)});
