@@ -1,6 +1,6 @@
 #pragma once
-// oscar swarm submit and oscar swarm status: jobs to the running system's coordinator and what
-// its swarm looks like (docs/swarm.md, "The live swarm").
+// oscar swarm submit, status and snapshot: jobs to the running system's coordinator, what its
+// swarm looks like, and a picture of it (docs/swarm.md, "The live swarm").
 
 #include <string>
 #include <vector>
