@@ -8,6 +8,7 @@
 #include <cstring>
 #include <exception>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <optional>
 #include <stdexcept>
@@ -42,6 +43,21 @@ void write_output(const std::string& path, const std::string& text) {
   if (!out) throw OutputError(fmt::format("cannot write '{}': {}", path, std::strerror(errno)));
 }
 
+// Runs a command that writes its output through write_output(): exit code 0, 1 for an output
+// that could not be written, 2 for anything else (bad input, nobody answered), said on stderr.
+int run_writing(const char* command, const std::function<void()>& run) {
+  try {
+    run();
+  } catch (const OutputError& e) {
+    std::cerr << "oscar swarm " << command << ": " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "oscar swarm " << command << ": " << e.what() << "\n";
+    return 2;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -68,16 +84,9 @@ int main(int argc, char** argv) {
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 #ifdef OSCAR_SWARM_LIVE
   if (snapshot.command->parsed()) {
-    try {
+    return run_writing("snapshot", [&] {
       write_output(snapshot.output, oscar::swarm::tools::snapshot_svg(snapshot));
-    } catch (const OutputError& e) {
-      std::cerr << "oscar swarm snapshot: " << e.what() << "\n";
-      return 1;
-    } catch (const std::exception& e) {
-      std::cerr << "oscar swarm snapshot: " << e.what() << "\n";
-      return 2;
-    }
-    return 0;
+    });
   }
   if (submit.command->parsed() || status.command->parsed()) {
     const char* which = submit.command->parsed() ? "submit" : "status";
@@ -90,7 +99,7 @@ int main(int argc, char** argv) {
     }
   }
 #endif
-  try {
+  return run_writing("plan", [&] {
     auto problem = oscar::swarm::load_problem(problem_path);
     if (seed) problem.settings.seed = *seed;
     oscar::swarm::ProblemRunner runner(problem);
@@ -100,12 +109,5 @@ int main(int argc, char** argv) {
       write_output(svg, st_node.empty() ? oscar::swarm::tools::world_svg(runner.scheduler())
                                         : oscar::swarm::tools::st_svg(runner.scheduler(), st_node));
     }
-  } catch (const OutputError& e) {
-    std::cerr << "oscar swarm plan: " << e.what() << "\n";
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "oscar swarm plan: " << e.what() << "\n";
-    return 2;
-  }
-  return 0;
+  });
 }
