@@ -115,12 +115,6 @@ std::string snapshot_svg(const SnapshotOptions& o) {
   const auto states = robot_states(*participant, robots, std::chrono::milliseconds(2000));
   const auto now = wall_now();
   WorldPicture picture;
-  picture.caption = {
-      fmt::format("oscar swarm snapshot, {} robots, {} jobs to do: static obstacles (grey), moving "
-                  "obstacles now and their path (orange, dashed),",
-                  plan->paths().size(), plan->jobs().size()),
-      "robots now (discs; red: broken down) with their committed paths from now on (colour), "
-      "jobs (dots: id @ start in s from now)"};
   for (const auto& a : plan->static_obstacles()) picture.static_obstacles.push_back(polygon_of(a));
   for (const auto& m : plan->moving_obstacles()) {
     if (m.path().empty()) continue;
@@ -128,6 +122,7 @@ std::string snapshot_svg(const SnapshotOptions& o) {
     for (const auto& w : m.path()) drawn.path.emplace_back(w.x(), w.y());
     picture.moving_obstacles.push_back(std::move(drawn));
   }
+  std::size_t jobs_to_do = 0;
   for (const auto& path : plan->paths()) {
     WorldPicture::Robot r{path.robot(), {}, {}, std::nullopt, path.radius(), false};
     if (const auto s = states.find(path.robot()); s != states.end()) {
@@ -147,8 +142,15 @@ std::string snapshot_svg(const SnapshotOptions& o) {
           {Point(j.x(), j.y()),
            fmt::format("{} @{:+.1f}", j.id(), static_cast<double>(j.start_ns() - now) * 1e-9)});
     }
+    jobs_to_do += r.jobs.size();
     picture.robots.push_back(std::move(r));
   }
+  picture.caption = {
+      fmt::format("oscar swarm snapshot, {} robots, {} jobs to do: static obstacles (grey), moving "
+                  "obstacles now and their path (orange, dashed),",
+                  plan->paths().size(), jobs_to_do),
+      "robots now (discs; red: broken down) with their committed paths from now on (colour), "
+      "jobs (dots: id @ start in s from now)"};
   return world_svg(picture);
 }
 
