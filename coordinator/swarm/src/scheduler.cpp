@@ -36,11 +36,15 @@ Scheduler::Scheduler(World world, SchedulerSettings settings)
   if (!std::isfinite(settings_.wait_threshold) || settings_.wait_threshold < 0) {
     throw std::invalid_argument("settings.wait_threshold must be finite and >= 0");
   }
-  for (std::size_t i = 0; i < world_.dynamic_obstacles.size(); ++i) {
-    if (world_.dynamic_obstacles[i].trajectory.empty()) {
+  check_world(world_);
+}
+
+void Scheduler::check_world(const World& world) {
+  for (std::size_t i = 0; i < world.dynamic_obstacles.size(); ++i) {
+    if (world.dynamic_obstacles[i].trajectory.empty()) {
       throw std::invalid_argument(fmt::format("world.dynamic[{}]: trajectory is empty", i));
     }
-    for (const auto& w : world_.dynamic_obstacles[i].trajectory.points()) {
+    for (const auto& w : world.dynamic_obstacles[i].trajectory.points()) {
       check_time(w.t, fmt::format("world.dynamic[{}] trajectory time", i));
     }
   }
@@ -358,7 +362,7 @@ void Scheduler::record(TransactionId tx, NodeState& n, double lo, double hi) {
 
 TransactionId Scheduler::open_transaction(bool atomic, std::string what) {
   const TransactionId id = next_transaction_++;
-  transactions_[id] = Transaction{{}, atomic, std::move(what), {}};
+  transactions_[id] = Transaction{{}, atomic, std::move(what), {}, {}};
   return id;
 }
 
@@ -408,6 +412,11 @@ void Scheduler::finish(TransactionId tx, const std::string& node, bool commit) {
           "§4.2.2), not for node '{}' alone",
           tx, it->second.what, changes.size(), commit ? "commit" : "abort", node));
     }
+  }
+  const bool whole = node.empty() || (changes.size() == 1 && changes.begin()->first == node);
+  if (commit && whole) {
+    // Before the changes below end the memberships of the jobs they remove.
+    for (const auto& j : it->second.displaced_members) lost_.emplace(j.id, j);
   }
   for (auto c = changes.begin(); c != changes.end();) {
     if (!node.empty() && c->first != node) {

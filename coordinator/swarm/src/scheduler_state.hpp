@@ -39,6 +39,8 @@ struct Scheduler::Transaction {
   std::string what;  // for messages: "periodic set P1, P2"
   // unschedule_set: members a broken-down node lost that leave their set when this commits
   std::vector<std::string> lost_given_up;
+  // change_world: set members it removes, lost (as after break_down) when this commits
+  std::vector<Job> displaced_members;
 };
 
 // A periodic or dependent set (§4.2.3, §4.2.4): its members are unscheduled together or not at all.

@@ -122,6 +122,40 @@ std::optional<Trajectory> TrajectoryPlanner::fixed_arrival(const std::vector<Poi
   return compose(path, *profile);
 }
 
+std::optional<double> TrajectoryPlanner::first_hit(const Trajectory& trajectory, double lo,
+                                                   double hi) const {
+  // The trajectory over [lo, hi] as a spatial path and its s–t profile (s never decreases).
+  std::vector<Waypoint> w{{trajectory.position_at(lo).x(), trajectory.position_at(lo).y(), lo}};
+  for (const auto& p : trajectory.points()) {
+    if (p.t > lo && p.t < hi) w.push_back(p);
+  }
+  const Point end = trajectory.position_at(hi);
+  w.push_back({end.x(), end.y(), hi});
+  std::vector<Point> path{Point(w.front().x, w.front().y)};
+  std::vector<Point> profile{Point(0, lo)};
+  double s = 0;
+  for (std::size_t k = 1; k < w.size(); ++k) {
+    const Point p(w[k].x, w[k].y);
+    const double d = distance(path.back(), p);
+    if (d > kEpsilon) {
+      path.push_back(p);
+      s += d;
+    }
+    profile.emplace_back(s, w[k].t);
+  }
+  if (path.size() == 1) {  // it stands still all the while
+    for (const auto& [from, to] : blocked_times(path.front(), lo, hi)) {
+      if (to - from > kEpsilon) return from;
+    }
+    return std::nullopt;
+  }
+  const VelocityPlanner st(s, lo, regions(path, lo, hi), settings_);
+  for (std::size_t k = 1; k < profile.size(); ++k) {
+    if (!st.free(profile[k - 1], profile[k])) return profile[k - 1].y();
+  }
+  return std::nullopt;
+}
+
 Trajectory compose(const std::vector<Point>& path, const std::vector<Point>& profile) {
   std::vector<double> s(path.size(), 0.0);
   for (std::size_t i = 1; i < path.size(); ++i) s[i] = s[i - 1] + distance(path[i - 1], path[i]);

@@ -58,6 +58,15 @@ struct Slot {
   double detour = 0;      ///< Δs of eq. 4.5 (s1 + s2 - s12)
 };
 
+/// What Scheduler::change_world did.
+struct WorldChange {
+  bool ok = false;
+  std::string reason;              ///< why the change was refused (the world stayed as it was)
+  TransactionId transaction = 0;   ///< the open transaction re-planning nodes; 0: none had to
+  std::vector<std::string> nodes;  ///< the nodes it re-plans
+  std::vector<Job> displaced;      ///< jobs those nodes cannot keep in the changed world
+};
+
 /// Schedules jobs onto nodes and plans their trajectories (seed ch. 4): location sampling, idle
 /// slots by conditions 4.2–4.4, least detour first (4.5), path-velocity decomposition (§4.3),
 /// periodic (A.2) and dependent (A.3) sets atomically, and transactions (§4.2.7) whose alternative
@@ -143,6 +152,22 @@ class Scheduler {
   std::vector<Slot> qualifying_slots(const JobSpec& spec, const Point& at,
                                      TransactionId tx = 0) const;
 
+  /// The world changes while the swarm runs: obstacles are added or removed (beyond seed §4.1,
+  /// whose world is fixed). From the frozen horizon on the schedule lives in the new world: every
+  /// node whose trajectory after t_FH runs into it is planned again, all in one atomic
+  /// transaction — from where it is at t_FH, each of its jobs at its place and start where it
+  /// can still get there around the new obstacles, then idling as after any last job. The jobs
+  /// it cannot keep are removed and returned in `displaced`, to be placed again once the
+  /// transaction commits: a single job with schedule, a member of a periodic or dependent set
+  /// (which then is lost, as after break_down) with schedule_lost. Nothing before t_FH changes,
+  /// so a change that a node runs into before t_FH, or that covers the place of a job worked
+  /// then, is refused (`ok` false, the reason names the node and the time) and the world stays
+  /// as it was. If the transaction aborts, the world stays changed: call change_world again with
+  /// the same world to plan the nodes again, or with the old one to go back.
+  /// @throws std::invalid_argument on an invalid world (as the constructor) or while a
+  /// transaction is open (the change must not meet half-applied plans).
+  WorldChange change_world(World world);
+
   /// Removes a node that has no job left to do (seed §4.1, §5.5.2): every job of it ends before the
   /// present and no open transaction changes it. From then on it is no obstacle to anyone (§4.1:
   /// removed robots vanish).
@@ -213,6 +238,10 @@ class Scheduler {
   const NodeState& state(const std::string& id) const;
   TransactionId open_transaction(bool atomic = false, std::string what = "");
   void check_node_spec(const NodeSpec& spec) const;
+  static void check_world(const World& world);
+  std::optional<double> runs_into_world(const NodeState& n, double lo, double hi) const;
+  bool replan_in_world(NodeState& n, TransactionId tx, std::vector<Job>& displaced,
+                       std::string& reason);
   void check_committed(const NodeSpec& spec, const Trajectory& committed,
                        std::vector<Job>& jobs) const;
   const JobSet* set_of(const std::string& job_id) const;

@@ -38,6 +38,11 @@ class TrajectoryPlanner {
   /// Times in [lo, hi] when a node standing at p would be hit (stationary case, eq. 4.21).
   std::vector<std::pair<double, double>> blocked_times(const Point& p, double lo, double hi) const;
 
+  /// The first time in [lo, hi] at which `trajectory` runs into a moving obstacle (its s–t
+  /// profile enters a forbidden region of its own path), or none: a trajectory planned before
+  /// the obstacles changed, checked against them.
+  std::optional<double> first_hit(const Trajectory& trajectory, double lo, double hi) const;
+
  private:
   std::vector<Polygon> regions(const std::vector<Point>& path, double lo, double hi) const;
 
