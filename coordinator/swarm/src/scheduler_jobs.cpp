@@ -51,23 +51,27 @@ std::optional<Trajectory> Scheduler::idle_tail(const NodeState& n, const Traject
     return distance(at, a) < distance(at, b);
   });
   const SpatialPathFinder& free_space = finder(n);
+  // The nearest spot nothing crosses once the node is there; failing that, the nearest it can
+  // reach once whatever crosses it has passed (an obstacle going round a loop, unrolled for a
+  // span ahead, crosses its spots until the span ends: only the last resort).
+  std::optional<Trajectory> after_passing;
   for (const auto& p : spots) {
     if (!free_space.is_free(p)) continue;
     const auto path = planner.path(at, p);
     if (!path) continue;
     const auto arrival = planner.earliest_arrival(*path, t, kForever / 2);
     if (!arrival) continue;
-    // Arrive once whatever crosses the spot has passed, then stay for good.
     double settle = *arrival;
     for (const auto& [lo, hi] : planner.blocked_times(p, t, kForever)) {
       if (hi > settle && hi - lo > kEpsilon) settle = std::max(settle, hi);
     }
-    if (settle >= kForever / 2) continue;
+    if (settle >= kForever / 2 || (after_passing && settle > *arrival)) continue;
     auto leg = planner.fixed_arrival(*path, t, settle);
     if (!leg || !planner.blocked_times(p, settle, kForever).empty()) continue;
-    return leg;
+    if (settle == *arrival) return leg;
+    after_passing = std::move(leg);
   }
-  return std::nullopt;
+  return after_passing;
 }
 
 bool Scheduler::try_candidate(const Slot& c, const JobSpec& spec, TransactionId tx,
