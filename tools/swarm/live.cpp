@@ -174,9 +174,14 @@ std::vector<SwarmRequest> requests_of(const SubmitOptions& o, std::int64_t now) 
 
 int run_submit(const SubmitOptions& o) {
   const auto now = wall_now();
-  const auto requests = requests_of(o, now);
-  auto participant = o.system.participant("oscar-swarm-submit");
-  const std::string sender = fmt::format("oscar-swarm-submit-{}", getpid());
+  return send_requests(o.system, "submit", requests_of(o, now), o.timeout_s, o.json, now);
+}
+
+int send_requests(const SystemOptions& system, const std::string& command,
+                  const std::vector<SwarmRequest>& requests, double timeout_s, bool json,
+                  std::int64_t now) {
+  auto participant = system.participant("oscar-swarm-" + command);
+  const std::string sender = fmt::format("oscar-swarm-{}-{}", command, getpid());
   std::mutex mutex;
   std::condition_variable changed;
   std::map<unsigned long long, SwarmReply> final_replies;
@@ -184,19 +189,19 @@ int run_submit(const SubmitOptions& o) {
       *participant, topics::swarm_reply(), [&](const SwarmReply& r, const auto&) {
         if (r.sender() != sender) return;
         std::lock_guard lock(mutex);
-        if (o.json) fmt::print("{}\n", reply_json(r, now).dump());
+        if (json) fmt::print("{}\n", reply_json(r, now).dump());
         if (r.outcome() != SWARM_PLANNED) final_replies[r.request()] = r;
         changed.notify_all();
       });
   TopicWriter<SwarmRequest, SwarmRequestPubSubType> writer(*participant, topics::swarm_request());
-  const auto wait = std::chrono::milliseconds(static_cast<long>(o.timeout_s * 1000));
+  const auto wait = std::chrono::milliseconds(static_cast<long>(timeout_s * 1000));
   const auto until_matched = std::chrono::steady_clock::now() + wait;
   while (writer.matched() == 0 || replies.matched() == 0) {
     if (std::chrono::steady_clock::now() > until_matched) {
-      std::fprintf(stderr,
-                   "oscar swarm submit: no coordinator with a swarm reads oscar/swarm/request on "
-                   "domain %d (does the system file have coordinator: swarm:?)\n",
-                   participant->domain());
+      fmt::print(stderr,
+                 "oscar swarm {}: no coordinator with a swarm reads oscar/swarm/request on "
+                 "domain {} (does the system file have coordinator: swarm:?)\n",
+                 command, participant->domain());
       return 2;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -214,12 +219,12 @@ int run_submit(const SubmitOptions& o) {
   for (unsigned long long i = 1; i <= id; ++i) {
     const auto it = final_replies.find(i);
     if (it == final_replies.end()) {
-      fmt::print(stderr, "request {}: no outcome within {:.1f} s\n", i, o.timeout_s);
+      fmt::print(stderr, "request {}: no outcome within {:.1f} s\n", i, timeout_s);
       continue;
     }
     const auto& r = it->second;
     if (r.outcome() != SWARM_COMMITTED) code = std::max(code, 1);
-    if (o.json) continue;
+    if (json) continue;
     if (r.outcome() != SWARM_COMMITTED) {
       fmt::print("request {}: {}: {}\n", i, outcome_name(r.outcome()), r.reason());
       continue;
@@ -269,7 +274,8 @@ int run_status(const StatusOptions& o) {
                              {"jobs_committed", s.jobs_committed()},
                              {"naks", s.naks()},
                              {"timeouts", s.timeouts()},
-                             {"replans", s.replans()}};
+                             {"replans", s.replans()},
+                             {"obstacles", s.obstacles()}};
     fmt::print("{}\n", doc.dump(2));
     return 0;
   }
@@ -278,6 +284,8 @@ int run_status(const StatusOptions& o) {
   fmt::print("\njobs: {} submitted, {} committed, {} to do; open transactions: {}\n",
              s.jobs_submitted(), s.jobs_committed(), s.jobs().size(), s.open_transactions().size());
   fmt::print("naks: {}, timeouts: {}, re-plans: {}\n", s.naks(), s.timeouts(), s.replans());
+  fmt::print("obstacles: {}\n",
+             s.obstacles().empty() ? "none" : fmt::format("{}", fmt::join(s.obstacles(), ", ")));
   for (const auto& j : s.jobs()) {
     fmt::print("  {:<12} {:<10} ({:7.2f}, {:7.2f})  start {:+8.1f} s  {:6.1f} s\n", j.id(),
                j.robot(), j.x(), j.y(), static_cast<double>(j.start_ns() - s.now_ns()) * 1e-9,

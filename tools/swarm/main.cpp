@@ -80,6 +80,8 @@ int main(int argc, char** argv) {
   oscar::swarm::tools::add_submit(app, submit);
   oscar::swarm::tools::add_status(app, status);
   oscar::swarm::tools::add_snapshot(app, snapshot);
+  oscar::swarm::tools::WorldOptions world;
+  oscar::swarm::tools::add_world(app, world);
 #endif
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 #ifdef OSCAR_SWARM_LIVE
@@ -88,11 +90,14 @@ int main(int argc, char** argv) {
       write_output(snapshot.output, oscar::swarm::tools::snapshot_svg(snapshot));
     });
   }
-  if (submit.command->parsed() || status.command->parsed()) {
-    const char* which = submit.command->parsed() ? "submit" : "status";
+  if (submit.command->parsed() || status.command->parsed() || world.command->parsed()) {
+    const char* which = submit.command->parsed()   ? "submit"
+                        : status.command->parsed() ? "status"
+                                                   : "world";
     try {
-      return submit.command->parsed() ? oscar::swarm::tools::run_submit(submit)
-                                      : oscar::swarm::tools::run_status(status);
+      return submit.command->parsed()   ? oscar::swarm::tools::run_submit(submit)
+             : status.command->parsed() ? oscar::swarm::tools::run_status(status)
+                                        : oscar::swarm::tools::run_world(world);
     } catch (const std::exception& e) {
       std::cerr << "oscar swarm " << which << ": " << e.what() << "\n";
       return 2;

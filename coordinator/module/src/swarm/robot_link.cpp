@@ -51,6 +51,10 @@ void RobotLink::abort(const std::string& robot, unsigned long long transaction) 
   post(Decision{"abort", d});
 }
 
+void RobotLink::tell_world(const std::string& monitor, SwarmWorld world) {
+  post(WorldNews{monitor, std::move(world)});
+}
+
 std::string RobotLink::committed(const std::string& robot) {
   CommittedPlanQuery q;
   q.robot(robot);
@@ -98,6 +102,17 @@ void RobotLink::send(const Decision& d) {
   } catch (const std::runtime_error& e) {
     spdlog::warn("swarm: robot '{}' did not take {} of transaction {}: {}", d.decision.robot(),
                  d.name, d.decision.transaction(), e.what());
+  }
+}
+
+void RobotLink::send(const WorldNews& w) {
+  try {
+    const auto reply = client_.command(module_, w.monitor, "world", w.world, timeout_);
+    if (!reply.ok()) {
+      spdlog::error("swarm: safety monitor '{}' refused the world: {}", w.monitor, reply.error());
+    }
+  } catch (const std::exception& e) {
+    spdlog::warn("swarm: safety monitor '{}' was not told the world: {}", w.monitor, e.what());
   }
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // The coordinator's line to the robots of one module: proposals, commits and aborts go out in the
 // order they were posted (a commit never overtakes its proposal), through the module's
-// configuration topic, on a thread of its own so that a slow robot holds up nobody else.
+// configuration topic, on a thread of its own so that a slow robot holds up nobody else. Safety
+// monitors hear the world through it the same way.
 
 #include <chrono>
 #include <condition_variable>
@@ -39,6 +40,9 @@ class RobotLink {
   void propose(Trajectory trajectory);
   void commit(const std::string& robot, unsigned long long transaction);
   void abort(const std::string& robot, unsigned long long transaction);
+  /// Tells a safety monitor of this module the world (command `world`); a refusal or silence is
+  /// logged (the monitor keeps the world it had).
+  void tell_world(const std::string& monitor, SwarmWorld world);
 
   /// Asks the robot now, on the caller's thread, what it has committed (command `committed`):
   /// the answer's text, a Trajectory in YAML (oscar/swarm_yaml.hpp).
@@ -51,11 +55,16 @@ class RobotLink {
     std::string name;  // "commit" or "abort"
     TransactionDecision decision;
   };
-  using Message = std::variant<Trajectory, Decision>;
+  struct WorldNews {
+    std::string monitor;
+    SwarmWorld world;
+  };
+  using Message = std::variant<Trajectory, Decision, WorldNews>;
   void post(Message m);
   void run();
   void send(const Trajectory& t);
   void send(const Decision& d);
+  void send(const WorldNews& w);
 
   ConfigClient& client_;
   std::string module_;

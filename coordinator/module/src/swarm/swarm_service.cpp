@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "live_world.hpp"
 #include "oscar/config_client.hpp"
 #include "oscar/coordinator/cue_feed.hpp"
 #include "oscar/swarm_types.hpp"
@@ -36,18 +37,21 @@ struct SwarmService::Impl {
     // that a broken-down robot lost (any one of them names the set).
     struct LostMembers {
       std::string member;
-      std::string robot;
+      std::string cause;  // "robot 'r3' broke down", "the world changed"
     };
     std::optional<LostMembers> lost;
     // Set by end_set(): the message unschedules a set that cannot be whole again, and its
     // requester hears ABORTED for this reason.
     std::string ends_set_because;
+    // A world change (add or remove obstacles): the world it makes, while it is planned.
+    std::optional<LiveWorld> next_world;
   };
   // A transaction waiting for its robots' answers.
   struct Pending {
     std::shared_ptr<Request> request;
     std::set<std::string> asked, waiting;
     std::vector<swarm::Job> jobs;
+    std::vector<swarm::Job> displaced;  // a world change's: placed again once it commits
   };
   struct Robot {
     SwarmSetup::Robot setup;
@@ -64,11 +68,15 @@ struct SwarmService::Impl {
   SwarmSetup setup;
   DdsParticipant& participant;
   swarm_wire::Clock clock;
+  LiveWorld world;
   swarm::Scheduler scheduler;
   ConfigClient client;
   std::map<std::string, std::unique_ptr<RobotLink>> links;  // by module
   std::map<std::string, Robot> robots;
   std::map<TransactionId, Pending> pending;
+  // Requests held while a world change waits for the open transactions to finish (it must not
+  // meet half-applied plans), in the order they came.
+  std::deque<std::shared_ptr<Request>> held;
   // Where each committed job came from, to place it again when its robot breaks down.
   std::map<std::string, std::shared_ptr<Request>> origin;
   SwarmStatus counters;
@@ -89,8 +97,21 @@ struct SwarmService::Impl {
       : setup(std::move(s)),
         participant(p),
         clock{wall_now() / 1'000'000'000 * 1'000'000'000},
-        scheduler(setup.world, with_present(setup.settings, clock.seconds(wall_now()))),
+        world(live_world(setup.world)),
+        scheduler(planned(world, clock, clock.seconds(wall_now())),
+                  with_present(setup.settings, clock.seconds(wall_now()))),
         client(p, "coordinator") {}
+
+  static LiveWorld live_world(const std::vector<SwarmObstacle>& obstacles) {
+    LiveWorld w;
+    for (const auto& o : obstacles) w.add(o);
+    return w;
+  }
+
+  // The planner's world from just before `now` until loops must be unrolled again.
+  static swarm::World planned(const LiveWorld& w, const swarm_wire::Clock& clock, double now) {
+    return w.planned(clock, now - 1, now + LiveWorld::kLoopSpan);
+  }
 
   static swarm::SchedulerSettings with_present(swarm::SchedulerSettings s, double now) {
     s.present = now;
@@ -105,16 +126,25 @@ struct SwarmService::Impl {
     wake.notify_all();
   }
 
+  RobotLink& link_to(const std::string& module) {
+    auto& link = links[module];
+    if (!link) {
+      link = std::make_unique<RobotLink>(client, module, setup.ack_timeout,
+                                         [this](RobotLink::Answer a) { post(std::move(a)); });
+    }
+    return *link;
+  }
+
+  void tell_monitors() {
+    for (const auto& m : setup.monitors) link_to(m.module).tell_world(m.kernel, world.wire());
+  }
+
   void start() {
     for (const auto& r : setup.robots) {
-      auto& link = links[r.module];
-      if (!link) {
-        link = std::make_unique<RobotLink>(client, r.module, setup.ack_timeout,
-                                           [this](RobotLink::Answer a) { post(std::move(a)); });
-      }
+      RobotLink* link = &link_to(r.module);
       Robot robot;
       robot.setup = r;
-      robot.link = link.get();
+      robot.link = link;
       robot.state = std::make_unique<CueFeed<RobotState>>(participant, r.kernel + "/state");
       robots.emplace(r.kernel, std::move(robot));
     }
@@ -124,6 +154,7 @@ struct SwarmService::Impl {
         participant, topics::swarm_status());
     plan_writer = std::make_unique<TopicWriter<SwarmPlan, SwarmPlanPubSubType>>(
         participant, topics::swarm_plan());
+    tell_monitors();
     thread = std::thread([this] { run(); });
     requests = std::make_unique<TopicReader<SwarmRequest, SwarmRequestPubSubType>>(
         participant, topics::swarm_request(),
@@ -146,6 +177,7 @@ struct SwarmService::Impl {
   void run() {
     auto next_status = std::chrono::steady_clock::now();
     auto next_forget = next_status + 10s;
+    auto next_world = next_status + kWorldAgain;
     auto next_plan = next_status;
     for (;;) {
       std::deque<Event> batch;
@@ -161,9 +193,14 @@ struct SwarmService::Impl {
       for (auto& e : batch) {
         try {
           std::visit([this](auto& x) { handle(x); }, e);
+          release_held();
         } catch (const std::exception& ex) {
           spdlog::error("swarm: {}", ex.what());  // a bug of ours: said, and the loop goes on
         }
+      }
+      if (std::chrono::steady_clock::now() >= next_world) {
+        renew_world();
+        next_world = std::chrono::steady_clock::now() + kWorldAgain;
       }
       if (!batch.empty() || std::chrono::steady_clock::now() >= next_status) {
         publish_status(now);
@@ -193,6 +230,7 @@ struct SwarmService::Impl {
                                  r.ends_set_because, reason);
       outcome = SWARM_ABORTED;
     }
+    if (r.message.sender().empty()) return;  // the service's own request (renew_world)
     SwarmReply m;
     m.sender(r.message.sender());
     m.request(r.message.id());
@@ -207,7 +245,24 @@ struct SwarmService::Impl {
     auto r = std::make_shared<Request>();
     r->message = message;
     counters.jobs_submitted(counters.jobs_submitted() + jobs_in(message));
+    if (!held.empty()) {
+      held.push_back(r);
+      return;
+    }
     plan(r);
+  }
+
+  // Plans the held requests in order, until a world change meets open transactions.
+  void release_held() {
+    while (!held.empty() && (pending.empty() || !changes_world(held.front()->message))) {
+      auto r = held.front();
+      held.pop_front();
+      plan(r);
+    }
+  }
+
+  static bool changes_world(const SwarmRequest& m) {
+    return m.kind() == SWARM_ADD_OBSTACLES || m.kind() == SWARM_REMOVE_OBSTACLES;
   }
 
   static std::uint64_t jobs_in(const SwarmRequest& m) {
@@ -217,6 +272,10 @@ struct SwarmService::Impl {
   }
 
   void plan(const std::shared_ptr<Request>& r) {
+    if (changes_world(r->message)) {
+      plan_world(r);
+      return;
+    }
     swarm::ScheduleResult result;
     scheduler.set_excluded(r->refused_by);
     try {
@@ -235,15 +294,24 @@ struct SwarmService::Impl {
                                              r->attempts + 1, result.reason));
       return;
     }
-    const TransactionId tx = result.transaction;
-    Pending p{r, {}, {}, result.jobs};
+    propose(r, result.transaction, result.jobs, {});
+  }
+
+  // Asks the robots a transaction changes; it commits when they all acknowledged.
+  void propose(const std::shared_ptr<Request>& r, TransactionId tx, std::vector<swarm::Job> jobs,
+               std::vector<swarm::Job> displaced) {
+    Pending p{r, {}, {}, std::move(jobs), std::move(displaced)};
+    if (tx == 0) {  // nothing to ask anyone (a world change nobody runs into)
+      finish(tx, p);
+      return;
+    }
     for (const auto& change : scheduler.changes(tx)) {
       auto it = robots.find(change.node);
       p.asked.insert(change.node);
       it->second.link->propose(swarm_wire::proposal(scheduler, tx, change, clock));
     }
     p.waiting = p.asked;
-    reply(*r, SWARM_PLANNED, tx, "", result.jobs);
+    reply(*r, SWARM_PLANNED, tx, "", p.jobs);
     if (p.asked.empty()) {
       finish(tx, p);
       return;
@@ -292,12 +360,81 @@ struct SwarmService::Impl {
   }
 
   void finish(TransactionId tx, const Pending& p) {
-    scheduler.commit(tx);
+    if (tx) scheduler.commit(tx);
     plan_changed = true;
     for (const auto& robot : p.asked) robots.at(robot).link->commit(robot, tx);
     for (const auto& j : p.jobs) origin[j.id] = p.request;
     counters.jobs_committed(counters.jobs_committed() + p.jobs.size());
+    if (p.request->next_world) {
+      world = std::move(*p.request->next_world);
+      p.request->next_world.reset();
+      tell_monitors();
+    }
     reply(*p.request, SWARM_COMMITTED, tx, "", p.jobs);
+    for (auto& again : requests_to_place(p.displaced, "the world changed", {})) {
+      counters.replans(counters.replans() + 1);
+      plan(again);
+    }
+  }
+
+  // ---- the world ----
+
+  // How often loops are unrolled again and the monitors told the world again (a monitor that
+  // restarted has only its parameters).
+  static constexpr auto kWorldAgain = 30s;
+
+  // A world change is planned when no transaction is open: nodes that run into the new world
+  // after the frozen horizon are planned again in one transaction (Scheduler::change_world), and
+  // the world is the new one once it commits. Obstacles added count from the frozen horizon on.
+  void plan_world(const std::shared_ptr<Request>& r) {
+    if (!pending.empty()) {
+      held.push_front(r);
+      return;
+    }
+    LiveWorld next = world;
+    try {
+      if (r->message.kind() == SWARM_ADD_OBSTACLES) {
+        if (r->message.obstacles().empty() && !r->message.sender().empty()) {
+          throw std::invalid_argument("add_obstacles: no obstacle given");
+        }
+        for (auto o : r->message.obstacles()) {
+          o.since_ns(clock.ns(scheduler.frozen_horizon_time()));
+          next.add(std::move(o));
+        }
+      } else {
+        if (r->message.obstacle_names().empty()) {
+          throw std::invalid_argument("remove_obstacles: no obstacle named");
+        }
+        for (const auto& name : r->message.obstacle_names()) next.remove(name);
+      }
+      const auto change = scheduler.change_world(planned(next, clock, scheduler.present()));
+      if (!change.ok) {
+        give_up(*r, r->attempts == 0 ? SWARM_REFUSED : SWARM_ABORTED, 0, change.reason);
+        return;
+      }
+      r->next_world = std::move(next);
+      if (!change.nodes.empty()) {
+        spdlog::info("swarm: the world changes ({}); robots planned again: {}",
+                     swarm_wire::kind_name(r->message.kind()), fmt::join(change.nodes, ", "));
+      }
+      propose(r, change.transaction, {}, change.displaced);
+    } catch (const std::invalid_argument& e) {
+      reply(*r, SWARM_REFUSED, 0, e.what());
+    }
+  }
+
+  // Loops are unrolled for a span ahead: before the present gets near its end they are
+  // unrolled again (a world change that changes nothing else), and the monitors hear the world.
+  void renew_world() {
+    tell_monitors();
+    if (!world.has_loops()) return;
+    auto r = std::make_shared<Request>();
+    r->message.kind(SWARM_ADD_OBSTACLES);  // nothing: the same world, unrolled from now
+    if (held.empty() && pending.empty()) {
+      plan(r);
+    } else {
+      held.push_back(r);
+    }
   }
 
   // ---- robots ----
@@ -413,21 +550,31 @@ struct SwarmService::Impl {
     }
     const auto jobs = scheduler.break_down(id, scheduler.present(), swarm::Point(s.x(), s.y()));
     plan_changed = true;
+    for (auto& r : requests_to_place(jobs, fmt::format("robot '{}' broke down", id), again)) {
+      counters.replans(counters.replans() + 1);
+      plan(r);
+    }
+  }
+
+  // The requests that place `jobs` again (removed from a robot that broke down, or displaced by
+  // a changed world), after those in `again`: a single job alone, in its original window; the
+  // lost members of a set together, within the set, once per set.
+  std::vector<std::shared_ptr<Request>> requests_to_place(
+      const std::vector<swarm::Job>& jobs, const std::string& cause,
+      std::vector<std::shared_ptr<Request>> again) {
     for (const auto& j : jobs) {
       auto from = origin.find(j.id);
       if (from == origin.end()) continue;
       if (const std::string set = scheduler.set_name(j.id); !set.empty()) {
-        // A set member: the set's lost members are placed again together, within the set.
         if (!handles_set(again, set)) {
           auto r = std::make_shared<Request>(*from->second);
           r->attempts = 0;
-          r->lost = Request::LostMembers{j.id, id};
+          r->lost = Request::LostMembers{j.id, cause};
           again.push_back(r);
         }
         origin.erase(from);
         continue;
       }
-      // The job alone, in its original window: what is left of it is planned again.
       auto r = std::make_shared<Request>(*from->second);
       r->message.kind(SWARM_SCHEDULE);
       r->message.jobs().clear();
@@ -438,10 +585,7 @@ struct SwarmService::Impl {
       origin.erase(from);
       again.push_back(r);
     }
-    for (auto& r : again) {
-      counters.replans(counters.replans() + 1);
-      plan(r);
-    }
+    return again;
   }
 
   // True if one of `planned` places the lost members of `set` again or ends the set.
@@ -459,7 +603,16 @@ struct SwarmService::Impl {
   // broken-down robot left short and that cannot be whole again ends.
   void give_up(const Request& r, SwarmOutcome outcome, TransactionId tx,
                const std::string& reason) {
-    if (r.lost) {
+    if (changes_world(r.message)) {
+      if (!r.message.sender().empty()) {
+        // The planner goes back to the world as it is, first thing once no transaction is open
+        // (a change not made only removes obstacles from the planner's: nobody runs into that).
+        auto back = std::make_shared<Request>();
+        back->message.kind(SWARM_ADD_OBSTACLES);
+        held.push_front(back);
+      }
+      reply(r, outcome, tx, reason);
+    } else if (r.lost) {
       end_set(r, reason);
     } else {
       reply(r, outcome, tx, reason);
@@ -474,9 +627,8 @@ struct SwarmService::Impl {
     end->message = r.message;
     end->message.kind(SWARM_UNSCHEDULE_SET);
     end->message.job_id(r.lost->member);
-    end->ends_set_because =
-        fmt::format("robot '{}' broke down and the {} cannot be whole again: {}", r.lost->robot,
-                    scheduler.set_name(r.lost->member), why);
+    end->ends_set_because = fmt::format("{} and the {} cannot be whole again: {}", r.lost->cause,
+                                        scheduler.set_name(r.lost->member), why);
     spdlog::warn("swarm: {}", end->ends_set_because);
     plan(end);
   }
@@ -505,6 +657,7 @@ struct SwarmService::Impl {
     }
     s.jobs(swarm_wire::upcoming_jobs(scheduler, clock));
     s.open_transactions(scheduler.open_transactions());
+    for (const auto& o : world.obstacles()) s.obstacles().push_back(o.name());
     status_writer->write(s);
     std::lock_guard lock(mutex);
     published = std::move(s);

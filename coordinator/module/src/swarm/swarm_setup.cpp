@@ -1,8 +1,10 @@
 // The `coordinator: swarm:` section of a system file (docs/swarm.md, "The live swarm").
 #include <fmt/format.h>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
+#include "live_world.hpp"
 #include "oscar/coordinator/swarm_setup.hpp"
 #include "oscar/module_spec.hpp"
 #include "oscar/swarm/problem.hpp"
@@ -56,6 +58,117 @@ const SystemModule* host_of(const SystemSpec& system, const std::string& name,
   return nullptr;
 }
 
+// Kernels named in `key` (a list), or every kernel of `type` when the key is left out.
+std::vector<SwarmSetup::Robot> kernels(const SystemSpec& system, const YAML::Node& node,
+                                       const std::string& key, const std::string& type) {
+  std::vector<SwarmSetup::Robot> result;
+  const std::string& file = system.file;
+  if (const auto list = node[key]) {
+    if (!list.IsSequence())
+      fail(file, list, fmt::format("swarm.{}: expected a list of kernel names", key));
+    for (const auto& r : list) {
+      const auto name = r.IsScalar() ? r.Scalar() : std::string();
+      const auto* m = host_of(system, name);
+      if (!m) {
+        fail(file, r, fmt::format("swarm.{}: no kernel named '{}' in the system", key, name));
+      }
+      result.push_back({name, m->spec.name});
+    }
+    return result;
+  }
+  for (const auto& m : system.modules) {
+    for (const auto& k : m.spec.kernels) {
+      if (k.type == type) result.push_back({k.name, m.spec.name});
+    }
+  }
+  return result;
+}
+
+std::vector<double> numbers(const std::string& file, const YAML::Node& n, std::size_t count,
+                            const std::string& what) {
+  std::vector<double> v;
+  if (n.IsSequence() && n.size() == count) {
+    for (const auto& x : n) {
+      try {
+        v.push_back(x.as<double>());
+      } catch (const YAML::Exception&) {
+        break;
+      }
+    }
+  }
+  if (v.size() != count ||
+      !std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); })) {
+    fail(file, n,
+         fmt::format("{}: expected [{}] of finite numbers", what, count == 2 ? "x, y" : "x, y, t"));
+  }
+  return v;
+}
+
+// `world:`: static polygons as a problem file has them; moving obstacles go round loops in Unix
+// time, as the safety monitor's moving_obstacles.
+std::vector<SwarmObstacle> parse_live_world(const std::string& file, const YAML::Node& node) {
+  if (!node.IsMap()) fail(file, node, "swarm.world: expected a map (static, dynamic)");
+  check_yaml_keys(node, file, "swarm.world", {"static", "dynamic"});
+  LiveWorld world;
+  if (const auto st = node["static"]) {
+    YAML::Node only;
+    only["static"] = st;
+    const auto polygons = swarm::parse_world(only, file).static_obstacles;
+    for (std::size_t i = 0; i < polygons.size(); ++i) {
+      SwarmObstacle o;
+      o.name(fmt::format("static[{}]", i));
+      for (const auto& p : swarm::vertices(polygons[i])) {
+        o.shape().x().push_back(p.x());
+        o.shape().y().push_back(p.y());
+      }
+      world.add(std::move(o));
+    }
+  }
+  if (const auto dyn = node["dynamic"]) {
+    if (!dyn.IsSequence()) fail(file, dyn, "world.dynamic: expected a list of {name, shape, loop}");
+    for (std::size_t i = 0; i < dyn.size(); ++i) {
+      const auto e = dyn[i];
+      const std::string what = fmt::format("world.dynamic[{}]", i);
+      if (!e.IsMap()) fail(file, e, what + ": expected a map {name, shape, loop}");
+      if (e["trajectory"]) {
+        fail(file, e["trajectory"],
+             what +
+                 ": a running swarm's moving obstacle goes round a loop in Unix time: "
+                 "loop: [[x, y, t], ...] from t = 0 to its period, ending where it starts (it "
+                 "starts again at every multiple of the period since the Unix epoch), not a "
+                 "trajectory");
+      }
+      check_yaml_keys(e, file, what, {"name", "shape", "loop"});
+      SwarmObstacle o;
+      o.name(e["name"] && e["name"].IsScalar() ? e["name"].Scalar() : what);
+      const auto shape = e["shape"];
+      if (!shape || !shape.IsSequence()) fail(file, e, what + ".shape: expected [[x, y], ...]");
+      for (const auto& p : shape) {
+        const auto xy = numbers(file, p, 2, what + ".shape");
+        o.shape().x().push_back(xy[0]);
+        o.shape().y().push_back(xy[1]);
+      }
+      const auto loop = e["loop"];
+      if (!loop || !loop.IsSequence()) fail(file, e, what + ".loop: expected [[x, y, t], ...]");
+      for (const auto& p : loop) {
+        const auto xyt = numbers(file, p, 3, what + ".loop");
+        SwarmWaypoint w;
+        w.x(xyt[0]);
+        w.y(xyt[1]);
+        w.t_ns(std::llround(xyt[2] * 1e9));
+        o.path().push_back(w);
+      }
+      if (!o.path().empty()) o.loop_ns(o.path().back().t_ns());
+      try {
+        world.add(std::move(o));
+      } catch (const std::invalid_argument& ex) {
+        fail(file, e, fmt::format("{}: {}", what, ex.what()));
+      }
+    }
+  }
+  return world.obstacles();
+}
+
 }  // namespace
 
 std::optional<SwarmSetup> SwarmSetup::from(const SystemSpec& system) {
@@ -68,33 +181,18 @@ std::optional<SwarmSetup> SwarmSetup::from(const SystemSpec& system) {
   if (!node.IsMap()) fail(file, node, "coordinator.swarm: expected a map (robots, world, ...)");
   check_yaml_keys(
       node, file, "coordinator.swarm",
-      {"robots", "world", "frozen_horizon_ms", "ack_timeout_ms", "replan_attempts", "lost_after_ms",
-       "location_samples", "dependency_margin_s", "wait_threshold_s", "seed"});
+      {"robots", "monitors", "world", "frozen_horizon_ms", "ack_timeout_ms", "replan_attempts",
+       "lost_after_ms", "location_samples", "dependency_margin_s", "wait_threshold_s", "seed"});
   SwarmSetup s;
   s.where = yaml_where(file, node);
-  if (const auto robots = node["robots"]) {
-    if (!robots.IsSequence()) fail(file, robots, "swarm.robots: expected a list of kernel names");
-    for (const auto& r : robots) {
-      const auto name = r.IsScalar() ? r.Scalar() : std::string();
-      const auto* m = host_of(system, name);
-      if (!m) {
-        fail(file, r, fmt::format("swarm.robots: no kernel named '{}' in the system", name));
-      }
-      s.robots.push_back({name, m->spec.name});
-    }
-  } else {
-    for (const auto& m : system.modules) {
-      for (const auto& k : m.spec.kernels) {
-        if (k.type == "robot_sim") s.robots.push_back({k.name, m.spec.name});
-      }
-    }
-  }
+  s.robots = kernels(system, node, "robots", "robot_sim");
+  s.monitors = kernels(system, node, "monitors", "safety_monitor");
   if (s.robots.empty()) {
     fail(file, node,
          "coordinator.swarm: no robots (name them in robots:, or add robot_sim kernels)");
   }
   if (const auto world = node["world"]) {
-    s.world = swarm::parse_world(world, file);
+    s.world = parse_live_world(file, world);
   }
   auto& st = s.settings;
   st.frozen_horizon = 1.0;

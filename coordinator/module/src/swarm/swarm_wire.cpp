@@ -27,6 +27,10 @@ std::string kind_name(SwarmRequestKind kind) {
       return "reschedule";
     case SWARM_UNSCHEDULE_SET:
       return "unschedule_set";
+    case SWARM_ADD_OBSTACLES:
+      return "add_obstacles";
+    case SWARM_REMOVE_OBSTACLES:
+      return "remove_obstacles";
   }
   return "request kind " + std::to_string(static_cast<int>(kind));
 }
@@ -164,8 +168,11 @@ swarm::ScheduleResult apply(swarm::Scheduler& scheduler, const SwarmRequest& r,
       for (const auto& dep : r.depends()) d.depends[dep.job()] = dep.after();
       return scheduler.schedule(d);
     }
+    case SWARM_ADD_OBSTACLES:
+    case SWARM_REMOVE_OBSTACLES:
+      break;  // the world's, not the planner's jobs': the service changes the world
   }
-  throw std::invalid_argument(kind_name(r.kind()) + " is no request kind");
+  throw std::invalid_argument(kind_name(r.kind()) + " is no job request");
 }
 
 SwarmPlacedJob placed(const swarm::Job& job, const Clock& clock) {

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <oscar/swarm.h>
+
 #include "oscar/registry/system_spec.hpp"
 #include "oscar/swarm/scheduler.hpp"
 
@@ -20,7 +22,12 @@ struct SwarmSetup {
     std::string module;  ///< the module that hosts its pilot kernel
   };
   std::vector<Robot> robots;
-  swarm::World world;
+  /// The safety monitors the coordinator tells the world (command `world`); left out: every
+  /// kernel of type safety_monitor.
+  std::vector<Robot> monitors;
+  /// The obstacles: `static` polygons (named static[i]) and `dynamic` ones going round a loop in
+  /// Unix time ({name, shape, loop}; named dynamic[i] without a name).
+  std::vector<SwarmObstacle> world;
   swarm::SchedulerSettings settings;  ///< the present is the system clock
   /// How long a robot may take to answer a proposal before it counts as a NAK.
   std::chrono::milliseconds ack_timeout{500};
