@@ -5,6 +5,30 @@
 #include <limits>
 
 namespace oscar::modules::safety {
+namespace {
+
+// Twice the signed area of the triangle a, b, q: positive when q lies left of a->b, 0 when the
+// three are collinear. Exact signs matter more here than magnitudes.
+double cross(Point a, Point b, Point q) {
+  return (b.x - a.x) * (q.y - a.y) - (b.y - a.y) * (q.x - a.x);
+}
+
+int sign(double v) { return (v > 0) - (v < 0); }
+
+// Whether q, collinear with a and b, lies on the segment between them.
+bool within(Point a, Point b, Point q) {
+  return std::min(a.x, b.x) <= q.x && q.x <= std::max(a.x, b.x) && std::min(a.y, b.y) <= q.y &&
+         q.y <= std::max(a.y, b.y);
+}
+
+// Whether two edges that share the vertex s meet anywhere else: when their other ends u and v lie
+// on the same ray from s (one runs back along the other), or one of them has no length.
+bool fold_back(Point s, Point u, Point v) {
+  const double dot = (u.x - s.x) * (v.x - s.x) + (u.y - s.y) * (v.y - s.y);
+  return cross(s, u, v) == 0 && dot >= 0;
+}
+
+}  // namespace
 
 double signed_area(const Polygon& polygon) {
   double twice = 0;
@@ -54,6 +78,36 @@ double distance_to_edges(const Polygon& polygon, Point q) {
 double disc_clearance(const Polygon& polygon, Point centre, double radius) {
   const double d = distance_to_edges(polygon, centre);
   return contains(polygon, centre) ? -(d + radius) : d - radius;
+}
+
+bool segments_touch(Point a, Point b, Point c, Point d) {
+  const int a_side = sign(cross(c, d, a));
+  const int b_side = sign(cross(c, d, b));
+  const int c_side = sign(cross(a, b, c));
+  const int d_side = sign(cross(a, b, d));
+  if (a_side * b_side < 0 && c_side * d_side < 0) return true;  // a proper crossing
+  // Otherwise they meet only where an end of one lies on the other.
+  return (a_side == 0 && within(c, d, a)) || (b_side == 0 && within(c, d, b)) ||
+         (c_side == 0 && within(a, b, c)) || (d_side == 0 && within(a, b, d));
+}
+
+std::optional<std::pair<std::size_t, std::size_t>> self_contact(const Polygon& polygon) {
+  const auto n = polygon.size();
+  auto vertex = [&](std::size_t i) { return polygon[i % n]; };
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 1; j < n; ++j) {
+      bool meet = false;
+      if (j == i + 1) {  // edge j starts where edge i ends
+        meet = fold_back(vertex(j), vertex(i), vertex(j + 1));
+      } else if (i == 0 && j == n - 1) {  // edge i starts where edge j ends
+        meet = fold_back(vertex(0), vertex(1), vertex(j));
+      } else {
+        meet = segments_touch(vertex(i), vertex(i + 1), vertex(j), vertex(j + 1));
+      }
+      if (meet) return std::pair{i, j};
+    }
+  }
+  return std::nullopt;
 }
 
 Polygon translated(const Polygon& polygon, Point offset) {

@@ -4,7 +4,10 @@
 /// its loop. Written for the monitor alone: it checks the planner (coordinator/swarm) and so
 /// shares none of its code.
 
+#include <cstddef>
 #include <cstdint>
+#include <optional>
+#include <utility>
 #include <vector>
 
 namespace oscar::modules::safety {
@@ -36,6 +39,16 @@ double distance_to_edges(const Polygon& polygon, Point q);
 /// minus its radius when the centre is outside; minus (that distance plus the radius) when it is
 /// inside. Negative: the disc reaches into the polygon's interior by that much; 0: it touches.
 double disc_clearance(const Polygon& polygon, Point centre, double radius);
+
+/// Whether the closed segments a-b and c-d share at least one point (crossing, touching or
+/// overlapping).
+bool segments_touch(Point a, Point b, Point c, Point d);
+
+/// Two edges where the polygon's boundary meets itself (edge i runs from vertex i to vertex
+/// i + 1), or nothing if the polygon is simple. Consecutive edges may share their common vertex
+/// and nothing more: one folding back along the other, or a vertex repeated, counts as meeting.
+/// A polygon that meets itself has no well-defined inside for `contains` and `disc_clearance`.
+std::optional<std::pair<std::size_t, std::size_t>> self_contact(const Polygon& polygon);
 
 /// The polygon moved by `offset`.
 Polygon translated(const Polygon& polygon, Point offset);

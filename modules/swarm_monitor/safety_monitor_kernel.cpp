@@ -129,25 +129,25 @@ std::vector<std::string> SafetyMonitor::parse_inputs(const std::string& text) {
   return out;
 }
 
-std::vector<Polygon> SafetyMonitor::parse_static_obstacles(const std::string& text) {
+std::vector<safety::StaticObstacle> SafetyMonitor::parse_static_obstacles(const std::string& text) {
   const std::string param = "static_obstacles";
   const auto root = load_yaml(param, text);
-  std::vector<Polygon> out;
+  std::vector<safety::StaticObstacle> out;
   if (root.IsNull()) return out;
   if (!root.IsSequence()) {
     throw param_error(param, "must be a list of polygons, each a list of [x, y]");
   }
   for (std::size_t i = 0; i < root.size(); ++i) {
-    out.push_back(parse_polygon(param, fmt::format("obstacle {}", i), root[i]));
+    // Unnamed: its violations name it by its index, as they always have.
+    out.push_back({"", parse_polygon(param, fmt::format("obstacle {}", i), root[i]), 0});
   }
   return out;
 }
 
-std::vector<SafetyMonitor::MovingObstacle> SafetyMonitor::parse_moving_obstacles(
-    const std::string& text) {
+std::vector<safety::MovingObstacle> SafetyMonitor::parse_moving_obstacles(const std::string& text) {
   const std::string param = "moving_obstacles";
   const auto root = load_yaml(param, text);
-  std::vector<MovingObstacle> out;
+  std::vector<safety::MovingObstacle> out;
   if (root.IsNull()) return out;
   if (!root.IsSequence()) {
     throw param_error(param, "must be a list of {shape: [[x, y], ...], loop: [[x, y, t], ...]}");
@@ -165,7 +165,7 @@ std::vector<SafetyMonitor::MovingObstacle> SafetyMonitor::parse_moving_obstacles
                           fmt::format("{}: unknown key '{}' (it has shape and loop)", what, key));
       }
     }
-    MovingObstacle o;
+    safety::MovingObstacle o;
     o.shape = parse_polygon(param, what + ": shape", node["shape"]);
     const auto loop = node["loop"];
     if (!loop || !loop.IsSequence() || loop.size() < 2) {
@@ -183,14 +183,14 @@ std::vector<SafetyMonitor::MovingObstacle> SafetyMonitor::parse_moving_obstacles
       if (k == 0 && p.t != 0) {
         throw param_error(param, fmt::format("{}: the loop starts at t = 0, not {}", what, p.t));
       }
-      if (k > 0 && p.t < o.loop.back().t) {
+      if (k > 0 && p.t < o.path.back().t) {
         throw param_error(param, fmt::format("{}: loop point {} goes back in time ({} < {})", what,
-                                             k, p.t, o.loop.back().t));
+                                             k, p.t, o.path.back().t));
       }
-      o.loop.push_back(p);
+      o.path.push_back(p);
     }
-    const auto& first = o.loop.front();
-    const auto& last = o.loop.back();
+    const auto& first = o.path.front();
+    const auto& last = o.path.back();
     if (last.t <= 0) {
       throw param_error(param, fmt::format("{}: the loop's period (its last t) must be > 0", what));
     }
@@ -209,8 +209,9 @@ std::vector<SafetyMonitor::MovingObstacle> SafetyMonitor::parse_moving_obstacles
 SafetyMonitor::SafetyMonitor(KernelSetup& setup)
     : out_(setup.output<SafetyViolation>("violations", {.depth = 64, .reliable = true})) {
   setup.params(params_);
-  static_obstacles_ = parse_static_obstacles(params_.static_obstacles);
-  moving_obstacles_ = parse_moving_obstacles(params_.moving_obstacles);
+  obstacles_.static_obstacles = parse_static_obstacles(params_.static_obstacles);
+  obstacles_.moving_obstacles = parse_moving_obstacles(params_.moving_obstacles);
+  setup.command<SwarmWorld>("world", [this](const SwarmWorld& w) { return set_world(w); });
   std::set<std::string> names;
   for (const auto& name : setup.configured_inputs()) names.insert(name);
   for (const auto& name : parse_inputs(params_.inputs)) names.insert(name);
@@ -223,6 +224,44 @@ SafetyMonitor::SafetyMonitor(KernelSetup& setup)
     robots_.push_back({name, &setup.input<RobotState>(name, {.depth = 64})});
   }
   for (const auto* kind : kKinds) counts_[kind] = 0;
+}
+
+CommandAnswer SafetyMonitor::set_world(const SwarmWorld& world) {
+  safety::Obstacles obstacles;
+  try {
+    obstacles = safety::obstacles_of(world);
+  } catch (const std::invalid_argument& e) {
+    return CommandAnswer::refuse(e.what());
+  }
+  // A violation of an obstacle that left the world has ended; one of an obstacle that stays
+  // (the same kind and name) goes on, so that sending the same world again reports nothing anew.
+  std::set<std::string> labels;  // "kind|label"
+  for (std::size_t k = 0; k < obstacles.static_obstacles.size(); ++k) {
+    labels.insert("static_obstacle|" +
+                  safety::obstacle_label(obstacles.static_obstacles[k].name, k));
+  }
+  for (std::size_t k = 0; k < obstacles.moving_obstacles.size(); ++k) {
+    labels.insert("moving_obstacle|" +
+                  safety::obstacle_label(obstacles.moving_obstacles[k].name, k));
+  }
+  std::size_t ended = 0;
+  for (auto it = conditions_.begin(); it != conditions_.end();) {
+    // Keys of obstacles are "kind|input|label"; input names have no '|'.
+    const auto kind_end = it->first.find('|');
+    const auto input_end = it->first.find('|', kind_end + 1);
+    const auto kind = it->first.substr(0, kind_end);
+    const bool obstacle = kind == "static_obstacle" || kind == "moving_obstacle";
+    if (obstacle && !labels.count(kind + "|" + it->first.substr(input_end + 1))) {
+      ended += it->second.active ? 1 : 0;
+      it = conditions_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  obstacles_ = std::move(obstacles);
+  return CommandAnswer::accept(fmt::format(
+      "world: {} static, {} moving obstacles; violations ended with their obstacles: {}",
+      obstacles_.static_obstacles.size(), obstacles_.moving_obstacles.size(), ended));
 }
 
 std::uint64_t SafetyMonitor::count(const std::string& kind) const {
@@ -303,50 +342,10 @@ void SafetyMonitor::check(Cycle& cycle, std::size_t robot, const RobotState& sta
     evaluate(cycle, key, t, header, std::move(f));
   }
 
-  // (2) Static obstacles.
-  for (std::size_t k = 0; k < static_obstacles_.size(); ++k) {
-    const auto& polygon = static_obstacles_[k];
-    const double clearance = safety::disc_clearance(polygon, at, r);
-    std::optional<Finding> f;
-    if (clearance < -tol) {
-      f = Finding{"static_obstacle",
-                  {name},
-                  "",
-                  fmt::format("{} (radius {:.3f} m) at {} reaches {:.3f} m into static obstacle "
-                              "{} (centre {}, {:.3f} m from its edge; tolerance {} m)",
-                              name, r, point_text(at), -clearance, k,
-                              safety::contains(polygon, at) ? "inside" : "outside",
-                              safety::distance_to_edges(polygon, at), tol),
-                  at};
-    }
-    evaluate(cycle, fmt::format("static_obstacle|{}|{}", input, k), t, header, std::move(f));
-  }
+  // (2) Static and moving obstacles.
+  check_obstacles(cycle, robot, state);
 
-  // (3) Moving obstacles, where their loops have them at this state's time.
-  for (std::size_t k = 0; k < moving_obstacles_.size(); ++k) {
-    const auto& o = moving_obstacles_[k];
-    const double phase = safety::loop_phase_s(t, o.period_ns);
-    const auto origin = safety::loop_position(o.loop, phase);
-    const auto polygon = safety::translated(o.shape, origin);
-    const double clearance = safety::disc_clearance(polygon, at, r);
-    std::optional<Finding> f;
-    if (clearance < -tol) {
-      f = Finding{"moving_obstacle",
-                  {name},
-                  "",
-                  fmt::format("{} (radius {:.3f} m) at {} reaches {:.3f} m into moving obstacle "
-                              "{} at loop time {:.3f} s of {:.3f} s, its origin at {} (centre {}, "
-                              "{:.3f} m from its edge; tolerance {} m)",
-                              name, r, point_text(at), -clearance, k, phase,
-                              static_cast<double>(o.period_ns) * 1e-9, point_text(origin),
-                              safety::contains(polygon, at) ? "inside" : "outside",
-                              safety::distance_to_edges(polygon, at), tol),
-                  at};
-    }
-    evaluate(cycle, fmt::format("moving_obstacle|{}|{}", input, k), t, header, std::move(f));
-  }
-
-  // (4) The job it works: at its place, within its windows.
+  // (3) The job it works: at its place, within its windows.
   const auto& job = state.job();
   const auto job_prefix = fmt::format("job|{}|", input);
   const auto place_key = job.id().empty() ? "" : job_prefix + job.id() + "|place";
@@ -405,6 +404,69 @@ void SafetyMonitor::check(Cycle& cycle, std::size_t robot, const RobotState& sta
                 at};
   }
   evaluate(cycle, time_key, t, header, std::move(f));
+}
+
+void SafetyMonitor::check_obstacles(Cycle& cycle, std::size_t robot, const RobotState& state) {
+  const Stamp t = stamp_of(state, cycle.now());
+  const auto& input = robots_[robot].input;
+  const auto name = name_of(state, input);
+  const Point at{state.x(), state.y()};
+  const double r = state.radius();
+  const double tol = params_.distance_tolerance;
+  const auto& header = state.header();
+
+  // Static obstacles. One the coordinator added for later (since_ns) does not count for states
+  // stamped before then: a robot may legally be inside it until then.
+  for (std::size_t k = 0; k < obstacles_.static_obstacles.size(); ++k) {
+    const auto& o = obstacles_.static_obstacles[k];
+    const auto label = safety::obstacle_label(o.name, k);
+    std::optional<Finding> f;
+    const double clearance = safety::disc_clearance(o.polygon, at, r);
+    if (o.counts_at(t) && clearance < -tol) {
+      f = Finding{"static_obstacle",
+                  {name},
+                  "",
+                  fmt::format("{} (radius {:.3f} m) at {} reaches {:.3f} m into static obstacle "
+                              "{} (centre {}, {:.3f} m from its edge; tolerance {} m)",
+                              name, r, point_text(at), -clearance, label,
+                              safety::contains(o.polygon, at) ? "inside" : "outside",
+                              safety::distance_to_edges(o.polygon, at), tol),
+                  at};
+    }
+    evaluate(cycle, fmt::format("static_obstacle|{}|{}", input, label), t, header, std::move(f));
+  }
+
+  // Moving obstacles, where their paths have them at this state's time (a path driven once: only
+  // while it lasts), from since_ns on.
+  for (std::size_t k = 0; k < obstacles_.moving_obstacles.size(); ++k) {
+    const auto& o = obstacles_.moving_obstacles[k];
+    const auto label = safety::obstacle_label(o.name, k);
+    const auto origin = o.origin_at(t);
+    std::optional<Finding> f;
+    if (origin) {
+      const auto polygon = safety::translated(o.shape, *origin);
+      const double clearance = safety::disc_clearance(polygon, at, r);
+      if (clearance < -tol) {
+        const auto when =
+            o.period_ns > 0
+                ? fmt::format("loop time {:.3f} s of {:.3f} s", o.path_time_s(t),
+                              static_cast<double>(o.period_ns) * 1e-9)
+                : fmt::format("path time {:.3f} s of {:.3f} s", o.path_time_s(t), o.path.back().t);
+        f = Finding{
+            "moving_obstacle",
+            {name},
+            "",
+            fmt::format("{} (radius {:.3f} m) at {} reaches {:.3f} m into moving obstacle "
+                        "{} at {}, its origin at {} (centre {}, {:.3f} m from its edge; "
+                        "tolerance {} m)",
+                        name, r, point_text(at), -clearance, label, when, point_text(*origin),
+                        safety::contains(polygon, at) ? "inside" : "outside",
+                        safety::distance_to_edges(polygon, at), tol),
+            at};
+      }
+    }
+    evaluate(cycle, fmt::format("moving_obstacle|{}|{}", input, label), t, header, std::move(f));
+  }
 }
 
 void SafetyMonitor::evaluate(Cycle& cycle, const std::string& key, Stamp t, const CueHeader& header,

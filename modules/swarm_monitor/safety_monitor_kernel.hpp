@@ -12,6 +12,7 @@
 #include <oscar/swarm_types.hpp>
 
 #include "monitor_geometry.hpp"
+#include "monitor_obstacles.hpp"
 
 namespace oscar::modules {
 
@@ -32,14 +33,6 @@ class SafetyMonitor final : public Kernel {
     void describe(ParamSpec& spec);
   };
 
-  /// An obstacle moving along a closed loop; the loop starts again at every multiple of its
-  /// period since the Unix epoch.
-  struct MovingObstacle {
-    safety::Polygon shape;  ///< around the obstacle's own origin
-    std::vector<safety::LoopPoint> loop;
-    std::int64_t period_ns = 0;  ///< the loop's last t
-  };
-
   /// The kinds of violation, in the order the counts list them.
   static constexpr const char* kKinds[] = {"distance", "static_obstacle", "moving_obstacle", "job"};
 
@@ -48,12 +41,13 @@ class SafetyMonitor final : public Kernel {
   static std::vector<std::string> parse_inputs(const std::string& text);
   /// Parses parameter `static_obstacles` (YAML text; empty: none).
   /// @throws std::invalid_argument naming the obstacle and the rule it breaks.
-  static std::vector<safety::Polygon> parse_static_obstacles(const std::string& text);
+  static std::vector<safety::StaticObstacle> parse_static_obstacles(const std::string& text);
   /// Parses parameter `moving_obstacles` (YAML text; empty: none).
   /// @throws std::invalid_argument naming the obstacle and the rule it breaks.
-  static std::vector<MovingObstacle> parse_moving_obstacles(const std::string& text);
+  static std::vector<safety::MovingObstacle> parse_moving_obstacles(const std::string& text);
 
-  /// Declares one RobotState input per input the configuration names and per name in `inputs`.
+  /// Declares one RobotState input per input the configuration names and per name in `inputs`,
+  /// and command `world`.
   /// @throws std::invalid_argument without any input or on a bad obstacle.
   explicit SafetyMonitor(KernelSetup& setup);
   void process(Cycle& cycle) override;
@@ -89,7 +83,11 @@ class SafetyMonitor final : public Kernel {
     safety::Point at;
   };
 
+  /// Command `world`: the coordinator's world replaces all obstacles, those of the parameters
+  /// too; a bad one is refused and changes nothing.
+  CommandAnswer set_world(const SwarmWorld& world);
   void check(Cycle& cycle, std::size_t robot, const RobotState& state);
+  void check_obstacles(Cycle& cycle, std::size_t robot, const RobotState& state);
   std::optional<Place> place_of(std::size_t robot, Stamp t) const;
   /// Applies one evaluation of `key` at time t: reports `finding` if it starts a violation.
   void evaluate(Cycle& cycle, const std::string& key, Stamp t, const CueHeader& header,
@@ -98,8 +96,7 @@ class SafetyMonitor final : public Kernel {
 
   Params params_;
   std::vector<Robot> robots_;
-  std::vector<safety::Polygon> static_obstacles_;
-  std::vector<MovingObstacle> moving_obstacles_;
+  safety::Obstacles obstacles_;
   Output<SafetyViolation>& out_;
   std::map<std::string, Condition> conditions_;  // by key
   std::map<std::string, std::uint64_t> counts_;  // by kind

@@ -1,7 +1,10 @@
 #include "monitor_geometry.hpp"
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <optional>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -60,6 +63,35 @@ TEST(MonitorGeometry, DiscClearanceIsNegativeByHowFarTheDiscReachesIn) {
   // Near a corner from outside: distance to the vertex.
   EXPECT_NEAR(disc_clearance(kSquare, {1.3, 1.4}, 0.4), 0.1, 1e-12);
   EXPECT_NEAR(disc_clearance(kSquare, {1.3, 1.4}, 0.6), -0.1, 1e-12);
+}
+
+TEST(MonitorGeometry, SegmentsTouchWhenTheyCrossMeetAtAnEndOrOverlap) {
+  EXPECT_TRUE(segments_touch({0, 0}, {2, 2}, {0, 2}, {2, 0}));     // an X
+  EXPECT_TRUE(segments_touch({0, 0}, {2, 0}, {1, 0}, {1, 3}));     // a T: an end on the other
+  EXPECT_TRUE(segments_touch({0, 0}, {2, 0}, {1, 0}, {3, 0}));     // collinear, overlapping
+  EXPECT_TRUE(segments_touch({0, 0}, {2, 0}, {2, 0}, {3, 1}));     // end to end
+  EXPECT_FALSE(segments_touch({0, 0}, {2, 0}, {3, 0}, {4, 0}));    // collinear, apart
+  EXPECT_FALSE(segments_touch({0, 0}, {2, 0}, {1, 0.1}, {1, 3}));  // a T just short
+  EXPECT_FALSE(segments_touch({0, 0}, {2, 2}, {0, 1}, {1, 2}));    // parallel
+}
+
+TEST(MonitorGeometry, SelfContactFindsTheEdgesWhereAPolygonMeetsItself) {
+  using Edges = std::pair<std::size_t, std::size_t>;
+  EXPECT_EQ(self_contact(kSquare), std::nullopt);
+  EXPECT_EQ(self_contact(kL), std::nullopt);
+  EXPECT_EQ(self_contact(Polygon(kL.rbegin(), kL.rend())), std::nullopt);
+  EXPECT_EQ(self_contact({{0, 0}, {1, 0}, {0, 1}}), std::nullopt);
+  // A bow-tie: the edges (0, 0)-(1, 1) and (1, 0)-(0, 1) cross.
+  EXPECT_EQ(self_contact({{0, 0}, {1, 1}, {1, 0}, {0, 1}}), Edges(0, 2));
+  // Two squares touching at the vertex (1, 1), drawn as one polygon.
+  EXPECT_NE(self_contact({{0, 0}, {1, 0}, {1, 1}, {2, 1}, {2, 2}, {1, 2}, {1, 1}, {0, 1}}),
+            std::nullopt);
+  // Three collinear points: the closing edge runs back over the other two.
+  EXPECT_EQ(self_contact({{0, 0}, {1, 0}, {2, 0}}), Edges(0, 2));
+  // A spike: edge 1 runs back along edge 0.
+  EXPECT_EQ(self_contact({{0, 0}, {2, 0}, {1, 0}, {1, 1}}), Edges(0, 1));
+  // A vertex repeated: an edge of no length.
+  EXPECT_NE(self_contact({{0, 0}, {1, 0}, {1, 0}, {1, 1}}), std::nullopt);
 }
 
 TEST(MonitorGeometry, TranslatedMovesEveryVertex) {

@@ -12,6 +12,8 @@
 #include <oscar/swarm_types.hpp>
 #include <oscar/testing/conformance.hpp>
 
+#include "world_builder.hpp"
+
 namespace oscar::modules {
 namespace {
 using testing::ElementsAre;
@@ -20,6 +22,10 @@ using testing::IsEmpty;
 using testing::Not;
 using testing::SizeIs;
 using testing::ThrowsMessage;
+using world_builder::area;
+using world_builder::obstacle;
+using world_builder::waypoint;
+using world_builder::world;
 
 constexpr Stamp kSecond = 1'000'000'000;
 constexpr Stamp kT0 = 1'700'000'000 * kSecond;  // a Unix time, a multiple of 20 s
@@ -263,6 +269,130 @@ TEST(SafetyMonitor, AMovingObstacleSweepingOverAStandingRobotIsReportedAtItsLoop
   EXPECT_THAT(v[0]->detail(), HasSubstr("at loop time 15.000 s of 20.000 s, its origin at "
                                         "(4.000, 0.000)"));
   EXPECT_EQ(v[0]->count(), 2u);
+}
+
+// --- the coordinator's world (command `world`) ---
+
+const SwarmArea kPallet = area({{2, 0}, {4, 0}, {4, 2}, {2, 2}});
+const SwarmArea kUnitSquare = area({{-0.5, -0.5}, {0.5, -0.5}, {0.5, 0.5}, {-0.5, 0.5}});
+
+TEST(SafetyMonitor, AStaticObstacleOfTheWorldIsAViolationNamedFromItsSinceOn) {
+  auto h = monitor("{}", {"r1"});
+  const Stamp since = kT0 + 10 * kSecond;
+  const auto answer = h.command("world", world({obstacle("pallet", kPallet, {}, 0, since)}));
+  EXPECT_TRUE(answer.accepted);
+  EXPECT_EQ(answer.text,
+            "world: 1 static, 0 moving obstacles; violations ended with their obstacles: 0");
+
+  // Inside before since_ns: the coordinator added it for later, the robot may still be there.
+  h.feed("r1", robot("r1", 3, 1, since - 1));
+  h.step();
+  EXPECT_THAT(violations(h), IsEmpty());
+  h.feed("r1", robot("r1", 3, 1, since));
+  h.step();
+  const auto v = violations(h);
+  ASSERT_THAT(v, SizeIs(1));
+  EXPECT_EQ(v[0]->kind(), "static_obstacle");
+  EXPECT_THAT(v[0]->detail(), HasSubstr("r1 (radius 0.200 m) at (3.000, 1.000) reaches 1.200 m "
+                                        "into static obstacle 'pallet' (centre inside"));
+}
+
+TEST(SafetyMonitor, AMovingObstacleOnAPathDrivenOnceIsAViolationOnlyWhileItIsThere) {
+  // A 1 m square drives from (0, 0) at kT0 to (8, 0) at kT0 + 8 s, and then leaves the world.
+  const auto cart = world(
+      {obstacle("cart", kUnitSquare, {waypoint(0, 0, kT0), waypoint(8, 0, kT0 + 8 * kSecond)})});
+  // A fresh monitor per state: each judged on its own.
+  auto judged = [&](double x, Stamp t) {
+    auto h = monitor("{}", {"r1"});
+    EXPECT_TRUE(h.command("world", cart).accepted);
+    h.feed("r1", robot("r1", x, 0, t));
+    h.step();
+    return violations(h);
+  };
+  const auto v = judged(4, kT0 + 4 * kSecond);
+  ASSERT_THAT(v, SizeIs(1));
+  EXPECT_EQ(v[0]->kind(), "moving_obstacle");
+  EXPECT_THAT(v[0]->detail(),
+              HasSubstr("r1 (radius 0.200 m) at (4.000, 0.000) reaches 0.700 m into moving "
+                        "obstacle 'cart' at path time 4.000 s of 8.000 s, its origin at (4.000, "
+                        "0.000) (centre inside"));
+  EXPECT_THAT(judged(4, kT0 + 1 * kSecond), IsEmpty()) << "the cart is at (1, 0) then";
+  EXPECT_THAT(judged(8, kT0 + 8 * kSecond), SizeIs(1)) << "the path's last point counts";
+  EXPECT_THAT(judged(8, kT0 + 8 * kSecond + kSecond / 10), IsEmpty()) << "after the path";
+  EXPECT_THAT(judged(0, kT0 - kSecond / 10), IsEmpty()) << "before the path";
+}
+
+TEST(SafetyMonitor, TheWorldReplacesTheParametersObstacles) {
+  const std::string params =
+      "{static_obstacles: '[[[2, 0], [4, 0], [4, 2], [2, 2]]]', moving_obstacles: '[{shape: "
+      "[[0, 0], [1, 0], [1, 1], [0, 1]], loop: [[20, 0, 0], [20, 0, 10]]}]'}";
+  auto inside_both = [](KernelHarness& h) {
+    h.feed("r1", robot("r1", 3, 1, kT0));       // in the static obstacle
+    h.feed("r2", robot("r2", 20.5, 0.5, kT0));  // in the moving one
+    h.step();
+    return violations(h);
+  };
+  auto before = monitor(params);
+  EXPECT_THAT(inside_both(before), SizeIs(2)) << "the parameters' obstacles count until then";
+
+  auto h = monitor(params);
+  const auto answer =
+      h.command("world", world({obstacle("pallet", area({{9, 9}, {10, 9}, {10, 10}}))}));
+  EXPECT_TRUE(answer.accepted) << answer.text;
+  EXPECT_THAT(answer.text, HasSubstr("world: 1 static, 0 moving obstacles"));
+  EXPECT_THAT(inside_both(h), IsEmpty());
+}
+
+TEST(SafetyMonitor, AViolationEndsWithItsObstacleAndGoesOnWhileTheWorldKeepsIt) {
+  auto h = monitor("{}", {"r1"});
+  const auto pallet = world({obstacle("pallet", kPallet)});
+  ASSERT_TRUE(h.command("world", pallet).accepted);
+  h.feed("r1", robot("r1", 3, 1, kT0));
+  h.step();
+  EXPECT_THAT(violations(h), SizeIs(1));
+  // The same world again (as the coordinator sends it after any change): the same violation.
+  EXPECT_THAT(h.command("world", pallet).text, HasSubstr("ended with their obstacles: 0"));
+  h.feed("r1", robot("r1", 3, 1, kT0 + 1));
+  h.step();
+  EXPECT_THAT(violations(h), IsEmpty());
+  // Without the pallet, the violation ends; with it back, a robot still inside is a new one.
+  EXPECT_EQ(h.command("world", world({})).text,
+            "world: 0 static, 0 moving obstacles; violations ended with their obstacles: 1");
+  ASSERT_TRUE(h.command("world", pallet).accepted);
+  h.feed("r1", robot("r1", 3, 1, kT0 + 2));
+  h.step();
+  EXPECT_THAT(violations(h), SizeIs(1));
+  EXPECT_EQ(kernel(h).count("static_obstacle"), 2u);
+}
+
+TEST(SafetyMonitor, ABadWorldIsRefusedWithAReasonAndChangesNothing) {
+  auto h = monitor("{}", {"r1", "r2"});
+  ASSERT_TRUE(h.command("world", world({obstacle("pallet", kPallet)})).accepted);
+  // Each bad world would drop the pallet and add a crate at (10, 10), were it taken.
+  const auto crate = obstacle("crate", area({{9, 9}, {11, 9}, {11, 11}, {9, 11}}));
+  auto refused = [&](const SwarmObstacle& bad, const std::string& reason) {
+    const auto answer = h.command("world", world({crate, bad}));
+    EXPECT_FALSE(answer.accepted) << reason;
+    EXPECT_THAT(answer.text, HasSubstr(reason));
+  };
+  refused(obstacle("bow", area({{0, 0}, {1, 1}, {1, 0}, {0, 1}})),
+          "world: obstacle 'bow': its shape meets itself at edges 0 and 2 (a polygon must not "
+          "intersect itself)");
+  refused(obstacle("crate", kUnitSquare),
+          "world: obstacle 'crate': obstacles 0 and 1 share the name (names are unique)");
+  refused(obstacle("forklift", kUnitSquare,
+                   {waypoint(0, 0, 0), waypoint(4, 0, 5 * kSecond), waypoint(8, 0, 10 * kSecond)},
+                   10 * kSecond),
+          "world: obstacle 'forklift': its loop's first and last points differ: (0.000, 0.000) "
+          "and (8.000, 0.000) (a loop ends where it starts)");
+
+  h.feed("r1", robot("r1", 3, 1, kT0));    // in the pallet
+  h.feed("r2", robot("r2", 10, 10, kT0));  // in the crate
+  h.step();
+  const auto v = violations(h);
+  ASSERT_THAT(v, SizeIs(1));
+  EXPECT_THAT(v[0]->robots(), ElementsAre("r1"));
+  EXPECT_THAT(v[0]->detail(), HasSubstr("static obstacle 'pallet'"));
 }
 
 // --- (4) jobs ---
