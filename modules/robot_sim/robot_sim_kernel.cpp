@@ -66,6 +66,10 @@ void RobotSim::Params::describe(ParamSpec& spec) {
              "fault injection: the answer to a proposal waits this long, ms (keep it below the "
              "module's watchdog)")
       .range(0, 60000);
+  spec.field("undecided_for", undecided_for,
+             "a proposal with no commit or abort is dropped once its first section began this "
+             "long ago (a coordinator that restarted forgot its open transactions)")
+      .range(0.001, 3600);
 }
 
 RobotSim::RobotSim(KernelSetup& setup)
@@ -129,6 +133,7 @@ void RobotSim::process(Cycle& cycle) {
   }
   committed_.forget_before(now);
   std::erase_if(jobs_, [&](const auto& kv) { return kv.second.end_ns() < now; });
+  drop_undecided(cycle, now);
   RobotState s = state_at(now, committed_.at(now));
   if (!broken_) {
     s.job(job_at(now));
@@ -249,6 +254,22 @@ std::string RobotSim::refusal(const Trajectory& request, Stamp now) const {
     }
   }
   return {};
+}
+
+void RobotSim::drop_undecided(Cycle& cycle, Stamp now) {
+  for (auto it = pending_.begin(); it != pending_.end();) {
+    Stamp begins = now;
+    for (const auto& s : it->second.sections()) begins = std::min(begins, s.from_ns());
+    if (now - begins <= params_.undecided_for.count()) {
+      ++it;
+      continue;
+    }
+    cycle.log().info(
+        "robot '{}' drops transaction {}: no commit or abort came, and it began "
+        "{:.1f} s ago",
+        name_, it->first, static_cast<double>(now - begins) * 1e-9);
+    it = pending_.erase(it);
+  }
 }
 
 CommandAnswer RobotSim::propose(const Trajectory& request) {

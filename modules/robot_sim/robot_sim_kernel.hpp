@@ -32,6 +32,8 @@ class RobotSim final : public Kernel {
     int seed = 1;                   ///< of the random NAKs
     double breakdown_after_s = -1;  ///< after activation; negative = never
     int ack_delay_ms = 0;           ///< the answer to `propose` waits this long
+    /// A proposal nobody decided on is dropped once its first section began this long ago.
+    std::chrono::nanoseconds undecided_for{std::chrono::seconds(10)};
     void describe(ParamSpec& spec);
   };
   explicit RobotSim(KernelSetup& setup);
@@ -49,6 +51,7 @@ class RobotSim final : public Kernel {
   Stamp command_time() const;
   void clock(Stamp now);
   void break_down_if_due(Stamp now);
+  void drop_undecided(Cycle& cycle, Stamp now);
   RobotJob job_at(Stamp now) const;  // id empty: none
   RobotState state_at(Stamp now, const Motion& m) const;
 

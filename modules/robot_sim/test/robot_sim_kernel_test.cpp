@@ -289,6 +289,22 @@ TEST(RobotSim, AbortDropsTheProposal) {
   EXPECT_EQ(r.at(2).x(), 0);
 }
 
+// A coordinator that restarted forgot its open transactions: their proposals do not stay for
+// good, only until they began `undecided_for` ago.
+TEST(RobotSim, AProposalNobodyDecidesOnIsDroppedOnceItBeganLongAgo) {
+  Robot r("{undecided_for: 5s}");
+  ASSERT_TRUE(r.propose(proposal("r1", 7, {open(at_s(1), {wp(0, 0, at_s(1)), wp(2, 0, at_s(3))})}))
+                  .accepted);
+  ASSERT_TRUE(r.propose(proposal("r1", 8, {open(at_s(5), {wp(0, 0, at_s(5)), wp(0, 2, at_s(7))})}))
+                  .accepted);
+  r.at(5.9);  // 4.9 s after 7 began: kept
+  EXPECT_EQ(r.abort(9).text, "no proposal of transaction 9 is pending (pending: 7, 8)");
+  r.at(6.1);
+  EXPECT_EQ(r.commit(7).text, "no proposal of transaction 7 is pending (pending: 8)");
+  EXPECT_EQ(r.at(6.2).x(), 0) << "the dropped proposal changed nothing";
+  EXPECT_TRUE(r.commit(8).accepted);
+}
+
 TEST(RobotSim, ADecisionOnAnUnknownTransactionOrForAnotherRobotIsRefused) {
   Robot r;
   ASSERT_TRUE(r.propose(proposal("r1", 4, {open(at_s(1), {wp(0, 0, at_s(1)), wp(1, 0, at_s(2))})}))
