@@ -39,9 +39,11 @@ WorldChange Scheduler::change_world(World world) {
       if (n.broken) continue;  // it stands where it stopped, whatever the world
       if (const auto t = runs_into_world(n, settings_.present, frozen_horizon_time())) {
         result.reason = fmt::format(
-            "node '{}' runs into the changed world at {} (at {:.3f}), before the frozen horizon "
-            "{:.3f}, where its trajectory cannot change any more",
-            n.spec.id, place_text(n.committed.position_at(*t)), *t, frozen_horizon_time());
+            "node '{}' runs into the changed world at {} at t = {:.3f} ({:.3f} s from now), "
+            "before the frozen horizon ({:.3f} s from now), where its trajectory cannot change "
+            "any more",
+            n.spec.id, place_text(n.committed.position_at(*t)), *t, *t - settings_.present,
+            settings_.frozen_horizon);
         return refuse(tx);
       }
       if (!runs_into_world(n, frozen_horizon_time(), kForever)) continue;
