@@ -31,8 +31,9 @@ struct KeystoreSettings {
 /// re-signs governance and permissions that no longer match the system file. Identities the
 /// system no longer has are left in place (and reported).
 /// @returns one line per thing done or kept, for the user.
-/// @throws std::runtime_error if a CA has a certificate without its key or the reverse (a new
-///         CA would orphan every identity), or a file cannot be written.
+/// @throws std::runtime_error if `dir` is a non-empty folder without identities/ (not a
+///         keystore), if a CA has a certificate without its key or the reverse (a new CA would
+///         orphan every identity), or if a file cannot be written.
 std::vector<std::string> init_keystore(const SystemSpec& system, const std::filesystem::path& dir,
                                        const KeystoreSettings& settings = {});
 

@@ -135,8 +135,16 @@ std::vector<std::string> init_keystore(const SystemSpec& system, const fs::path&
                                        const KeystoreSettings& settings) {
   std::vector<std::string> said;
   const bool existed = fs::exists(dir);
-  if (existed && others_may_read(dir))
+  // init makes the folder owner-only and writes into it: never do that to a folder of something
+  // else (a mistyped --keystore $HOME).
+  if (existed && !fs::is_directory(dir / "identities") && !fs::is_empty(dir)) {
+    throw std::runtime_error(fmt::format(
+        "{} exists and is no keystore (it has no identities/ folder): give a new or empty folder",
+        dir.string()));
+  }
+  if (existed && others_may_read(dir)) {
     said.push_back("made " + dir.string() + " owner-only (0700)");
+  }
   make_private_dir(dir);
   make_private_dir(dir / "private");
   fs::create_directories(dir / "public");

@@ -215,6 +215,22 @@ TEST_F(Keystore, ACaWithoutItsKeyIsRefusedRatherThanReplaced) {
   }
 }
 
+TEST_F(Keystore, InitRefusesAFolderThatHoldsSomethingElse) {
+  fs::create_directories(dir_);
+  std::ofstream(dir_ / "notes.txt") << "mine";
+  fs::permissions(dir_, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec,
+                  fs::perm_options::replace);
+  try {
+    init_keystore(system_of(), dir_);
+    ADD_FAILURE() << "took over a folder that is no keystore";
+  } catch (const std::runtime_error& e) {
+    EXPECT_THAT(e.what(), HasSubstr("exists and is no keystore (it has no identities/ folder)"));
+  }
+  EXPECT_EQ(mode_of(dir_), 0750u) << "its mode was changed";
+  fs::remove(dir_ / "notes.txt");
+  EXPECT_NO_THROW(init_keystore(system_of(), dir_)) << "an empty folder is fine";
+}
+
 TEST_F(Keystore, ListShowsWhatEachIdentityMayPublishFromItsSignedPermissions) {
   init_keystore(system_of(), dir_);
   const auto listed = list_keystore(dir_);
