@@ -35,19 +35,28 @@ std::string escaped(const std::string& text) {
   return out;
 }
 
-const char* kind(SecuritySpec::CueProtection p) {
+// The protection of a cue topic's submessages (metadata) and of its samples (data). "sign"
+// signs the whole DATA submessage, sample included, and leaves the sample itself alone: Fast DDS
+// 2.9 cannot decode a sample signed on its own (data SIGN) when its serialized form ends in
+// padding (secure_participants_test saw every sample dropped; fixed upstream only in 2026).
+struct Protection {
+  const char* metadata;
+  const char* data;
+};
+
+Protection protection(SecuritySpec::CueProtection p) {
   switch (p) {
     case SecuritySpec::CueProtection::kNone:
-      return "NONE";
+      return {"NONE", "NONE"};
     case SecuritySpec::CueProtection::kSign:
-      return "SIGN";
+      return {"SIGN", "NONE"};
     case SecuritySpec::CueProtection::kEncrypt:
-      return "ENCRYPT";
+      return {"ENCRYPT", "ENCRYPT"};
   }
-  return "ENCRYPT";
+  return {"ENCRYPT", "ENCRYPT"};
 }
 
-std::string topic_rule(const std::string& expression, const char* metadata, const char* data) {
+std::string topic_rule(const std::string& expression, Protection p) {
   return fmt::format(
       "        <topic_rule>\n"
       "          <topic_expression>{}</topic_expression>\n"
@@ -58,7 +67,7 @@ std::string topic_rule(const std::string& expression, const char* metadata, cons
       "          <metadata_protection_kind>{}</metadata_protection_kind>\n"
       "          <data_protection_kind>{}</data_protection_kind>\n"
       "        </topic_rule>\n",
-      escaped(expression), metadata, data);
+      escaped(expression), p.metadata, p.data);
 }
 
 std::string topic_list(const char* element, const std::vector<std::string>& topics) {
@@ -93,10 +102,10 @@ std::string governance_xml(SecuritySpec::CueProtection cue) {
       "    </domain_rule>\n"
       "  </domain_access_rules>\n"
       "</dds>\n",
-      kAllDomains, topic_rule(std::string(topics::kCuePrefix) + "*", kind(cue), kind(cue)),
-      topic_rule(topics::pull_request("*").name, kind(cue), kind(cue)),
-      topic_rule(topics::pull_reply("*").name, kind(cue), kind(cue)),
-      topic_rule("*", "SIGN", "ENCRYPT"));
+      kAllDomains, topic_rule(std::string(topics::kCuePrefix) + "*", protection(cue)),
+      topic_rule(topics::pull_request("*").name, protection(cue)),
+      topic_rule(topics::pull_reply("*").name, protection(cue)),
+      topic_rule("*", {"SIGN", "ENCRYPT"}));
 }
 
 std::string permissions_xml(const IdentityPolicy& identity, const std::string& subject_rfc2253,

@@ -10,8 +10,9 @@
 namespace oscar::security {
 
 /// The system-wide rules: no unauthenticated participants, discovery and liveliness encrypted,
-/// write access control on every topic; cue and pull topics protected as `cue` says, every
-/// other (control) topic signed and its data encrypted.
+/// write access control on every topic; cue and pull topics protected as `cue` says (none;
+/// sign: submessages signed; encrypt: submessages and data encrypted), every other (control)
+/// topic with submessages signed and data encrypted.
 std::string governance_xml(SecuritySpec::CueProtection cue);
 
 /// What `identity` may do, for the holder of the certificate with subject `subject_rfc2253`,
