@@ -41,12 +41,15 @@ modules:
 )";
 constexpr const char* kCueTopic = "oscar/cue/talker/out";
 
+constexpr int kParticipantIds = 8;
+
 // One participant on loopback only: UDP on 127.0.0.1, discovery unicast to the well-known ports
-// of the first participant ids on this host (like OSCAR's own participants, network.hpp), with
-// the DDS Security properties of an identity (none: an unauthenticated participant).
+// of participant ids 0..7 on this host (like OSCAR's own participants, network.hpp), with the
+// DDS Security properties of an identity (none: an unauthenticated participant). Ids are given:
+// Fast DDS counts its automatic ids up for the whole process, past the ports the peers name.
 class Participant {
  public:
-  explicit Participant(const std::vector<security_files::Property>& properties) {
+  Participant(int id, const std::vector<security_files::Property>& properties) {
     dds::DomainParticipantQos qos;
     qos.name("oscar-security-test");
     for (const auto& [name, value] : properties) {
@@ -60,12 +63,14 @@ class Participant {
     auto& builtin = qos.wire_protocol().builtin;
     builtin.avoid_builtin_multicast = true;
     const int domain = test::test_domain();
-    for (int id = 0; id < 8; ++id) {
+    for (int peer_id = 0; peer_id < kParticipantIds; ++peer_id) {
       eprosima::fastrtps::rtps::Locator_t peer;
       eprosima::fastrtps::rtps::IPLocator::setIPv4(peer, "127.0.0.1");
-      peer.port = static_cast<std::uint32_t>(7400 + 250 * domain + 10 + 2 * id);  // RTPS 9.6.1.1
+      // The metatraffic unicast port of RTPS 2.2 §9.6.1.1.
+      peer.port = static_cast<std::uint32_t>(7400 + 250 * domain + 10 + 2 * peer_id);
       builtin.initialPeersList.push_back(peer);
     }
+    qos.wire_protocol().participant_id = id;
     participant_ = dds::DomainParticipantFactory::get_instance()->create_participant(domain, qos);
     if (!participant_) return;
     type_.register_type(participant_);
@@ -139,7 +144,14 @@ class SecureParticipants : public ::testing::Test {
     root_ = fs::temp_directory_path() / ("oscar_secure_dds_" + std::to_string(getpid()));
     fs::remove_all(root_);
     const auto system = SystemSpec::parse(YAML::Load(kSystem), "secure.yaml");
-    init_keystore(system, root_ / "keystore");
+    init_keystore(system, root_ / "keystore");  // cue_protection: none
+    for (const auto* protection : {"sign", "encrypt"}) {
+      init_keystore(
+          SystemSpec::parse(YAML::Load(std::string(kSystem) +
+                                       "security: { cue_protection: " + protection + " }\n"),
+                            "secure.yaml"),
+          root_ / (std::string("keystore_") + protection));
+    }
     // The same system's identities, issued by CAs of another keystore.
     init_keystore(system, root_ / "foreign");
   }
@@ -159,24 +171,39 @@ class SecureParticipants : public ::testing::Test {
 };
 fs::path SecureParticipants::root_;
 
+// Cues travel with each protection a system file may choose; a configuration command (a control
+// topic: signed, data encrypted) reaches the module from an identity with boot's authority.
 TEST_F(SecureParticipants, AnAllowedWriterMatchesItsReaderAndDeliversASample) {
-  Participant talker(as("module.talker"));
-  Participant listener(as("module.listener"));
-  ASSERT_TRUE(talker.ok()) << "Fast DDS refused the talker's keystore files";
-  ASSERT_TRUE(listener.ok()) << "Fast DDS refused the listener's keystore files";
-  auto* writer = talker.writer(kCueTopic);
-  ASSERT_NE(writer, nullptr) << "module.talker may publish its own cue topic";
-  auto* reader = listener.reader(kCueTopic);
-  ASSERT_NE(reader, nullptr);
-  ASSERT_TRUE(matched_within(*writer, 15s)) << "authenticated participants did not match";
-  send(*writer, "hello over secure DDS");
-  EXPECT_EQ(first_message(*reader, 10s), "hello over secure DDS");
+  for (const auto* keystore : {"keystore", "keystore_sign", "keystore_encrypt"}) {
+    SCOPED_TRACE(keystore);
+    Participant talker(0, as("module.talker", keystore));
+    Participant listener(1, as("module.listener", keystore));
+    ASSERT_TRUE(talker.ok()) << "Fast DDS refused the talker's keystore files";
+    ASSERT_TRUE(listener.ok()) << "Fast DDS refused the listener's keystore files";
+    auto* writer = talker.writer(kCueTopic);
+    ASSERT_NE(writer, nullptr) << "module.talker may publish its own cue topic";
+    auto* reader = listener.reader(kCueTopic);
+    ASSERT_NE(reader, nullptr);
+    ASSERT_TRUE(matched_within(*writer, 15s)) << "authenticated participants did not match";
+    send(*writer, std::string("a cue from ") + keystore);
+    EXPECT_EQ(first_message(*reader, 10s), std::string("a cue from ") + keystore);
+  }
+  Participant boot(0, as("operator_boot"));
+  Participant talker(1, as("module.talker"));
+  ASSERT_TRUE(boot.ok() && talker.ok());
+  auto* commands = boot.writer("oscar/config/talker");
+  ASSERT_NE(commands, nullptr);
+  auto* inbox = talker.reader("oscar/config/talker");
+  ASSERT_NE(inbox, nullptr);
+  ASSERT_TRUE(matched_within(*commands, 15s));
+  send(*commands, "configure");
+  EXPECT_EQ(first_message(*inbox, 10s), "configure");
 }
 
 TEST_F(SecureParticipants, AnIdentityCannotCreateAWriterItsPermissionsDoNotGrant) {
-  Participant listener(as("module.listener"));
-  Participant op(as("operator"));
-  Participant boot(as("operator_boot"));
+  Participant listener(0, as("module.listener"));
+  Participant op(1, as("operator"));
+  Participant boot(2, as("operator_boot"));
   ASSERT_TRUE(listener.ok() && op.ok() && boot.ok());
   EXPECT_EQ(listener.writer(kCueTopic), nullptr) << "a module wrote another module's cue topic";
   EXPECT_EQ(listener.writer("oscar/config/talker"), nullptr)
@@ -190,10 +217,10 @@ TEST_F(SecureParticipants, AnIdentityCannotCreateAWriterItsPermissionsDoNotGrant
 }
 
 TEST_F(SecureParticipants, AParticipantOfAnotherCaOrWithoutSecurityNeverMatches) {
-  Participant talker(as("module.talker"));
-  Participant listener(as("module.listener"));
-  Participant impostor(as("module.listener", "foreign"));
-  Participant plain({});
+  Participant talker(0, as("module.talker"));
+  Participant listener(1, as("module.listener"));
+  Participant impostor(2, as("module.listener", "foreign"));
+  Participant plain(3, {});
   ASSERT_TRUE(talker.ok() && listener.ok() && impostor.ok() && plain.ok());
   auto* writer = talker.writer(kCueTopic);
   ASSERT_NE(writer, nullptr);
