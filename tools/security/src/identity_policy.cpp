@@ -59,8 +59,8 @@ void add_applet_process_topics(std::vector<std::string>& out) {
   }
 }
 
-IdentityPolicy make(std::string name, std::string role, std::vector<std::string> publish) {
-  return {std::move(name), std::move(role), std::move(publish), {"*"}};
+IdentityPolicy make(std::string name, std::vector<std::string> publish) {
+  return {std::move(name), std::move(publish), {"*"}};
 }
 
 }  // namespace
@@ -68,32 +68,26 @@ IdentityPolicy make(std::string name, std::string role, std::vector<std::string>
 std::vector<IdentityPolicy> identities_of(const SystemSpec& system) {
   const auto log = topics::log().name;
   // Boot sends the initial configuration and asks the registry (shutdown); the registry
-  // suspends, resumes and re-applies configurations, launches and answers.
+  // suspends, resumes and re-applies configurations, launches and answers; the read-only
+  // operator writes nothing.
   const std::vector<std::string> boot{log, kAnyModulesConfig, topics::registry_request().name};
   std::vector<IdentityPolicy> all{
-      make(files::kRegistry, "registry",
-           {log, kAnyModulesConfig, topics::launch().name, topics::registry_reply().name,
-            topics::system_state().name}),
-      make(files::kBoot, "boot", boot),
-      make(files::kOperator, "command-line tools, read-only", {}),
-      make(files::kOperatorBoot, "command-line tools with boot's authority", boot),
+      make(files::kRegistry, {log, kAnyModulesConfig, topics::launch().name,
+                              topics::registry_reply().name, topics::system_state().name}),
+      make(files::kBoot, boot),
+      make(files::kOperator, {}),
+      make(files::kOperatorBoot, boot),
   };
   for (const auto& h : system.hosts) {
-    all.push_back(make(files::monitor_identity(h.name), "monitor of host " + h.name,
+    all.push_back(make(files::monitor_identity(h.name),
                        {log, topics::monitor_alive(std::chrono::milliseconds(1)).name,
                         topics::process_events().name}));
   }
   for (const auto& m : system.modules) {
     auto publish = module_topics(m);
-    std::string role = "module " + m.spec.name;
-    if (m.program == "oscar-coordinator") {
-      add_coordinator_topics(publish);
-      role = "the coordinator";
-    } else if (m.program == "oscar-applet") {
-      add_applet_process_topics(publish);
-      role = "applet process " + m.spec.name;
-    }
-    all.push_back(make(files::module_identity(m.spec.name), role, std::move(publish)));
+    if (m.program == "oscar-coordinator") add_coordinator_topics(publish);
+    if (m.program == "oscar-applet") add_applet_process_topics(publish);
+    all.push_back(make(files::module_identity(m.spec.name), std::move(publish)));
   }
   return all;
 }

@@ -12,7 +12,6 @@ namespace oscar::security {
 
 struct IdentityPolicy {
   std::string name;  ///< e.g. "module.camera" (security_files.hpp)
-  std::string role;  ///< what runs as it, for `oscar security list`
   /// Topic names or fnmatch patterns it may create writers on (DDS Security <publish>).
   std::vector<std::string> publish;
   /// Topic patterns it may read. Reading is not access-controlled (the governance leaves

@@ -46,7 +46,7 @@ TEST(Governance, CueProtectionSetsTheCueAndPullRulesAndControlTopicsStayProtecte
 }
 
 TEST(Permissions, NameTheSubjectAndDenyWhatIsNotAllowed) {
-  const IdentityPolicy viewer{"module.viewer", "module viewer", {"oscar/cue/view/*"}, {"*"}};
+  const IdentityPolicy viewer{"module.viewer", {"oscar/cue/view/*"}, {"*"}};
   const auto xml = permissions_xml(viewer, "CN=module.viewer,O=OSCAR", "2026-01-01T00:00:00",
                                    "2028-01-01T00:00:00");
   EXPECT_THAT(xml, HasSubstr("<grant name=\"module.viewer\">\n      <subject_name>CN=module."
@@ -55,7 +55,7 @@ TEST(Permissions, NameTheSubjectAndDenyWhatIsNotAllowed) {
   EXPECT_THAT(xml, HasSubstr("<publish>\n          <topics>\n            <topic>oscar/cue/view/*"
                              "</topic>"));
   EXPECT_THAT(xml, HasSubstr("<default>DENY</default>"));
-  const IdentityPolicy reader{"operator", "tools", {}, {"*"}};
+  const IdentityPolicy reader{"operator", {}, {"*"}};
   EXPECT_THAT(permissions_xml(reader, "CN=operator,O=OSCAR", "a", "b"),
               ::testing::Not(HasSubstr("<publish>")));
 }
