@@ -106,7 +106,9 @@ Cert issue(const EVP_PKEY& key, const std::string& common_name, const X509* issu
   BIGNUM* serial = BN_bin2bn(bytes, sizeof bytes, nullptr);
   if (!serial || !BN_to_ASN1_INTEGER(serial, X509_get_serialNumber(cert.get()))) fail("serial");
   BN_free(serial);
-  X509_gmtime_adj(X509_getm_notBefore(cert.get()), 0);
+  // Valid from an hour ago: a host whose clock lags a little behind the one that ran init must
+  // not refuse a certificate just issued as not valid yet.
+  X509_gmtime_adj(X509_getm_notBefore(cert.get()), -3600);
   X509_gmtime_adj(X509_getm_notAfter(cert.get()),
                   std::chrono::duration_cast<std::chrono::seconds>(validity).count());
   X509_NAME* name = X509_get_subject_name(cert.get());

@@ -27,9 +27,10 @@ using Clock = std::chrono::system_clock;
 /// A new EC key pair on prime256v1.
 Key new_key();
 
-/// A certificate for `key` with subject "CN=<common_name>,O=OSCAR", valid from now for
-/// `validity`, signed by `issuer`/`issuer_key`, or self-signed when `issuer` is null. A CA
-/// certificate may sign certificates and documents; any other only signs (authentication).
+/// A certificate for `key` with subject "CN=<common_name>,O=OSCAR", valid from an hour ago
+/// until `validity` from now, signed by `issuer`/`issuer_key`, or self-signed when `issuer` is
+/// null. A CA certificate may sign certificates and documents; any other only signs
+/// (authentication).
 Cert issue(const EVP_PKEY& key, const std::string& common_name, const X509* issuer,
            const EVP_PKEY& issuer_key, std::chrono::hours validity, bool ca);
 
