@@ -24,14 +24,14 @@ class Checker {
   void error(std::string text) { found_.push_back({Finding::Level::kError, std::move(text)}); }
   void warning(std::string text) { found_.push_back({Finding::Level::kWarning, std::move(text)}); }
 
-  void dates(const std::string& what, const X509& cert) {
+  // `then`: what to do before it expires.
+  void dates(const std::string& what, const X509& cert, const char* then) {
     const auto until = pki::not_after(cert);
     if (until <= now_) {
       error(fmt::format("{}: certificate expired on {}", what, date(until)));
     } else if (until - now_ < settings_.renew_before) {
-      warning(
-          fmt::format("{}: certificate expires in {} days ({}); `oscar security init` renews it",
-                      what, days_between(now_, until), date(until)));
+      warning(fmt::format("{}: certificate expires in {} days ({}); {}", what,
+                          days_between(now_, until), date(until), then));
     } else if (pki::not_before(cert) > now_) {
       error(fmt::format("{}: certificate not valid before {}", what,
                         timestamp(pki::not_before(cert))));
@@ -53,7 +53,7 @@ class Checker {
                         *why));
       return nullptr;
     }
-    dates(name, *cert);
+    dates(name, *cert, "init does not renew a CA: make a new keystore");
     if (!fs::exists(ca_key_file(dir_, name))) {
       warning(fmt::format("{}: no private key in {} (init cannot add or renew identities here)",
                           name, (dir_ / "private").string()));
@@ -85,7 +85,7 @@ class Checker {
         error(fmt::format("{}: certificate not issued by the identity CA: {}", name, *why));
       }
     }
-    dates(name, *cert);
+    dates(name, *cert, "`oscar security init` renews it");
     const auto key_file = idir / files::kPrivateKey;
     try {
       if (!pki::key_matches(*cert, *pki::read_key(key_file))) {

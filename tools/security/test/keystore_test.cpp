@@ -152,8 +152,14 @@ TEST_F(Keystore, CheckWarnsBeforeExpiryAndFailsAfter) {
   init_keystore(system_of(), dir_);
   const auto until = pki::not_after(*pki::read_cert(identity("boot") / "cert.pem"));
   const auto soon = check_keystore(system_of(), dir_, until - std::chrono::hours(24 * 10));
-  EXPECT_THAT(warnings(soon), Contains(HasSubstr("boot: certificate expires in 10 days")));
+  EXPECT_THAT(warnings(soon), Contains(HasSubstr("boot: certificate expires in 10 days (")));
+  EXPECT_THAT(warnings(soon), Contains(HasSubstr("; `oscar security init` renews it")));
   EXPECT_TRUE(errors(soon).empty());
+  const auto ca_until = pki::not_after(*pki::read_cert(dir_ / "public" / "identity_ca.cert.pem"));
+  EXPECT_THAT(warnings(check_keystore(system_of(), dir_, ca_until - std::chrono::hours(24 * 5))),
+              Contains(HasSubstr("identity_ca: certificate expires in 5 days (")));
+  EXPECT_THAT(warnings(check_keystore(system_of(), dir_, ca_until - std::chrono::hours(24 * 5))),
+              Contains(HasSubstr("init does not renew a CA: make a new keystore")));
   const auto late = check_keystore(system_of(), dir_, until + std::chrono::hours(1));
   EXPECT_THAT(errors(late), Contains(HasSubstr("boot: certificate expired on")));
 }
