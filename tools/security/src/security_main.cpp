@@ -66,7 +66,7 @@ int list(const fs::path& dir, bool json) {
     auto out = nlohmann::json::array();
     for (const auto& i : identities) {
       nlohmann::json j{{"identity", i.name}, {"subject", i.subject}, {"publish", i.publish}};
-      j["expires"] = i.problem.empty() && !i.subject.empty() ? date(i.not_after) : "";
+      j["expires"] = i.subject.empty() ? "" : date(i.not_after);  // known once the cert is read
       if (!i.problem.empty()) j["problem"] = i.problem;
       out.push_back(std::move(j));
     }
