@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config clang-format git ccache
-  libfastrtps-dev fastddsgen fastdds-tools
+  libfastrtps-dev fastddsgen fastdds-tools libssl-dev
   libeigen3-dev libopencv-dev libapriltag-dev libompl-dev libboost-dev libboost-graph-dev
   libgtest-dev libgmock-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
   nlohmann-json3-dev libexpected-dev libzstd-dev liblz4-dev zlib1g-dev

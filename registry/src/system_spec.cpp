@@ -2,6 +2,7 @@
 
 #include <arpa/inet.h>
 
+#include <filesystem>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -128,6 +129,37 @@ DebugSpec parse_debug(const YAML::Node& node, const std::string& file, const std
   return d;
 }
 
+SecuritySpec parse_security(const YAML::Node& node, const std::string& file) {
+  SecuritySpec sec;
+  sec.where = yaml_where(file, node);
+  if (!node.IsMap()) {
+    fail(sec.where, "security: expected {keystore: DIR, cue_protection: none|sign|encrypt}");
+  }
+  check_yaml_keys(node, file, "security", {"keystore", "cue_protection"});
+  if (const auto k = node["keystore"]) {
+    if (!k.IsScalar() || k.Scalar().empty()) {
+      fail(yaml_where(file, k), "security.keystore: expected a folder");
+    }
+    std::filesystem::path dir = k.Scalar();
+    if (dir.is_relative()) dir = std::filesystem::absolute(file).parent_path() / dir;
+    sec.keystore = dir.lexically_normal().string();
+  }
+  if (const auto p = node["cue_protection"]) {
+    const auto text = p.IsScalar() ? p.Scalar() : std::string();
+    if (text == "none") {
+      sec.cue_protection = SecuritySpec::CueProtection::kNone;
+    } else if (text == "sign") {
+      sec.cue_protection = SecuritySpec::CueProtection::kSign;
+    } else if (text == "encrypt") {
+      sec.cue_protection = SecuritySpec::CueProtection::kEncrypt;
+    } else {
+      fail(yaml_where(file, p),
+           fmt::format("security.cue_protection '{}': expected none, sign or encrypt", text));
+    }
+  }
+  return sec;
+}
+
 // A replace chain must end at a standby module and never come back to where it started.
 void check_replace_chains(const SystemSpec& s) {
   for (const auto& m : s.modules) {
@@ -222,6 +254,18 @@ void add_applet_modules(SystemSpec& s, const std::vector<std::string>& plugins) 
 
 }  // namespace
 
+const char* to_string(SecuritySpec::CueProtection protection) {
+  switch (protection) {
+    case SecuritySpec::CueProtection::kNone:
+      return "none";
+    case SecuritySpec::CueProtection::kSign:
+      return "sign";
+    case SecuritySpec::CueProtection::kEncrypt:
+      return "encrypt";
+  }
+  return "?";
+}
+
 std::string DebugSpec::describe() const {
   if (gdbserver_port > 0) return fmt::format("gdbserver 127.0.0.1:{}", gdbserver_port);
   return valgrind ? "valgrind" : "";
@@ -236,7 +280,7 @@ SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
   if (!root.IsMap()) fail(file, "a system file is a map with system, hosts and modules");
   check_yaml_keys(root, file, "system file",
                   {"system", "domain", "hosts", "modules", "network", "lease", "plugins",
-                   "services", "coordinator"});
+                   "services", "coordinator", "security"});
   const auto plugins = ModuleSpec::plugins_of(root, file);
   s.name = root["system"] ? root["system"].as<std::string>() : "system";
   if (root["domain"]) {
@@ -244,6 +288,7 @@ SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
     if (s.domain < 0 || s.domain > 232) fail(yaml_where(file, root["domain"]), "domain: 0..232");
   }
   if (root["lease"]) s.lease = millis(root["lease"], file, "lease");
+  if (root["security"]) s.security = parse_security(root["security"], file);
   if (const auto hosts = root["hosts"]) {
     if (!hosts.IsMap() || hosts.size() == 0) fail(yaml_where(file, hosts), "hosts: a map");
     for (const auto& kv : hosts) {

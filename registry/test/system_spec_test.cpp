@@ -94,6 +94,33 @@ TEST(SystemSpec, UnknownKeysAreErrorsWithTheirLine) {
       HasSubstr("unknown key 'polcy'"));
 }
 
+constexpr const char* kOneModule = "modules: [ { name: m, kernels: [ {type: relay} ] } ]\n";
+
+TEST(SystemSpec, SecuritySectionIsOptionalAndReadsKeystoreAndCueProtection) {
+  EXPECT_FALSE(parse(kOneModule).security);
+  const auto s =
+      SystemSpec::parse(YAML::Load(std::string(kOneModule) +
+                                   "security: { keystore: keys, cue_protection: encrypt }\n"),
+                        "/robots/alpha/s.yaml");
+  ASSERT_TRUE(s.security);
+  EXPECT_EQ(s.security->keystore, "/robots/alpha/keys");  // relative to the system file
+  EXPECT_EQ(s.security->cue_protection, SecuritySpec::CueProtection::kEncrypt);
+  const auto plain = parse(std::string(kOneModule) + "security: { keystore: /etc/oscar/keys }\n");
+  EXPECT_EQ(plain.security->keystore, "/etc/oscar/keys");
+  EXPECT_EQ(plain.security->cue_protection, SecuritySpec::CueProtection::kNone);
+}
+
+TEST(SystemSpec, SecuritySectionRefusesUnknownKeysAndProtections) {
+  EXPECT_THAT(error_of(std::string(kOneModule) + "security: { keystore: k, cue: sign }\n"),
+              HasSubstr("s.yaml:2: security: unknown key 'cue' (allowed: keystore, "
+                        "cue_protection)"));
+  EXPECT_THAT(error_of(std::string(kOneModule) + "security: { cue_protection: secret }\n"),
+              HasSubstr("s.yaml:2: security.cue_protection 'secret': expected none, sign or "
+                        "encrypt"));
+  EXPECT_THAT(error_of(std::string(kOneModule) + "security: yes\n"),
+              HasSubstr("s.yaml:2: security: expected {keystore: DIR"));
+}
+
 TEST(SystemSpec, UnknownHostIsAnErrorListingTheHosts) {
   EXPECT_THAT(error_of(R"(
 hosts: { a: { local: true } }

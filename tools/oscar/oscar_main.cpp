@@ -34,6 +34,8 @@ const char* const kUsage =
     "  hz TOPIC              a topic's rate and the min/max/std of its period\n"
     "  graph [-o FILE.svg]   the running system as a graph (modules, kernels, channels)\n"
     "  new-module NAME ...   generate a module: kernel, CMake, README, unit test\n"
+    "  security init|check|list SYSTEM.yaml\n"
+    "                        the system's DDS Security keystore (--keystore DIR)\n"
     "  bench <what> ...      benchmarks: cueflow, restart, applets, swarm, record, replay,\n"
     "                        landmarks, stalls\n"
     "\n"

@@ -125,6 +125,18 @@ struct CoordinatorSpec {
   std::string where;
 };
 
+/// The `security:` section (docs/security.md): where the system's DDS Security keystore lies and
+/// how cue data is protected on the wire. Control topics are always protected; cue topics carry
+/// the bulk of the traffic, so the system file chooses what their protection may cost.
+struct SecuritySpec {
+  enum class CueProtection { kNone, kSign, kEncrypt };
+  std::string keystore;  ///< absolute (a relative path is taken from the system file's folder)
+  CueProtection cue_protection = CueProtection::kNone;
+  std::string where;  ///< "file:line"
+};
+/// "none", "sign", "encrypt".
+const char* to_string(SecuritySpec::CueProtection protection);
+
 /// Services and applets added to a running system (docs/coordinator.md, "Adding and removing at
 /// run time"), as SystemSpec::parse_addition reads them.
 struct SystemAddition {
@@ -141,6 +153,7 @@ struct SystemSpec {
   std::vector<SystemModule> modules;  ///< with the coordinator's module, if there is one
   std::vector<ServiceSpec> services;
   std::optional<CoordinatorSpec> coordinator;
+  std::optional<SecuritySpec> security;
   YAML::Node root;
 
   /// The module name the `coordinator:` section's process announces itself under.
