@@ -93,12 +93,15 @@ eprosima::fastrtps::types::ReturnCode_t take_next(eprosima::fastdds::dds::DataRe
                                                   void* data,
                                                   eprosima::fastdds::dds::SampleInfo& info) {
   Reading here{reader.get_topicdescription()->get_name(), {}};
-  struct Restore {
-    Reading* outer;
-    ~Restore() { reading = outer; }
-  } restore{std::exchange(reading, &here)};
-  const auto result = reader.take_next_sample(data, &info);
-  reading = restore.outer;
+  eprosima::fastrtps::types::ReturnCode_t result;
+  {
+    // Restored however the take ends: `here` must not outlive its use.
+    struct Restore {
+      Reading* outer;
+      ~Restore() { reading = outer; }
+    } restore{std::exchange(reading, &here)};
+    result = reader.take_next_sample(data, &info);
+  }
   for (const auto& r : here.refused) counts().record(here.topic, r);
   return result;
 }
