@@ -16,6 +16,7 @@
 
 #include "oscar/dds_participant.hpp"
 #include "oscar/input.hpp"
+#include "oscar/malformed_samples.hpp"
 #include "oscar/topics.hpp"
 
 namespace oscar {
@@ -74,7 +75,7 @@ class TopicReader final : public eprosima::fastdds::dds::DataReaderListener {
   void on_data_available(eprosima::fastdds::dds::DataReader* reader) override {
     T sample;
     eprosima::fastdds::dds::SampleInfo info;
-    while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+    while (take_next(*reader, &sample, info) == ReturnCode_t::RETCODE_OK) {
       if (info.valid_data) on_sample_(sample, info);
     }
   }

@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <oscar/configPubSubTypes.h>
 
+#include "oscar/malformed_samples.hpp"
 #include "oscar/topics.hpp"
 
 #include <fastdds/dds/publisher/DataWriter.hpp>
@@ -97,7 +98,7 @@ ModuleState ConfigClient::module_state(const std::string& module,
   while (!found && std::chrono::steady_clock::now() < until) {
     ModuleState s;
     dds::SampleInfo info;
-    while (reader->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
+    while (take_next(*reader, &s, info) == ReturnCode_t::RETCODE_OK) {
       if (info.valid_data && s.module_name() == module) found = s;
     }
     if (!found) reader->wait_for_unread_message(eprosima::fastrtps::Duration_t(0, 50'000'000));
@@ -152,7 +153,7 @@ ConfigReply ConfigClient::send(ConfigCommand cmd, std::chrono::milliseconds time
     }
     ConfigReply reply;
     dds::SampleInfo info;
-    while (c.reader->take_next_sample(&reply, &info) == ReturnCode_t::RETCODE_OK) {
+    while (take_next(*c.reader, &reply, info) == ReturnCode_t::RETCODE_OK) {
       if (info.valid_data && reply.id() == cmd.id()) return reply;
     }
     c.reader->wait_for_unread_message(eprosima::fastrtps::Duration_t(0, 20'000'000));

@@ -1,6 +1,8 @@
 #include "dds/module_dds.hpp"
 
+#include "dds/guarded_type.hpp"
 #include "dds/log_sink.hpp"
+#include "oscar/malformed_samples.hpp"
 #include "oscar/raw_cdr_type.hpp"
 #include "oscar/topic_io.hpp"
 
@@ -54,7 +56,8 @@ namespace {
 const CueTypeInfo* wire_type(DdsParticipant& p, const InputPort& input, const std::string& type) {
   if (!input.takes_any_type()) return &input.type();
   const auto registered = p.get().find_type(type);
-  if (registered.get() && dynamic_cast<RawCdrType*>(registered.get())) return nullptr;
+  const auto* guarded = dynamic_cast<internal::GuardedType*>(registered.get());
+  if (guarded && dynamic_cast<const RawCdrType*>(&guarded->inner())) return nullptr;
   return find_cue_type(type);
 }
 }  // namespace
@@ -89,7 +92,7 @@ class Module::Dds::CueReader final : public dds::DataReaderListener {
     dds::SampleInfo info;
     for (;;) {
       auto cue = arriving.make();
-      if (reader->take_next_sample(cue.get(), &info) != ReturnCode_t::RETCODE_OK) break;
+      if (take_next(*reader, cue.get(), info) != ReturnCode_t::RETCODE_OK) break;
       if (!info.valid_data) continue;
       if (!received_) take_over();
       std::lock_guard lock(deliver_mutex_);
@@ -164,7 +167,11 @@ class Module::Dds::CueReader final : public dds::DataReaderListener {
 };
 
 Module::Dds::Dds(Module& module, int domain)
-    : module_(module), participant_(domain, "oscar:" + module.spec_.name, module.spec_.network) {}
+    : module_(module), participant_(domain, "oscar:" + module.spec_.name, module.spec_.network) {
+  // Samples dropped as malformed are reported where the module's other lines go: its console
+  // and oscar/log. The logger outlives this (shared), and its DDS sink is detached below.
+  set_malformed_sample_log(module.log_);
+}
 
 Module::Dds::~Dds() {
   wishes_.reset();

@@ -18,7 +18,10 @@
 #include <yaml-cpp/yaml.h>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/log/Log.hpp>
+#include "dds/guarded_type.hpp"
 #include "dds/participant_identity.hpp"
+#include "dds/wire_bounds.hpp"
+#include "oscar/raw_cdr_type.hpp"
 
 namespace oscar {
 namespace dds = eprosima::fastdds::dds;
@@ -334,7 +337,12 @@ dds::Topic& DdsParticipant::topic(const std::string& name, dds::TopicDataType* t
   // with LineSeg3DSeq). Types are matched by name; OSCAR's own registry knows them.
   type->auto_fill_type_object(false);
   type->auto_fill_type_information(false);
-  dds::TypeSupport support(type);  // owns `type` from here on
+  // Every type is registered guarded: a sample its bytes cannot be decoded from is dropped and
+  // counted, never thrown on a Fast DDS thread (guarded_type.hpp). RawCdrType keeps the bytes
+  // as they come, so it needs no size check.
+  const bool raw = dynamic_cast<RawCdrType*>(type) != nullptr;
+  dds::TypeSupport support(
+      new internal::GuardedType(type, raw ? nullptr : internal::wire_check(type->getName())));
   std::lock_guard lock(mutex_);
   if (auto it = topics_.find(name); it != topics_.end()) {
     if (it->second->get_type_name() != support.get_type_name()) {

@@ -1,5 +1,7 @@
 #include "dds/pull.hpp"
 
+#include "dds/wire_bounds.hpp"
+#include "oscar/malformed_samples.hpp"
 #include "oscar/topics.hpp"
 
 #include <thread>
@@ -120,7 +122,7 @@ DdsPullServer::~DdsPullServer() {
 void DdsPullServer::on_data_available(dds::DataReader* reader) {
   PullRequest request;
   dds::SampleInfo info;
-  while (reader->take_next_sample(&request, &info) == ReturnCode_t::RETCODE_OK) {
+  while (take_next(*reader, &request, info) == ReturnCode_t::RETCODE_OK) {
     if (!info.valid_data) continue;
     PullReply reply;
     reply.requester(request.requester());
@@ -240,7 +242,7 @@ std::shared_future<CueBlock> DdsPullSource::request(const PullBlock& block) {
 void DdsPullSource::on_data_available(dds::DataReader* reader) {
   PullReply reply;
   dds::SampleInfo info;
-  while (reader->take_next_sample(&reply, &info) == ReturnCode_t::RETCODE_OK) {
+  while (take_next(*reader, &reply, info) == ReturnCode_t::RETCODE_OK) {
     if (!info.valid_data) continue;
     if (reply.requester() != requester_) {  // the filter lets none through; be sure
       ++others_replies_seen_;
@@ -248,8 +250,14 @@ void DdsPullSource::on_data_available(dds::DataReader* reader) {
     }
     CueBlock cues;
     try {
-      for (const auto& c : reply.cues()) cues.push_back(input_.type().deserialize(c.cdr()));
-    } catch (const std::exception&) {
+      // The cues inside a reply get the size checks a cue's own reader makes before decoding.
+      const auto check = wire_check(input_.type().name);
+      for (const auto& c : reply.cues()) {
+        if (const auto why = check ? check(c.cdr()) : std::nullopt) throw std::runtime_error(*why);
+        cues.push_back(input_.type().deserialize(c.cdr()));
+      }
+    } catch (const std::exception& e) {
+      note_malformed_sample(input_.type().name, e.what());
       cues.clear();  // a malformed reply answers "nothing", never garbage
     }
     for (const auto& cue : cues) {

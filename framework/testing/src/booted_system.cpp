@@ -25,6 +25,7 @@
 #include "oscar/config_client.hpp"
 #include "oscar/cue_type_info.hpp"
 #include "oscar/cue_types.hpp"
+#include "oscar/malformed_samples.hpp"
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/registry/running_systems.hpp"
 #include "oscar/shared_memory.hpp"
@@ -177,7 +178,7 @@ class CueCounter final : public eprosima::fastdds::dds::DataReaderListener {
   void on_data_available(eprosima::fastdds::dds::DataReader* reader) override {
     const auto cue = type_.make();
     eprosima::fastdds::dds::SampleInfo info;
-    while (reader->take_next_sample(cue.get(), &info) == ReturnCode_t::RETCODE_OK) {
+    while (take_next(*reader, cue.get(), info) == ReturnCode_t::RETCODE_OK) {
       if (info.valid_data) ++count_;
     }
   }

@@ -10,6 +10,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
+#include "oscar/malformed_samples.hpp"
 #include "oscar/raw_cdr_type.hpp"
 
 namespace oscar::inspect {
@@ -28,7 +29,7 @@ struct RawTap::Impl {
     void on_data_available(dds::DataReader* reader) override {
       RawCue s;
       dds::SampleInfo info;
-      while (reader->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
+      while (take_next(*reader, &s, info) == ReturnCode_t::RETCODE_OK) {
         if (info.valid_data) fn_(topic_, std::move(s.cdr), now_ns());
       }
     }

@@ -17,6 +17,7 @@
 
 #include "oscar/dds_participant.hpp"
 #include "oscar/idl_texts.hpp"
+#include "oscar/malformed_samples.hpp"
 #include "oscar/mcap/writer.hpp"
 #include "oscar/raw_cdr_type.hpp"
 #include "oscar/topics.hpp"
@@ -64,7 +65,7 @@ struct Recorder::Impl {
     void on_data_available(dds::DataReader* reader) override {
       RawCue s;
       dds::SampleInfo info;
-      while (reader->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
+      while (take_next(*reader, &s, info) == ReturnCode_t::RETCODE_OK) {
         if (info.valid_data) impl_.push(topic_, std::move(s));
       }
     }
