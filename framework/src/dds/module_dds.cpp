@@ -1,5 +1,6 @@
 #include "dds/module_dds.hpp"
 
+#include "command_bounds.hpp"
 #include "dds/log_sink.hpp"
 #include "oscar/raw_cdr_type.hpp"
 #include "oscar/topic_io.hpp"
@@ -449,12 +450,16 @@ void Module::Dds::serve_config() {
     queue_.pop_front();
     lock.unlock();
     // A repeated command (same sender and id: the client did not see our reply) is answered
-    // again, not applied twice.
-    auto& last = last_reply_[command.sender()];
-    if (last.id() != command.id() || last.module_name().empty()) {
-      last = module_.apply(command, origin);
+    // again, not applied twice. A sender over its limit is refused and not remembered.
+    if (const auto* last = last_replies_.find(command.sender(), command.id())) {
+      reply_writer_->write(*last);
+    } else {
+      const auto reply = module_.apply(command, origin);
+      if (command.sender().size() <= internal::kMaxSenderChars) {
+        last_replies_.remember(command.sender(), reply);
+      }
+      reply_writer_->write(reply);
     }
-    reply_writer_->write(last);
     lock.lock();
   }
 }

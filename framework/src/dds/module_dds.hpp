@@ -25,6 +25,7 @@
 #include "oscar/module.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
+#include "reply_memory.hpp"
 
 namespace oscar {
 
@@ -101,7 +102,7 @@ class Module::Dds {
   std::deque<Command> queue_;
   std::deque<Refollow> refollow_;  // served by the configuration thread, like queue_
   std::map<InputPort*, std::string> awaiting_type_;  // raw inputs whose source is not seen yet
-  std::map<std::string, ConfigReply> last_reply_;    // by sender: answers repeated commands
+  internal::ReplyMemory last_replies_;  // the configuration thread's: answers repeated commands
   bool serving_ = false;
   std::thread config_thread_;
   std::unique_ptr<TopicWriter<ModuleBeat, ModuleBeatPubSubType>> beat_writer_;
