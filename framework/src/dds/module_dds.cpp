@@ -14,6 +14,7 @@
 #include <thread>
 
 #include <fmt/format.h>
+#include <fmt/ostream.h>
 #include <oscar/configPubSubTypes.h>
 #include <oscar/registryPubSubTypes.h>
 
@@ -381,10 +382,7 @@ void Module::Dds::start_config() {
   config_reader_ = std::make_unique<TopicReader<ConfigCommand, ConfigCommandPubSubType>>(
       participant_, topics::config(name),
       [this](const ConfigCommand& c, const eprosima::fastdds::dds::SampleInfo& info) {
-        auto origin = origin_of(info);
-        std::lock_guard lock(queue_mutex_);
-        queue_.push_back({c, std::move(origin)});
-        queue_cv_.notify_all();
+        enqueue(c, info);
       });
   log_writer_ =
       std::make_unique<TopicWriter<LogRecord, LogRecordPubSubType>>(participant_, topics::log());
@@ -419,19 +417,55 @@ CommandOrigin Module::Dds::origin_of(const eprosima::fastdds::dds::SampleInfo& i
   return origin;
 }
 
+void Module::Dds::enqueue(const ConfigCommand& c, const eprosima::fastdds::dds::SampleInfo& info) {
+  const auto now = std::chrono::steady_clock::now();
+  const auto writer =
+      fmt::format("{}", fmt::streamed(info.sample_identity.writer_guid().guidPrefix));
+  {
+    std::lock_guard lock(queue_mutex_);
+    if (!rate_limit_.admit(writer, now)) return;  // reported by the configuration thread
+    if (queue_.size() >= kMaxQueuedCommands) {
+      ++queue_full_drops_;
+      return;
+    }
+  }
+  auto origin = origin_of(info);  // asks discovery: not under the queue's lock
+  std::lock_guard lock(queue_mutex_);
+  queue_.push_back({c, std::move(origin)});
+  queue_cv_.notify_all();
+}
+
+void Module::Dds::report_drops() {
+  std::optional<std::string> over_rate;
+  std::uint64_t queue_full = 0;
+  {
+    std::lock_guard lock(queue_mutex_);
+    over_rate = rate_limit_.report(std::chrono::steady_clock::now());
+    if (over_rate || queue_full_drops_ > 0) std::swap(queue_full, queue_full_drops_);
+  }
+  if (over_rate) module_.log_->warn("{}", *over_rate);
+  if (queue_full > 0) {
+    module_.log_->warn("dropped {} configuration command(s): {} were waiting already", queue_full,
+                       kMaxQueuedCommands);
+  }
+}
+
 // Commands are applied on their own thread, never inside a DDS callback: a rewire creates and
 // deletes readers, and activate waits for the processing thread.
 void Module::Dds::serve_config() {
   std::unique_lock lock(queue_mutex_);
   const auto ready = [&] { return !serving_ || !queue_.empty() || !refollow_.empty(); };
   while (true) {
-    if (awaiting_type_.empty()) {
-      queue_cv_.wait(lock, ready);
-    } else {
-      // Discovery is polled for raw inputs whose source has not shown up yet.
-      queue_cv_.wait_for(lock, std::chrono::milliseconds(50), ready);
-    }
+    // Discovery is polled for raw inputs whose source has not shown up yet; dropped commands
+    // are reported within a second.
+    queue_cv_.wait_for(
+        lock,
+        awaiting_type_.empty() ? std::chrono::milliseconds(1000) : std::chrono::milliseconds(50),
+        ready);
     if (!serving_) return;
+    lock.unlock();
+    report_drops();
+    lock.lock();
     if (!awaiting_type_.empty()) {
       lock.unlock();
       subscribe_discovered();
