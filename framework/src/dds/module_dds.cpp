@@ -431,6 +431,10 @@ void Module::Dds::enqueue(const ConfigCommand& c, const eprosima::fastdds::dds::
   }
   auto origin = origin_of(info);  // asks discovery: not under the queue's lock
   std::lock_guard lock(queue_mutex_);
+  if (queue_.size() >= kMaxQueuedCommands) {  // filled by another DDS thread meanwhile
+    ++queue_full_drops_;
+    return;
+  }
   queue_.push_back({c, std::move(origin)});
   queue_cv_.notify_all();
 }
