@@ -4,6 +4,7 @@
 // quotes excerpts only.
 #include <atomic>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <string>
 #include <thread>
@@ -33,11 +34,25 @@ long vm_rss_kib(pid_t pid) {
   return -1;
 }
 
+// Under AddressSanitizer freed memory stays in its quarantine (256 MB by default), so the
+// module's resident set grows with any churn; a small quarantine leaves what is really kept.
+// Measured under ASan with the bounds in place: +121908 KiB with the default, +4872 KiB with 4 MB.
+std::string with_small_asan_quarantine(const std::string& module) {
+#if defined(__SANITIZE_ADDRESS__)
+  const char* options = std::getenv("ASAN_OPTIONS");
+  const std::string merged =
+      std::string(options ? options : "") + (options ? ":" : "") + "quarantine_size_mb=4";
+  setenv("ASAN_OPTIONS", merged.c_str(), 1);  // inherited by the module process
+#endif
+  return module;
+}
+
 // A module process with one kernel, up and answering `boot` commands.
 struct FloodedModule {
   explicit FloodedModule(const std::string& module)
       : name(module),
-        process(test::run_module(module, {"-k", "bench_source:src", "-m", "continuous:100ms"})),
+        process(test::run_module(with_small_asan_quarantine(module),
+                                 {"-k", "bench_source:src", "-m", "continuous:100ms"})),
         participant(test::test_domain(), "test:operator"),
         boot(participant, "boot") {}
   // Waits until the module answers, then lets it settle: the resident set grows while Fast DDS
