@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "command_bounds.hpp"
 #include "dds/module_dds.hpp"
 #include "module_slot.hpp"
 #include "oscar/time.hpp"
@@ -16,34 +17,6 @@ namespace {
 // How long a rewire waits for the new source's first cue unless the command says (a source
 // slower than 1 Hz needs its sender to say).
 constexpr std::chrono::milliseconds kRewireWait{1000};
-
-const char* kind_name(CommandKind k) {
-  switch (k) {
-    case CMD_ACTIVATE:
-      return "activate";
-    case CMD_DEACTIVATE:
-      return "deactivate";
-    case CMD_TRIGGER:
-      return "trigger";
-    case CMD_SET_CYCLE:
-      return "set_cycle";
-    case CMD_SET_PARAM:
-      return "set_param";
-    case CMD_REWIRE:
-      return "rewire";
-    case CMD_SUSPEND:
-      return "suspend";
-    case CMD_RESUME:
-      return "resume";
-    case CMD_STUB:
-      return "stub";
-    case CMD_SHUTDOWN:
-      return "shutdown";
-    case CMD_COMMAND:
-      return "command";
-  }
-  return "?";
-}
 
 // The module the `coordinator:` section's process announces itself as (SystemSpec).
 constexpr const char* kCoordinatorModule = "coordinator";
@@ -79,7 +52,8 @@ std::optional<std::string> refusal(const ConfigCommand& c, const CommandOrigin& 
 void need_args(const ConfigCommand& c, std::size_t n, const char* form) {
   if (c.args().size() != n) {
     throw std::invalid_argument(fmt::format("{} takes {} argument(s) ({}), got {}",
-                                            kind_name(c.kind()), n, form, c.args().size()));
+                                            internal::command_kind_name(c.kind()), n, form,
+                                            c.args().size()));
   }
 }
 
@@ -110,8 +84,11 @@ ConfigReply Module::apply(const ConfigCommand& c, const CommandOrigin& origin) {
   ConfigReply reply;
   reply.id(c.id());
   reply.module_name(spec_.name);
-  const std::string kind = kind_name(c.kind());
-  if (auto why = refusal(c, origin, kind, spec_.name)) {
+  // Checked before anything quotes the command: its fields are the writer's to choose.
+  auto why = internal::malformed(c);
+  const std::string kind = why ? "" : internal::command_kind_name(c.kind());
+  if (!why) why = refusal(c, origin, kind, spec_.name);
+  if (why) {
     reply.ok(false);
     reply.error(std::move(*why));
     log_->warn("{}", reply.error());
@@ -221,7 +198,8 @@ ConfigReply Module::apply(const ConfigCommand& c, const CommandOrigin& origin) {
           }
           s.instance->kernel().on_params_changed();
         });
-        transition = fmt::format("{}: {} = {}", s.instance->name(), c.args()[1], c.args()[2]);
+        transition = fmt::format("{}: {} = {}", s.instance->name(), internal::excerpt(c.args()[1]),
+                                 internal::excerpt(c.args()[2]));
         break;
       }
       case CMD_REWIRE: {
@@ -235,8 +213,11 @@ ConfigReply Module::apply(const ConfigCommand& c, const CommandOrigin& origin) {
             c.args().size() == 4
                 ? std::chrono::duration_cast<std::chrono::milliseconds>(parse_duration(c.args()[3]))
                 : kRewireWait;
-        reply.note(rewire(slot_for(c.args()[0], kind), c.args()[1], c.args()[2], wait));
-        transition = fmt::format("{}.{} <- {}", c.args()[0], c.args()[1], c.args()[2]);
+        reply.note(
+            internal::excerpt(rewire(slot_for(c.args()[0], kind), c.args()[1], c.args()[2], wait),
+                              internal::kMaxReplyTextChars));
+        transition = fmt::format("{}.{} <- {}", internal::excerpt(c.args()[0]),
+                                 internal::excerpt(c.args()[1]), internal::excerpt(c.args()[2]));
         break;
       }
       case CMD_SUSPEND:
@@ -272,11 +253,13 @@ ConfigReply Module::apply(const ConfigCommand& c, const CommandOrigin& origin) {
         const auto request = port.decode(c.payload_type(), c.payload());
         const auto answer = deliver_command(s, port, request.get());
         reply.answered(true);
-        reply.answer(answer.text);
+        // A kernel's answer is its own text: the reply and the log get at most a page of it.
+        const auto text = internal::excerpt(answer.text, internal::kMaxReplyTextChars);
+        reply.answer(text);
         reply.ok(answer.accepted);
         if (!answer.accepted) {
           reply.error(fmt::format("command '{}' refused by kernel '{}': {}", port.name(),
-                                  port.kernel(), answer.text));
+                                  port.kernel(), text));
           log_->warn("{}", reply.error());
         }
         reply.state(state());
@@ -287,7 +270,9 @@ ConfigReply Module::apply(const ConfigCommand& c, const CommandOrigin& origin) {
     reply.ok(true);
   } catch (const std::exception& e) {
     reply.ok(false);
-    reply.error(fmt::format("{} failed: {}", kind, e.what()));
+    // An exception's text may quote an argument (up to kMaxArgChars) or a kernel's words.
+    reply.error(internal::excerpt(fmt::format("{} failed: {}", kind, e.what()),
+                                  internal::kMaxReplyTextChars));
     log_->warn("{}", reply.error());
   }
   reply.state(state());

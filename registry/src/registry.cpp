@@ -250,16 +250,19 @@ void Registry::fail(Tracked& m, const std::string& reason, bool process_gone) {
   const auto& policy = m.spec->restart;
   switch (policy.kind) {
     case RestartPolicy::Kind::kAuto:
-      if (static_cast<int>(m.restarts) < policy.max) {
+      if (m.budget.allows(failed_at, policy.max, policy.window)) {
         m.status = "restarting";
         m.restart_at = failed_at + policy.backoff;
         set_system("suspended",
-                   fmt::format("'{}' {}; restart {} of {} in {}", name, reason, m.restarts + 1,
-                               policy.max, format_duration(policy.backoff)));
+                   fmt::format("'{}' {}; restart {} of {} within {} in {}", name, reason,
+                               m.budget.within(failed_at, policy.window) + 1, policy.max,
+                               format_duration(policy.window), format_duration(policy.backoff)));
       } else {
-        m.last_failure = fmt::format("{} (restart limit {} reached; the module is given up)",
-                                     reason, policy.max);
-        spdlog::error("registry: module '{}' reached its restart limit ({}); {}", name, policy.max,
+        m.last_failure =
+            fmt::format("{} (restart limit {} reached within {}; the module is given up)", reason,
+                        policy.max, format_duration(policy.window));
+        spdlog::error("registry: module '{}' reached its restart limit ({} within {}); {}", name,
+                      policy.max, format_duration(policy.window),
                       policy.continue_on_limit ? "the rest continues without it"
                                                : "the system stays suspended");
         if (policy.continue_on_limit) {

@@ -46,7 +46,10 @@ void Registry::tick() {
       launch(*m, 1);
       publish();
     } else if (m->status == "restarting" && m->process_gone && now >= m->restart_at) {
-      if (m->incarnation > 0 && !m->restart_requested) ++m->restarts;
+      if (m->incarnation > 0 && !m->restart_requested) {
+        ++m->restarts;
+        m->budget.record(now);
+      }
       m->restart_requested = false;
       launch(*m, m->incarnation + 1);
       publish();

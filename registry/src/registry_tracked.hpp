@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "oscar/registry/registry.hpp"
+#include "restart_budget.hpp"
 
 namespace oscar {
 
@@ -14,7 +15,8 @@ struct Registry::Tracked {
   unsigned incarnation = 0;  // 0: never started
   long pid = 0;
   long launched_by = 0;            // pid of the monitor that started the current incarnation
-  unsigned restarts = 0;           // after failures (what the restart limit counts)
+  unsigned restarts = 0;           // after failures, all of them (`oscar ps`)
+  internal::RestartBudget budget;  // the restarts after failures the restart limit counts
   bool restart_requested = false;  // the pending restart is an operator's, not a failure's
   std::string last_failure;
   bool process_gone = true;  // the current incarnation's process is known to have ended

@@ -71,7 +71,7 @@ RestartPolicy parse_restart(const YAML::Node& node, const std::string& file,
   RestartPolicy r;
   if (!node) return r;
   if (!node.IsMap()) fail(yaml_where(file, node), what + ": expected a map with policy");
-  check_yaml_keys(node, file, what, {"policy", "max", "backoff", "replace", "on_limit"});
+  check_yaml_keys(node, file, what, {"policy", "max", "window", "backoff", "replace", "on_limit"});
   const auto policy =
       node["policy"] ? node["policy"].as<std::string>() : (node["replace"] ? "replace" : "auto");
   if (policy == "auto") {
@@ -93,6 +93,7 @@ RestartPolicy parse_restart(const YAML::Node& node, const std::string& file,
     r.max = node["max"].as<int>();
     if (r.max < 0) fail(yaml_where(file, node["max"]), what + ".max must be >= 0");
   }
+  if (node["window"]) r.window = millis(node["window"], file, what + ".window");
   if (node["backoff"]) r.backoff = millis(node["backoff"], file, what + ".backoff");
   if (node["on_limit"]) {
     const auto on_limit = node["on_limit"].as<std::string>();

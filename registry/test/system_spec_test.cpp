@@ -35,7 +35,7 @@ modules:
     host: a
     kernels: [ { type: bench_source, name: src } ]
     mode: { continuous: 50ms }
-    restart: { policy: auto, max: 2, backoff: 100ms, on_limit: continue }
+    restart: { policy: auto, max: 2, window: 30s, backoff: 100ms, on_limit: continue }
   - name: sink
     host: b
     kernels: [ { type: bench_sink, name: sink, inputs: { in: src/out } } ]
@@ -56,8 +56,10 @@ TEST(SystemSpec, ReadsHostsPoliciesAndPerHostNetworks) {
   const auto* src = s.find_module("src");
   ASSERT_NE(src, nullptr);
   EXPECT_EQ(src->restart.max, 2);
+  EXPECT_EQ(src->restart.window, std::chrono::seconds(30));
   EXPECT_EQ(src->restart.backoff, std::chrono::milliseconds(100));
   EXPECT_TRUE(src->restart.continue_on_limit);
+  EXPECT_EQ(s.find_module("sink")->restart.window, std::chrono::minutes(10)) << "the default";
   EXPECT_EQ(src->spec.domain, 7);
   EXPECT_EQ(src->spec.network.interfaces, std::vector<std::string>{"10.77.0.1"});
   EXPECT_EQ(src->spec.network.peers, (std::vector<std::string>{"10.77.0.1", "10.77.0.2"}));
@@ -172,6 +174,9 @@ TEST(SystemSpec, BadPolicyValuesAreErrors) {
       error_of(
           "modules: [ { name: a, kernels: [ { type: relay } ], restart: { backoff: soon } } ]"),
       HasSubstr("restart.backoff"));
+  EXPECT_THAT(
+      error_of("modules: [ { name: a, kernels: [ { type: relay } ], restart: { window: 0s } } ]"),
+      HasSubstr("module 'a'.restart.window: must be positive"));
   EXPECT_THAT(
       error_of("modules: [ { name: a, kernels: [ { type: relay } ], debug: { gdbserver: 0 } } ]"),
       HasSubstr("gdbserver: a TCP port"));

@@ -243,6 +243,36 @@ TEST(Registry, AtTheRestartLimitTheSystemStaysSuspendedByDefault) {
   });
 }
 
+// Restart limit 1 within 6 s: a failure after the window is restarted again; the count was
+// never reset, so the second failure gave the module up however long after the first it came.
+TEST(Registry, ARestartOlderThanTheWindowNoLongerCountsAgainstTheLimit) {
+  std::string yaml = limited("suspend");
+  yaml.replace(yaml.find("max: 1,"), 7, "max: 1, window: 6s,");
+  BootedSystem sys("limit_window", yaml);
+  auto s = sys.running();
+  kill(static_cast<pid_t>(entry(s, "flaky")->pid()), SIGKILL);
+  s = sys.wait_for([](const SystemState& st) {
+    return entry(st, "flaky")->incarnation() == 2 && st.state() == "running";
+  });
+  std::this_thread::sleep_for(std::chrono::seconds(7));  // the first restart leaves the window
+  kill(static_cast<pid_t>(entry(s, "flaky")->pid()), SIGKILL);
+  s = sys.wait_for([](const SystemState& st) {
+    const auto* flaky = entry(st, "flaky");
+    // "failed" is published before "restarting": only the limit's text says given up.
+    return (flaky->incarnation() == 3 && st.state() == "running") ||
+           flaky->last_failure().find("restart limit") != std::string::npos;
+  });
+  EXPECT_EQ(entry(s, "flaky")->incarnation(), 3u) << entry(s, "flaky")->last_failure();
+  EXPECT_EQ(entry(s, "flaky")->restarts(), 2u);
+  // A third failure within 6 s of the second restart is over the limit.
+  kill(static_cast<pid_t>(entry(s, "flaky")->pid()), SIGKILL);
+  s = sys.wait_for([](const SystemState& st) {
+    return entry(st, "flaky")->last_failure().find("restart limit") != std::string::npos;
+  });
+  EXPECT_EQ(entry(s, "flaky")->status(), "failed");
+  EXPECT_THAT(entry(s, "flaky")->last_failure(), HasSubstr("restart limit 1 reached within 6s"));
+}
+
 TEST(Registry, ReplacePolicyStartsTheStandbyModuleAndRewiresItsConsumers) {
   BootedSystem sys("replace", R"(
 system: replace

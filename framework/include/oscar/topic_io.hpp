@@ -34,6 +34,11 @@ eprosima::fastdds::dds::DataReaderQos stream_reader(int depth);
 /// Reliable, volatile, keep all: commands, none of which may be dropped (oscar/config/...).
 eprosima::fastdds::dds::DataWriterQos command_writer();
 eprosima::fastdds::dds::DataReaderQos command_reader();
+/// Reliable, volatile, keep last `depth`: the reader of requests anyone may write (a module's
+/// configuration commands). Its listener takes each sample as it comes, so nothing is replaced
+/// unless a writer outruns it; then the oldest go, instead of the reader's history growing
+/// without bound. Matches command_writer().
+eprosima::fastdds::dds::DataReaderQos request_reader(int depth);
 /// Reliable, keep last 1, manual-by-topic liveliness with `lease`.
 eprosima::fastdds::dds::DataWriterQos beat_writer(std::chrono::milliseconds lease);
 eprosima::fastdds::dds::DataReaderQos beat_reader(std::chrono::milliseconds lease);

@@ -48,7 +48,11 @@ bool is_cue(std::string_view topic);
 TopicSpec<PullRequest, PullRequestPubSubType> pull_request(std::string_view address);
 TopicSpec<PullReply, PullReplyPubSubType> pull_reply(std::string_view address);
 
-/// Configuration commands to `module` (reliable, keep all: no command is dropped).
+/// How many configuration commands a module's reader holds that its listener has not taken.
+inline constexpr int kConfigReaderDepth = 64;
+/// Configuration commands to `module`: reliable; the writer keeps all, the module's reader the
+/// last kConfigReaderDepth. A writer that outruns the module's listener has the oldest commands
+/// not yet taken replaced (whoever wrote them) instead of growing the reader without bound.
 TopicSpec<ConfigCommand, ConfigCommandPubSubType> config(const std::string& module);
 /// `module`'s replies to configuration commands (state class, 64 deep: a client that matches
 /// late still gets its reply).

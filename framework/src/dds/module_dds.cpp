@@ -1,5 +1,6 @@
 #include "dds/module_dds.hpp"
 
+#include "command_bounds.hpp"
 #include "dds/guarded_type.hpp"
 #include "dds/log_sink.hpp"
 #include "oscar/malformed_samples.hpp"
@@ -15,6 +16,7 @@
 #include <thread>
 
 #include <fmt/format.h>
+#include <fmt/ostream.h>
 #include <oscar/configPubSubTypes.h>
 #include <oscar/registryPubSubTypes.h>
 
@@ -387,10 +389,7 @@ void Module::Dds::start_config() {
   config_reader_ = std::make_unique<TopicReader<ConfigCommand, ConfigCommandPubSubType>>(
       participant_, topics::config(name),
       [this](const ConfigCommand& c, const eprosima::fastdds::dds::SampleInfo& info) {
-        auto origin = origin_of(info);
-        std::lock_guard lock(queue_mutex_);
-        queue_.push_back({c, std::move(origin)});
-        queue_cv_.notify_all();
+        enqueue(c, info);
       });
   log_writer_ =
       std::make_unique<TopicWriter<LogRecord, LogRecordPubSubType>>(participant_, topics::log());
@@ -425,19 +424,59 @@ CommandOrigin Module::Dds::origin_of(const eprosima::fastdds::dds::SampleInfo& i
   return origin;
 }
 
+void Module::Dds::enqueue(const ConfigCommand& c, const eprosima::fastdds::dds::SampleInfo& info) {
+  const auto now = std::chrono::steady_clock::now();
+  const auto writer =
+      fmt::format("{}", fmt::streamed(info.sample_identity.writer_guid().guidPrefix));
+  {
+    std::lock_guard lock(queue_mutex_);
+    if (!rate_limit_.admit(writer, now)) return;  // reported by the configuration thread
+    if (queue_.size() >= kMaxQueuedCommands) {
+      ++queue_full_drops_;
+      return;
+    }
+  }
+  auto origin = origin_of(info);  // asks discovery: not under the queue's lock
+  std::lock_guard lock(queue_mutex_);
+  if (queue_.size() >= kMaxQueuedCommands) {  // filled by another DDS thread meanwhile
+    ++queue_full_drops_;
+    return;
+  }
+  queue_.push_back({c, std::move(origin)});
+  queue_cv_.notify_all();
+}
+
+void Module::Dds::report_drops() {
+  std::optional<std::string> over_rate;
+  std::uint64_t queue_full = 0;
+  {
+    std::lock_guard lock(queue_mutex_);
+    over_rate = rate_limit_.report(std::chrono::steady_clock::now());
+    if (over_rate || queue_full_drops_ > 0) std::swap(queue_full, queue_full_drops_);
+  }
+  if (over_rate) module_.log_->warn("{}", *over_rate);
+  if (queue_full > 0) {
+    module_.log_->warn("dropped {} configuration command(s): {} were waiting already", queue_full,
+                       kMaxQueuedCommands);
+  }
+}
+
 // Commands are applied on their own thread, never inside a DDS callback: a rewire creates and
 // deletes readers, and activate waits for the processing thread.
 void Module::Dds::serve_config() {
   std::unique_lock lock(queue_mutex_);
   const auto ready = [&] { return !serving_ || !queue_.empty() || !refollow_.empty(); };
   while (true) {
-    if (awaiting_type_.empty()) {
-      queue_cv_.wait(lock, ready);
-    } else {
-      // Discovery is polled for raw inputs whose source has not shown up yet.
-      queue_cv_.wait_for(lock, std::chrono::milliseconds(50), ready);
-    }
+    // Discovery is polled for raw inputs whose source has not shown up yet; dropped commands
+    // are reported within a second.
+    queue_cv_.wait_for(
+        lock,
+        awaiting_type_.empty() ? std::chrono::milliseconds(1000) : std::chrono::milliseconds(50),
+        ready);
     if (!serving_) return;
+    lock.unlock();
+    report_drops();
+    lock.lock();
     if (!awaiting_type_.empty()) {
       lock.unlock();
       subscribe_discovered();
@@ -456,12 +495,16 @@ void Module::Dds::serve_config() {
     queue_.pop_front();
     lock.unlock();
     // A repeated command (same sender and id: the client did not see our reply) is answered
-    // again, not applied twice.
-    auto& last = last_reply_[command.sender()];
-    if (last.id() != command.id() || last.module_name().empty()) {
-      last = module_.apply(command, origin);
+    // again, not applied twice. A sender over its limit is refused and not remembered.
+    if (const auto* last = last_replies_.find(command.sender(), command.id())) {
+      reply_writer_->write(*last);
+    } else {
+      const auto reply = module_.apply(command, origin);
+      if (command.sender().size() <= internal::kMaxSenderChars) {
+        last_replies_.remember(command.sender(), reply);
+      }
+      reply_writer_->write(reply);
     }
-    reply_writer_->write(last);
     lock.lock();
   }
 }

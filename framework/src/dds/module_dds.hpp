@@ -18,6 +18,7 @@
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 
+#include "command_rate_limit.hpp"
 #include "dds/module_wishes.hpp"
 #include "dds/pull.hpp"
 #include "module_slot.hpp"
@@ -25,6 +26,7 @@
 #include "oscar/module.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
+#include "reply_memory.hpp"
 
 namespace oscar {
 
@@ -98,10 +100,20 @@ class Module::Dds {
   };
   // The modules of the running system living in the process that wrote a command.
   CommandOrigin origin_of(const eprosima::fastdds::dds::SampleInfo& info);
+  // Called on a DDS thread for each command: queues it unless its writer is over its rate or
+  // the queue is full.
+  void enqueue(const ConfigCommand& c, const eprosima::fastdds::dds::SampleInfo& info);
+  // On the configuration thread: a line for each kind of drop, at most once a second.
+  void report_drops();
+  /// Commands waiting to be applied, at most: a second of every writer at its full rate cannot
+  /// grow the queue without bound, and an honest command waits behind no more than these.
+  static constexpr std::size_t kMaxQueuedCommands = 256;
   std::deque<Command> queue_;
-  std::deque<Refollow> refollow_;  // served by the configuration thread, like queue_
+  internal::CommandRateLimit rate_limit_;  // under queue_mutex_
+  std::uint64_t queue_full_drops_ = 0;     // under queue_mutex_; reported and reset
+  std::deque<Refollow> refollow_;          // served by the configuration thread, like queue_
   std::map<InputPort*, std::string> awaiting_type_;  // raw inputs whose source is not seen yet
-  std::map<std::string, ConfigReply> last_reply_;    // by sender: answers repeated commands
+  internal::ReplyMemory last_replies_;  // the configuration thread's: answers repeated commands
   bool serving_ = false;
   std::thread config_thread_;
   std::unique_ptr<TopicWriter<ModuleBeat, ModuleBeatPubSubType>> beat_writer_;

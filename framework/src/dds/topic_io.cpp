@@ -58,6 +58,17 @@ dds::DataReaderQos command_reader() {
   return reliable(dds::DATAREADER_QOS_DEFAULT, kVolatile, kKeepAll);
 }
 
+dds::DataReaderQos request_reader(int depth) {
+  auto q = reliable(dds::DATAREADER_QOS_DEFAULT, kVolatile, kKeepLast, depth);
+  // The limits say the same as the depth. Without them (Fast DDS 2.9.1's defaults, 5000
+  // samples), a module's keep-last reader flooded by one writer delivered that writer's first
+  // command and then nothing at all, from any writer.
+  q.resource_limits().max_instances = 1;
+  q.resource_limits().max_samples_per_instance = depth;
+  q.resource_limits().max_samples = depth;
+  return q;
+}
+
 dds::DataWriterQos beat_writer(std::chrono::milliseconds lease) {
   dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
   q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;

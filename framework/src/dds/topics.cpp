@@ -30,7 +30,9 @@ TopicSpec<PullReply, PullReplyPubSubType> pull_reply(std::string_view address) {
 }
 
 TopicSpec<ConfigCommand, ConfigCommandPubSubType> config(const std::string& module) {
-  return {"oscar/config/" + module, qos::command_writer(), qos::command_reader()};
+  // The writer keeps every command until the module has it; the module's reader keeps at most
+  // kConfigReaderDepth not yet taken (its listener takes them at once and rate-limits writers).
+  return {"oscar/config/" + module, qos::command_writer(), qos::request_reader(kConfigReaderDepth)};
 }
 
 TopicSpec<ConfigReply, ConfigReplyPubSubType> config_reply(const std::string& module) {

@@ -28,7 +28,9 @@ struct HostSpec {
 struct RestartPolicy {
   enum class Kind { kAuto, kManual, kReplace };
   Kind kind = Kind::kAuto;
-  int max = 3;                             ///< kAuto: restarts before the module is given up
+  int max = 3;  ///< kAuto: restarts within `window` before the module is given up
+  /// kAuto: restarts longer ago than this no longer count against `max`.
+  std::chrono::milliseconds window{std::chrono::minutes(10)};
   std::chrono::milliseconds backoff{200};  ///< kAuto: wait before each restart
   std::string replacement;                 ///< kReplace: the standby module started instead
   bool continue_on_limit = false;          ///< the rest resumes once the module is given up
