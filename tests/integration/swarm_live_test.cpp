@@ -113,16 +113,27 @@ class LiveSwarm : public ::testing::Test {
     }
   }
 
+  // Waits until the coordinator plans with `robot`: each test boots the system anew, and on a
+  // slow machine a robot's module may still be coming up when the others are in planning.
+  static void in_planning(const std::string& robot) {
+    client_->status(
+        [&](const SwarmStatus& s) {
+          return std::find(s.robots().begin(), s.robots().end(), robot) != s.robots().end();
+        },
+        (robot + " in planning").c_str());
+  }
+  // The tests choose their jobs' places by which robot is nearest, so all nine must be there.
+  static void all_in_planning() {
+    client_->status([](const SwarmStatus& x) { return x.robots().size() == 9; },
+                    "nine robots in planning");
+  }
+
   // Waits until the robot standing at (x, y) is in planning and the coordinator reaches it: its
   // first command to a module may time out while the module's command channel is discovered
   // (ConfigClient opens it on first use), and the job would go elsewhere. So a tiny job where
   // the robot stands, due so soon that no other robot gets there, until it is committed.
   static void ready(const std::string& robot, double x, double y) {
-    client_->status(
-        [&](const SwarmStatus& s) {
-          return std::find(s.robots().begin(), s.robots().end(), robot) != s.robots().end();
-        },
-        "the robot in planning");
+    in_planning(robot);
     std::string why;
     for (int attempt = 0; attempt < 5; ++attempt) {
       const auto id = robot + "_ready_" + std::to_string(attempt);
@@ -162,7 +173,7 @@ TEST_F(LiveSwarm, AllRobotsJoinPlanning) {
 }
 
 TEST_F(LiveSwarm, AJobSubmittedOverDdsIsDoneByTheNearestRobotAtItsPlaceInItsWindow) {
-  client_->status([](const SwarmStatus& x) { return x.robots().size() >= 4; }, "robots");
+  all_in_planning();
   const auto id = client_->schedule(job("near_r1", 2, 1, 3, 30, 2));
   const auto r = client_->outcome(id);
   ASSERT_EQ(r.outcome(), SWARM_COMMITTED) << r.reason();
@@ -179,7 +190,7 @@ TEST_F(LiveSwarm, AJobSubmittedOverDdsIsDoneByTheNearestRobotAtItsPlaceInItsWind
 }
 
 TEST_F(LiveSwarm, ANakAbortsThatRobotsPartAndTheJobIsPlacedElsewhere) {
-  client_->status([](const SwarmStatus& x) { return x.robots().size() >= 4; }, "robots");
+  all_in_planning();
   const auto before = client_->status([](const SwarmStatus&) { return true; }, "a status");
   const auto id = client_->schedule(job("near_rn", 19, 1, 3, 60, 2));  // rn is nearest
   const auto r = client_->outcome(id);
@@ -195,7 +206,7 @@ TEST_F(LiveSwarm, ANakAbortsThatRobotsPartAndTheJobIsPlacedElsewhere) {
 }
 
 TEST_F(LiveSwarm, ASilentRobotTimesOutAndTheJobIsPlacedElsewhere) {
-  client_->status([](const SwarmStatus& x) { return x.robots().size() >= 4; }, "robots");
+  all_in_planning();
   const auto before = client_->status([](const SwarmStatus&) { return true; }, "a status");
   const auto id = client_->schedule(job("near_rs", 19, 19, 4, 60, 2));  // rs is nearest
   const auto r = client_->outcome(id);
@@ -231,7 +242,7 @@ TEST_F(LiveSwarm, BadJobSpecificationsAreRefusedWithTheReason) {
 }
 
 TEST_F(LiveSwarm, ABrokenDownRobotsJobsGoToOthers) {
-  client_->status([](const SwarmStatus& x) { return x.robots().size() >= 4; }, "robots");
+  all_in_planning();
   // rb is nearest; it breaks down before the job's window.
   const auto id = client_->schedule(job("after_breakdown", 39, 1, 20, 90, 2));
   const auto first = client_->outcome(id);
@@ -250,7 +261,7 @@ TEST_F(LiveSwarm, ABrokenDownRobotsJobsGoToOthers) {
 }
 
 TEST_F(LiveSwarm, ADependentSetStaysWholeWhenOneOfItsRobotsRefuses) {
-  client_->status([](const SwarmStatus& x) { return x.robots().size() >= 4; }, "robots");
+  all_in_planning();
   // A is nearest rn (which refuses), B nearest r2: the first plan asks both, rn's NAK aborts the
   // whole set, and the set is planned again without rn.
   const auto id =
@@ -277,7 +288,7 @@ bool clear_of(const SwarmPlacedJob& a, const SwarmPlacedJob& b, double clearance
 }
 
 TEST_F(LiveSwarm, ConcurrentSubmissionsSeeEachOthersOpenTransactions) {
-  client_->status([](const SwarmStatus& x) { return x.robots().size() >= 4; }, "robots");
+  all_in_planning();
   // Two requesters want the same 2 m square at once. The first plan goes to rs, which answers
   // only after the coordinator stopped waiting, so that transaction is open while the second
   // request is planned: the second must keep clear of it (and of where rs stands meanwhile).
@@ -325,7 +336,7 @@ Snapshot snapshot(std::vector<std::string> args) {
 // The picture of the running swarm: the robots where they are, labelled, the committed path of
 // a robot on its way to a job, and the job with its start from now.
 TEST_F(LiveSwarm, TheSnapshotDrawsTheRobotsTheirCommittedPathsAndJobs) {
-  client_->status([](const SwarmStatus& x) { return x.robots().size() >= 4; }, "robots");
+  all_in_planning();
   const auto id = client_->schedule(job("drawn", 6, 3, 20, 60, 2));
   const auto r = client_->outcome(id);
   ASSERT_EQ(r.outcome(), SWARM_COMMITTED) << r.reason();
