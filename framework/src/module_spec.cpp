@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "oscar/security_files.hpp"
 #include "oscar/time.hpp"
 
 namespace oscar {
@@ -322,6 +323,10 @@ ModuleSpec ModuleSpec::load(const std::string& path, const std::string& module) 
         auto spec = from_yaml(m, path);
         if (!spec.domain && root["domain"]) spec.domain = root["domain"].as<int>();
         if (!m["network"]) spec.network = NetworkConfig::for_host(root, spec.host);
+        if (const auto keystore = security_files::system_keystore(root, path); !keystore.empty()) {
+          spec.network.security =
+              ParticipantSecurity{keystore, security_files::module_identity(spec.name)};
+        }
         const auto system_plugins = plugins_of(root, path);
         spec.plugins.insert(spec.plugins.begin(), system_plugins.begin(), system_plugins.end());
         if (root["lease"]) {

@@ -13,6 +13,7 @@
 #include "oscar/cue_types.hpp"
 #include "oscar/module.hpp"
 #include "oscar/process_util.hpp"
+#include "oscar/security_files.hpp"
 #include "oscar/time.hpp"
 
 namespace {
@@ -112,6 +113,12 @@ int run_main(int argc, char** argv) {
     spec.incarnation = incarnation;
     if (!restore.empty()) spec.restore(YAML::Load(restore));
     spec.start_suspended = suspended;
+    if (const auto keystore = security_files::keystore_from_env();
+        !keystore.empty() && !spec.network.security) {
+      // A module of no system file joins a secured system as the module of its name.
+      spec.network.security =
+          ParticipantSecurity{keystore, security_files::module_identity(spec.name)};
+    }
     Module module(std::move(spec), plugin_search_path());
     if (check) {
       const auto state = module.state();  // kept: a range-for would not extend its life

@@ -1,8 +1,10 @@
 #include "oscar/security_files.hpp"
 
+#include <cstdlib>
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
 
 namespace oscar::security_files {
 
@@ -42,6 +44,24 @@ std::vector<Property> dds_security_properties(const std::filesystem::path& keyst
       {access + "permissions", uri(kPermissions)},
       {"dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC"},
   };
+}
+
+std::string keystore_from_env() {
+  const char* env = std::getenv("OSCAR_KEYSTORE");
+  if (!env || !*env) return "";
+  return std::filesystem::absolute(env).lexically_normal().string();
+}
+
+std::string system_keystore(const YAML::Node& root, const std::string& file) {
+  namespace fs = std::filesystem;
+  if (auto from_env = keystore_from_env(); !from_env.empty()) return from_env;
+  // (A key a map lacks gives an invalid node, whose every query but `if (node)` throws.)
+  const auto security = root && root.IsMap() ? root["security"] : YAML::Node();
+  const auto keystore = security && security.IsMap() ? security["keystore"] : YAML::Node();
+  if (!keystore || !keystore.IsScalar() || keystore.Scalar().empty()) return "";
+  fs::path dir = keystore.Scalar();
+  if (dir.is_relative()) dir = fs::absolute(file).parent_path() / dir;
+  return dir.lexically_normal().string();
 }
 
 }  // namespace oscar::security_files

@@ -30,6 +30,7 @@
 #include "oscar/registry/running_systems.hpp"
 #include "oscar/registry/supervisor.hpp"
 #include "oscar/registry/system_spec.hpp"
+#include "oscar/security_files.hpp"
 #include "oscar/time.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
@@ -48,6 +49,16 @@ void check_hosts(const oscar::SystemSpec& system) {
           h.where, h.name, h.netns, h.netns));
     }
   }
+}
+
+// With a keystore, every process of the system must find its identity there before anything
+// starts: a module without one would fail at each restart with the rest of the system running.
+void check_identities(const oscar::SystemSpec& system, const std::string& keystore) {
+  namespace sf = oscar::security_files;
+  std::vector<std::string> identities{sf::kRegistry, sf::kBoot};
+  for (const auto& h : system.hosts) identities.push_back(sf::monitor_identity(h.name));
+  for (const auto& m : system.modules) identities.push_back(sf::module_identity(m.spec.name));
+  for (const auto& identity : identities) sf::dds_security_properties(keystore, identity);
 }
 
 std::string summary(const oscar::SystemState& s) {
@@ -129,7 +140,7 @@ std::chrono::milliseconds seconds(double s) {
 
 int main(int argc, char** argv) {
   CLI::App app{"oscar boot: boots a system of modules across hosts from one YAML file"};
-  std::string file, log_dir;
+  std::string file, log_dir, keystore_flag;
   int domain = -1;
   double timeout_s = 30, duration_s = 0;
   bool check = false;
@@ -138,6 +149,9 @@ int main(int argc, char** argv) {
   app.add_option("--timeout", timeout_s, "seconds to wait until every module is announced");
   app.add_option("--duration", duration_s, "stop after this many seconds (default: Ctrl-C)");
   app.add_option("--log-dir", log_dir, "where process output goes (default /tmp/oscar/...)");
+  app.add_option("--keystore", keystore_flag,
+                 "DDS Security keystore for every process (default: the file's security: "
+                 "keystore:; docs/security.md)");
   app.add_flag("--check", check, "check the system file and its modules, start nothing");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 
@@ -145,8 +159,19 @@ int main(int argc, char** argv) {
 
   oscar::LogPrinter log(stdout, isatty(1) != 0);
   try {
+    if (!keystore_flag.empty()) {
+      if (!std::filesystem::is_directory(keystore_flag)) {
+        throw std::invalid_argument(fmt::format(
+            "--keystore {}: no such folder (make it: oscar security init {} --keystore {})",
+            keystore_flag, file, keystore_flag));
+      }
+      // Every process boot starts, and each module its monitor starts, inherits it.
+      setenv("OSCAR_KEYSTORE", std::filesystem::absolute(keystore_flag).c_str(), 1);
+    }
     auto system = oscar::SystemSpec::load(file);
     if (domain >= 0) system.override_domain(domain);
+    const auto keystore = system.keystore();
+    if (!keystore.empty()) check_identities(system, keystore);
     oscar::register_standard_cue_types();
     system.check_modules(oscar::plugin_search_path());
     oscar::coordinator::check_applets(system, oscar::plugin_search_path());
@@ -168,10 +193,11 @@ int main(int argc, char** argv) {
          .system = system.name,
          .file = file,
          .log_dir = log_dir,
+         .keystore = keystore,
          .boot_pid = getpid(),
          .started = static_cast<long long>(std::time(nullptr))});
     oscar::DdsParticipant participant(system.domain, "oscar-boot",
-                                      oscar::NetworkConfig::for_host(system.root, local.name));
+                                      system.network_for(local.name, oscar::security_files::kBoot));
     std::mutex last_line_mutex;  // DDS may call back from its UDP and shared-memory threads
     std::string last_line;
     bool booted = false;  // states before are another system's, which check_domain_free names
@@ -195,6 +221,19 @@ int main(int argc, char** argv) {
                                  "in {}",
                                  system.name, file, system.modules.size(), system.hosts.size(),
                                  system.domain, log_dir));
+    if (keystore.empty()) {
+      log.note("boot",
+               fmt::format("unauthenticated: the system runs without DDS Security, so any process "
+                           "that reaches domain {} can read its cues, configure its modules and "
+                           "stop it (a keystore: oscar security init, then oscar boot --keystore "
+                           "DIR; docs/security.md)",
+                           system.domain),
+               oscar::LOG_WARN);
+    } else {
+      log.note("boot", fmt::format("secured with keystore {}: every process authenticates as its "
+                                   "own identity",
+                                   keystore));
+    }
     {
       std::lock_guard lock(last_line_mutex);
       booted = true;

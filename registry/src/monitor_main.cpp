@@ -21,6 +21,7 @@
 #include "oscar/registry/launch_command.hpp"
 #include "oscar/registry/supervisor.hpp"
 #include "oscar/registry/system_spec.hpp"
+#include "oscar/security_files.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
 
@@ -64,7 +65,7 @@ int main(int argc, char** argv) {
       log_dir = fmt::format("/tmp/oscar/{}-{}/{}", system.name, system.domain, host);
     }
     oscar::Supervisor supervisor(log_dir);
-    const auto network = oscar::NetworkConfig::for_host(system.root, host);
+    const auto network = system.network_for(host, oscar::security_files::monitor_identity(host));
     oscar::DdsParticipant participant(system.domain, "oscar-monitor:" + host, network);
     oscar::TopicWriter<oscar::ProcessEvent, oscar::ProcessEventPubSubType> events(
         participant, oscar::topics::process_events());

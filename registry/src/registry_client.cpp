@@ -2,7 +2,10 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <filesystem>
+#include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 
@@ -11,6 +14,7 @@
 #include <oscar/registryPubSubTypes.h>
 
 #include "oscar/registry/system_spec.hpp"
+#include "oscar/security_files.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
 
@@ -19,7 +23,17 @@ namespace oscar {
 struct RegistryClient::Endpoints {
   TopicReader<SystemState, SystemStatePubSubType> states;
   TopicReader<RegistryReply, RegistryReplyPubSubType> replies;
-  TopicWriter<RegistryRequest, RegistryRequestPubSubType> requests;
+  // Made at the first request: a client that only watches writes nothing, which is all a
+  // read-only identity may do in a secured system.
+  DdsParticipant& participant;
+  std::mutex requests_mutex{};
+  std::optional<TopicWriter<RegistryRequest, RegistryRequestPubSubType>> requests{};
+
+  TopicWriter<RegistryRequest, RegistryRequestPubSubType>& request_writer() {
+    std::lock_guard lock(requests_mutex);
+    if (!requests) requests.emplace(participant, topics::registry_request());
+    return *requests;
+  }
 };
 
 RegistryClient::RegistryClient(DdsParticipant& participant, std::string sender,
@@ -40,7 +54,7 @@ RegistryClient::RegistryClient(DdsParticipant& participant, std::string sender,
                              replies_[r.id()] = r;
                              changed_.notify_all();
                            }},
-                          {participant, topics::registry_request()}});
+                          participant});
 }
 
 RegistryClient::~RegistryClient() { io_.reset(); }
@@ -71,13 +85,14 @@ void RegistryClient::request(RegistryRequestKind kind, const std::string& module
   q.module_name(module);
   // Wait for the registry's reader first: a request nobody matched would be lost in silence.
   const auto until = std::chrono::steady_clock::now() + timeout;
-  while (io_->requests.matched() == 0) {
+  auto& requests = io_->request_writer();
+  while (requests.matched() == 0) {
     if (std::chrono::steady_clock::now() > until) {
       throw std::runtime_error("no registry is running on this domain (is the system booted?)");
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  io_->requests.write(q);
+  requests.write(q);
   std::unique_lock lock(mutex_);
   if (!changed_.wait_until(lock, until, [&] { return replies_.contains(id); })) {
     throw std::runtime_error("the registry did not answer in time");
@@ -109,7 +124,11 @@ std::string where_systems_run(int domain) {
 }
 
 std::unique_ptr<DdsParticipant> tool_participant(const std::string& name, std::string system_file,
-                                                 const std::string& host, int domain) {
+                                                 const std::string& host, int domain,
+                                                 ToolAuthority authority) {
+  const std::string identity = authority == ToolAuthority::kActAsBoot
+                                   ? security_files::kOperatorBoot
+                                   : security_files::kOperator;
   if (system_file.empty() && domain < 0) {
     domain = domain_from_env(-1);
     if (domain < 0) {
@@ -119,11 +138,23 @@ std::unique_ptr<DdsParticipant> tool_participant(const std::string& name, std::s
       if (running && std::filesystem::exists(running->file)) system_file = running->file;
     }
   }
-  if (system_file.empty()) return std::make_unique<DdsParticipant>(domain, name);
-  const auto system = SystemSpec::load(system_file);
-  const auto& h = host.empty() ? system.local_host() : system.host(host);
-  return std::make_unique<DdsParticipant>(domain >= 0 ? domain : system.domain, name,
-                                          NetworkConfig::for_host(system.root, h.name));
+  NetworkConfig network;
+  std::optional<SystemSpec> system;
+  if (!system_file.empty()) {
+    system = SystemSpec::load(system_file);
+    if (domain < 0) domain = system->domain;
+    network = system->network_for((host.empty() ? system->local_host() : system->host(host)).name,
+                                  identity);
+  }
+  if (!network.security) {
+    // $OSCAR_KEYSTORE, else the keystore `oscar boot --keystore` was given for this domain.
+    std::string keystore = system ? "" : security_files::keystore_from_env();
+    if (const auto running = running_system(domain); keystore.empty() && running) {
+      keystore = running->keystore;
+    }
+    if (!keystore.empty()) network.security = ParticipantSecurity{keystore, identity};
+  }
+  return std::make_unique<DdsParticipant>(domain, name, network);
 }
 
 }  // namespace oscar

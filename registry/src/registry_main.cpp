@@ -9,6 +9,7 @@
 
 #include "oscar/process_util.hpp"
 #include "oscar/registry/registry.hpp"
+#include "oscar/security_files.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"oscar-registry: boots a system through its monitors and restarts failed modules"};
@@ -26,7 +27,7 @@ int main(int argc, char** argv) {
     if (domain >= 0) system.override_domain(domain);
     if (host.empty()) host = system.local_host().name;
     oscar::DdsParticipant participant(system.domain, "oscar-registry",
-                                      oscar::NetworkConfig::for_host(system.root, host));
+                                      system.network_for(host, oscar::security_files::kRegistry));
     oscar::Registry registry(system, participant);
     std::thread signal_waiter([&] {
       int sig = 0;

@@ -53,6 +53,7 @@ std::optional<RunningSystem> read_record(const fs::path& path) {
   s.system = j.value("system", "");
   s.file = j.value("file", "");
   s.log_dir = j.value("log_dir", "");
+  s.keystore = j.value("keystore", "");
   s.boot_pid = j.value("boot_pid", 0);
   s.started = j.value("started", 0LL);
   s.boot_started_ticks = j.value("boot_started_ticks", -1LL);
@@ -114,6 +115,7 @@ RunningSystemRecord::RunningSystemRecord(const RunningSystem& system)
                                    {"system", system.system},
                                    {"file", fs::absolute(system.file).string()},
                                    {"log_dir", system.log_dir},
+                                   {"keystore", system.keystore},
                                    {"boot_pid", system.boot_pid},
                                    {"started", system.started},
                                    {"boot_started_ticks", start_ticks(system.boot_pid)}}

@@ -25,8 +25,9 @@ void SystemOptions::add_domain_to(CLI::App& app) {
              "DDS domain (default: $OSCAR_DOMAIN, the system booted on this machine, or 0)");
 }
 
-std::unique_ptr<DdsParticipant> SystemOptions::participant(const std::string& name) const {
-  return tool_participant(name, system_file, host, domain);
+std::unique_ptr<DdsParticipant> SystemOptions::participant(const std::string& name,
+                                                           ToolAuthority authority) const {
+  return tool_participant(name, system_file, host, domain, authority);
 }
 
 int SystemOptions::resolved_domain() const {

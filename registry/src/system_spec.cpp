@@ -11,6 +11,7 @@
 #include <fmt/ranges.h>
 
 #include "oscar/module.hpp"
+#include "oscar/security_files.hpp"
 #include "oscar/time.hpp"
 #include "service_spec.hpp"
 
@@ -359,8 +360,24 @@ SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
   }
   std::vector<std::string> names;
   for (const auto& m : s.modules) names.push_back(m.spec.name);
-  for (auto& m : s.modules) m.spec.system_modules = names;
+  const auto keystore = s.keystore();
+  for (auto& m : s.modules) {
+    m.spec.system_modules = names;
+    if (!keystore.empty()) {
+      m.spec.network.security =
+          ParticipantSecurity{keystore, security_files::module_identity(m.spec.name)};
+    }
+  }
   return s;
+}
+
+std::string SystemSpec::keystore() const { return security_files::system_keystore(root, file); }
+
+NetworkConfig SystemSpec::network_for(const std::string& host_name,
+                                      const std::string& identity) const {
+  auto network = NetworkConfig::for_host(root, host_name);
+  if (const auto k = keystore(); !k.empty()) network.security = ParticipantSecurity{k, identity};
+  return network;
 }
 
 void SystemSpec::check_modules(const std::vector<std::string>& plugin_path) const {

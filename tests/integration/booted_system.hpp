@@ -22,6 +22,10 @@ class BootedSystem : public testing::SystemUnderTest {
   BootedSystem(const std::string& name, const std::string& yaml, int domain = -1)
       : SystemUnderTest(write(name, yaml), {.domain = domain < 0 ? test_domain() : domain,
                                             .log_dir = temp_path(name) + "_logs"}) {}
+  /// The same with more of boot's options (e.g. a keystore); domain and log folder as above
+  /// unless `options` gives them.
+  BootedSystem(const std::string& name, const std::string& yaml, testing::BootOptions options)
+      : SystemUnderTest(write(name, yaml), with_defaults(name, std::move(options))) {}
   ~BootedSystem() {
     shut_down();
     std::error_code ec;
@@ -44,6 +48,11 @@ class BootedSystem : public testing::SystemUnderTest {
   }
 
  private:
+  static testing::BootOptions with_defaults(const std::string& name, testing::BootOptions o) {
+    if (o.domain < 0) o.domain = test_domain();
+    if (o.log_dir.empty()) o.log_dir = temp_path(name) + "_logs";
+    return o;
+  }
   static std::string write(const std::string& name, const std::string& yaml) {
     const auto file = temp_path(name) + ".yaml";
     std::filesystem::remove_all(temp_path(name) + "_logs");

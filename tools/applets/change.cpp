@@ -51,7 +51,7 @@ int run_change(const ChangeOptions& options) {
     e.service(options.service);
     what = options.applet.empty() ? "service " + options.service : "applet " + options.applet;
   }
-  auto participant = options.tool.participant("oscar-applets-change");
+  auto participant = options.tool.participant("oscar-applets-change", ToolAuthority::kActAsBoot);
   // The coordinator's command port takes an operator's events from a tool as from boot.
   ConfigClient client(*participant, "boot");
   const auto timeout = std::chrono::milliseconds(static_cast<long>(options.timeout_s * 1000));

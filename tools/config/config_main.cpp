@@ -120,7 +120,7 @@ int main(int argc, char** argv) {
       timeout_ms +=
           static_cast<int>(std::chrono::duration_cast<std::chrono::milliseconds>(wait).count());
     }
-    auto participant = tool.participant("oscar-config");
+    auto participant = tool.participant("oscar-config", oscar::ToolAuthority::kActAsBoot);
     oscar::ConfigClient client(*participant, as);
     if (kind == oscar::CMD_COMMAND) {
       return send_command(client, module, args, std::chrono::milliseconds(timeout_ms));

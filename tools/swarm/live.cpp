@@ -180,7 +180,7 @@ int run_submit(const SubmitOptions& o) {
 int send_requests(const SystemOptions& system, const std::string& command,
                   const std::vector<SwarmRequest>& requests, double timeout_s, bool json,
                   std::int64_t now) {
-  auto participant = system.participant("oscar-swarm-" + command);
+  auto participant = system.participant("oscar-swarm-" + command, ToolAuthority::kActAsBoot);
   const std::string sender = fmt::format("oscar-swarm-{}-{}", command, getpid());
   std::mutex mutex;
   std::condition_variable changed;

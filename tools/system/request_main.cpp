@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
   tool.add_to(app);
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
-    auto participant = tool.participant(argv[0]);
+    auto participant = tool.participant(argv[0], oscar::ToolAuthority::kActAsBoot);
     oscar::RegistryClient client(*participant, "operator");
     client.request(restart ? oscar::REG_RESTART : oscar::REG_SHUTDOWN, module);
     std::printf(restart ? "restarting %s\n" : "shutting down%s\n", module.c_str());

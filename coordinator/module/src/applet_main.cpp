@@ -22,6 +22,7 @@
 #include "oscar/module.hpp"
 #include "oscar/network.hpp"
 #include "oscar/process_util.hpp"
+#include "oscar/security_files.hpp"
 
 namespace oscar::coordinator {
 namespace {
@@ -84,7 +85,8 @@ int main(int argc, char** argv) {
                               oscar::plugin_search_path());
       oscar::DdsParticipant participant(
           system.domain, "oscar:applets:" + module_name,
-          oscar::NetworkConfig::for_host(system.root, system.coordinator->host));
+          system.network_for(system.coordinator->host,
+                             oscar::security_files::module_identity(module_name)));
       oscar::coordinator::AppletHost host(system, participant, {}, joining, joining_file,
                                           module_name, plugin_path);
       host.start();
@@ -103,8 +105,7 @@ int main(int argc, char** argv) {
     if (!restore.empty()) spec.restore(YAML::Load(restore));
     const auto plugin_path = oscar::with_plugins(spec.plugins, oscar::plugin_search_path());
     oscar::Module module(spec, plugin_path);
-    oscar::DdsParticipant participant(system.domain, "oscar:applets:" + module_name,
-                                      oscar::NetworkConfig::for_host(system.root, spec.host));
+    oscar::DdsParticipant participant(system.domain, "oscar:applets:" + module_name, spec.network);
     oscar::coordinator::AppletHost host(system, participant, applets, joining, joining_file,
                                         module_name, plugin_path);
     // The applets' log goes where the module's goes: stdout and oscar/log (boot shows it).

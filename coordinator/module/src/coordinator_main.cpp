@@ -90,8 +90,7 @@ int main(int argc, char** argv) {
     if (!restore.empty()) spec.restore(YAML::Load(restore));
     const auto plugin_path = oscar::with_plugins(spec.plugins, oscar::plugin_search_path());
     oscar::Module module(spec, plugin_path);
-    oscar::DdsParticipant participant(system.domain, "oscar:coordinator-plan",
-                                      oscar::NetworkConfig::for_host(system.root, spec.host));
+    oscar::DdsParticipant participant(system.domain, "oscar:coordinator-plan", spec.network);
     oscar::coordinator::Coordinator coordinator(system, participant, plugin_path);
     std::unique_ptr<oscar::coordinator::SwarmService> swarm;
     if (auto setup = oscar::coordinator::SwarmSetup::from(system)) {

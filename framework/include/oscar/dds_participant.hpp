@@ -42,6 +42,10 @@ class DdsParticipant {
   eprosima::fastdds::dds::Publisher& publisher() { return *publisher_; }
   eprosima::fastdds::dds::Subscriber& subscriber() { return *subscriber_; }
   int domain() const { return domain_; }
+  /// What a writer that could not be made on `topic` may be missing: under DDS Security, the
+  /// permission of this participant's identity (" (identity 'module.a' of keystore K may not
+  /// publish on it ...)"); "" for a plain participant.
+  std::string permission_hint(const std::string& topic) const;
 
   /// The topic of that name, registering the type if needed.
   /// @throws std::invalid_argument if the topic exists here with another type, or if discovery
@@ -76,6 +80,7 @@ class DdsParticipant {
   class Listener;
   int domain_;
   std::string name_;
+  std::optional<ParticipantSecurity> security_;
   std::unique_ptr<Listener> listener_;
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   std::unique_ptr<internal::ParticipantIdClaim> id_claim_;  ///< released after the participant

@@ -2,6 +2,7 @@
 /// @file Where a participant may send and listen (docs/network.md).
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,13 @@ class Node;
 }
 
 namespace oscar {
+
+/// Who a participant authenticates as under DDS Security (docs/security.md): an identity of the
+/// system's keystore, whose certificate, key and signed permissions it loads.
+struct ParticipantSecurity {
+  std::string keystore;  ///< the keystore folder (`oscar security init`)
+  std::string identity;  ///< e.g. "registry", "monitor.h1", "module.camera", "operator"
+};
 
 /// The transport profile of a DDS participant. The default confines it to the loopback
 /// interface: UDP on 127.0.0.1 with unicast discovery to localhost, plus shared memory; no
@@ -20,6 +28,8 @@ struct NetworkConfig {
   bool shared_memory = true;
   std::uint32_t shm_segment_bytes = 8u << 20;  ///< must hold the largest cues in flight
   int max_participants_per_host = 32;          ///< participant ids probed per peer
+  /// DDS Security's builtin plugins with this identity; none: a plain participant.
+  std::optional<ParticipantSecurity> security;
 
   /// Reads a `network:` map (interfaces, peers, shared_memory, shm_segment_bytes).
   /// @throws std::invalid_argument on unknown keys or non-IPv4 addresses.

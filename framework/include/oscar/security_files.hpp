@@ -9,6 +9,10 @@
 #include <utility>
 #include <vector>
 
+namespace YAML {
+class Node;
+}
+
 namespace oscar::security_files {
 
 /// The files of one identity's folder, each named after what it is.
@@ -44,5 +48,15 @@ using Property = std::pair<std::string, std::string>;
 ///         (run `oscar security init`).
 std::vector<Property> dds_security_properties(const std::filesystem::path& keystore,
                                               std::string_view identity);
+
+/// $OSCAR_KEYSTORE as an absolute folder (`oscar boot --keystore` sets it for every process it
+/// starts), or "" if unset.
+std::string keystore_from_env();
+
+/// The keystore the processes of the system in `file` (whose YAML is `root`) run with:
+/// $OSCAR_KEYSTORE if set (`oscar boot --keystore` sets it for every process it starts), else
+/// the file's `security: keystore:` (a relative folder taken from the file's folder), else ""
+/// (the system runs without DDS Security).
+std::string system_keystore(const YAML::Node& root, const std::string& file);
 
 }  // namespace oscar::security_files

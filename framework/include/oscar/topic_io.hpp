@@ -119,7 +119,9 @@ class TopicWriter {
               const eprosima::fastdds::dds::DataWriterQos& qos)
       : participant_(p) {
     writer_ = p.publisher().create_datawriter(&p.topic(topic, new PubSubType()), qos);
-    if (!writer_) throw std::runtime_error("cannot create a writer for " + topic);
+    if (!writer_) {
+      throw std::runtime_error("cannot create a writer for " + topic + p.permission_hint(topic));
+    }
   }
   /// A writer of a catalogue topic (oscar/topics.hpp), with the catalogue's QoS.
   TopicWriter(DdsParticipant& p, const TopicSpec<T, PubSubType>& spec)

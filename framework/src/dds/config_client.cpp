@@ -55,7 +55,8 @@ ConfigClient::Channel& ConfigClient::channel(const std::string& module) {
   if (!c->writer || !c->reader) {
     if (c->writer) participant_.publisher().delete_datawriter(c->writer);
     if (c->reader) participant_.subscriber().delete_datareader(c->reader);
-    throw std::runtime_error("cannot create the configuration endpoints for module " + module);
+    throw std::runtime_error("cannot create the configuration endpoints for module " + module +
+                             participant_.permission_hint(commands.name));
   }
   return *(channels_[module] = std::move(c));
 }

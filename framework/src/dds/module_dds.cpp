@@ -30,7 +30,10 @@ class Module::Dds::OutputWriter final : public dds::DataWriterListener {
     auto& topic = p.topic(topics::cue(out.address()), out.type().new_topic_type());
     writer_ = p.publisher().create_datawriter(&topic, qos::cue_writer(out.options()), this,
                                               dds::StatusMask::publication_matched());
-    if (!writer_) throw std::runtime_error("cannot create a writer for " + out.address());
+    if (!writer_) {
+      throw std::runtime_error("cannot create a writer for " + out.address() +
+                               p.permission_hint(topics::cue(out.address())));
+    }
     const bool keep_history = out.options().transient_local;
     out.set_remote([this, keep_history](const void* cue) {
       if (keep_history || matched_.load(std::memory_order_relaxed) > 0) {

@@ -22,6 +22,7 @@
 #include "dds/participant_identity.hpp"
 #include "dds/wire_bounds.hpp"
 #include "oscar/raw_cdr_type.hpp"
+#include "oscar/security_files.hpp"
 
 namespace oscar {
 namespace dds = eprosima::fastdds::dds;
@@ -67,6 +68,12 @@ dds::DomainParticipantQos participant_qos(const std::string& name, const Network
   if (const auto modules = hosted(); !modules.empty()) {
     qos.properties().properties().emplace_back(
         kModulesProperty, fmt::format("{}", fmt::join(modules, ",")), true);  // propagated
+  }
+  if (net.security) {
+    for (auto& [property, value] :
+         security_files::dds_security_properties(net.security->keystore, net.security->identity)) {
+      qos.properties().properties().emplace_back(std::move(property), std::move(value));
+    }
   }
   auto& transport = qos.transport();
   transport.use_builtin_transports = false;
@@ -296,7 +303,7 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
 };
 
 DdsParticipant::DdsParticipant(int domain, const std::string& name, const NetworkConfig& network)
-    : domain_(domain), listener_(std::make_unique<Listener>()) {
+    : domain_(domain), security_(network.security), listener_(std::make_unique<Listener>()) {
   if (network.interfaces.empty()) throw std::invalid_argument("network: no interface given");
   auto* factory = dds::DomainParticipantFactory::get_instance();
   dds_log_level_from_env();
@@ -312,6 +319,15 @@ DdsParticipant::DdsParticipant(int domain, const std::string& name, const Networ
     if (participant_) {
       claim->record(participant_->guid().guidPrefix);
       id_claim_ = std::move(claim);
+    } else if (network.security) {
+      // The id and its port were free: Fast DDS refused the identity's files, and would refuse
+      // them for every other id too.
+      throw std::runtime_error(fmt::format(
+          "cannot create a DDS participant '{}' on domain {} as identity '{}' of keystore {}: "
+          "Fast DDS refused its security files (a certificate of another CA or expired, "
+          "permissions or governance not signed by the permissions CA, or not for domain {}); "
+          "`oscar security check` says which (OSCAR_DDS_LOG=warning shows Fast DDS's reason)",
+          name, domain, network.security->identity, network.security->keystore, domain));
     }
   }
   if (!participant_) {
@@ -322,6 +338,14 @@ DdsParticipant::DdsParticipant(int domain, const std::string& name, const Networ
   }
   publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
   subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+}
+
+std::string DdsParticipant::permission_hint(const std::string& topic) const {
+  if (!security_) return "";
+  return fmt::format(
+      " (identity '{}' of keystore {} may not publish on {}: `oscar security list` shows what "
+      "each identity may publish)",
+      security_->identity, security_->keystore, topic);
 }
 
 DdsParticipant::~DdsParticipant() {

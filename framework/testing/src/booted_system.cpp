@@ -26,8 +26,10 @@
 #include "oscar/cue_type_info.hpp"
 #include "oscar/cue_types.hpp"
 #include "oscar/malformed_samples.hpp"
+#include "oscar/module_spec.hpp"
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/registry/running_systems.hpp"
+#include "oscar/security_files.hpp"
 #include "oscar/shared_memory.hpp"
 #include "oscar/testing/eventually.hpp"
 
@@ -250,13 +252,21 @@ SystemUnderTest::SystemUnderTest(const std::string& system_file, BootOptions opt
     return is_port_of_domain(name, domain_);
   }).sweep();
   register_standard_cue_types();
-  participant_ = std::make_unique<DdsParticipant>(domain_, "oscar-test");
+  NetworkConfig network;
+  const auto keystore = options.keystore.empty()
+                            ? security_files::system_keystore(load_yaml_file(file_), file_)
+                            : fs::absolute(options.keystore).string();
+  if (!keystore.empty()) {
+    network.security = ParticipantSecurity{keystore, security_files::kOperatorBoot};
+  }
+  participant_ = std::make_unique<DdsParticipant>(domain_, "oscar-test", network);
   registry_ = std::make_unique<RegistryClient>(*participant_, "test");
   config_ = std::make_unique<ConfigClient>(*participant_, "boot");
 
   std::vector<std::string> argv{
       boot,        file_,    "--domain",  std::to_string(domain_),
       "--log-dir", log_dir_, "--timeout", std::to_string(options.boot_timeout.count())};
+  if (!options.keystore.empty()) argv.insert(argv.end(), {"--keystore", keystore});
   std::vector<char*> args;
   for (auto& a : argv) args.push_back(a.data());
   args.push_back(nullptr);

@@ -71,12 +71,15 @@ std::vector<IdentityPolicy> identities_of(const SystemSpec& system) {
   // suspends, resumes and re-applies configurations, launches and answers; the read-only
   // operator writes nothing.
   const std::vector<std::string> boot{log, kAnyModulesConfig, topics::registry_request().name};
+  // The tools acting with boot's authority may also submit jobs and world changes to the swarm.
+  auto operator_boot = boot;
+  operator_boot.push_back(topics::swarm_request().name);
   std::vector<IdentityPolicy> all{
       make(files::kRegistry, {log, kAnyModulesConfig, topics::launch().name,
                               topics::registry_reply().name, topics::system_state().name}),
       make(files::kBoot, boot),
       make(files::kOperator, {}),
-      make(files::kOperatorBoot, boot),
+      make(files::kOperatorBoot, operator_boot),
   };
   for (const auto& h : system.hosts) {
     all.push_back(make(files::monitor_identity(h.name),

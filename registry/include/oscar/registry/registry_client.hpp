@@ -55,12 +55,20 @@ std::optional<RunningSystem> default_system();
 /// how to name one, or that none was, e.g. " (running on this machine: ...; name one with -d)".
 std::string where_systems_run(int domain);
 
+/// What a command-line tool may do in a secured system (docs/security.md): look (the
+/// `operator` identity, which may write nothing) or act with boot's authority
+/// (`operator_boot`: configure modules, ask the registry to restart or shut down).
+enum class ToolAuthority { kLook, kActAsBoot };
+
 /// The participant of a command-line tool: with `system_file`, that system's domain and the
 /// network of its host `host` (default: its local host); `domain` >= 0 overrides the domain.
 /// Told neither, it takes $OSCAR_DOMAIN, else the system booted on this machine (its domain and
-/// file; see default_system()), else domain 0 on loopback.
+/// file; see default_system()), else domain 0 on loopback. It authenticates with the
+/// system's keystore ($OSCAR_KEYSTORE, the file's, or the one boot was given) as the identity
+/// `authority` names, if the system has one.
 /// @throws std::invalid_argument if several systems run and none was named.
 std::unique_ptr<DdsParticipant> tool_participant(const std::string& name, std::string system_file,
-                                                 const std::string& host, int domain);
+                                                 const std::string& host, int domain,
+                                                 ToolAuthority authority = ToolAuthority::kLook);
 
 }  // namespace oscar

@@ -18,6 +18,7 @@ struct RunningSystem {
   std::string system;                 ///< the system's name
   std::string file;                   ///< the system file, absolute
   std::string log_dir;                ///< where its processes write their output
+  std::string keystore{};             ///< its DDS Security keystore, absolute; "" for none
   pid_t boot_pid = 0;                 ///< the `oscar boot` that runs it
   long long started = 0;              ///< seconds since the epoch
   long long boot_started_ticks = -1;  ///< when boot_pid started (pids are reused); set on record

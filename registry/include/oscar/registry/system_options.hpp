@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "oscar/dds_participant.hpp"
+#include "oscar/registry/registry_client.hpp"
 
 namespace oscar {
 
@@ -23,7 +24,8 @@ struct SystemOptions {
   void add_domain_to(CLI::App& app);
   /// The participant of tool `name` on the chosen system (see tool_participant()).
   /// @throws std::invalid_argument if several systems run here and none was named.
-  std::unique_ptr<DdsParticipant> participant(const std::string& name) const;
+  std::unique_ptr<DdsParticipant> participant(const std::string& name,
+                                              ToolAuthority authority = ToolAuthority::kLook) const;
   /// The domain alone: -d, else the system file's, else $OSCAR_DOMAIN, else the system booted on
   /// this machine, else 0. @throws std::invalid_argument as participant() does.
   int resolved_domain() const;

@@ -180,6 +180,13 @@ struct SystemSpec {
   /// @throws std::invalid_argument naming module and rule.
   void check_modules(const std::vector<std::string>& plugin_path) const;
 
+  /// The keystore the system's processes run with: $OSCAR_KEYSTORE (`oscar boot --keystore`),
+  /// else `security: keystore:`; "" for a system without DDS Security.
+  std::string keystore() const;
+  /// The transport profile of a process on `host` that runs as `identity`: the host's
+  /// NetworkConfig::for_host, authenticated as `identity` when the system has a keystore.
+  NetworkConfig network_for(const std::string& host, const std::string& identity) const;
+
   /// Every module's domain becomes `domain` (boot --domain, tests).
   void override_domain(int domain);
   /// The host boot and the registry run on: the first `local: true` host.

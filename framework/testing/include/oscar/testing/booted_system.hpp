@@ -64,6 +64,9 @@ struct BootOptions {
   int domain = -1;  ///< the DDS domain; -1: a FreeDomain of its own (the file's is ignored)
   std::chrono::seconds boot_timeout{30};  ///< boot's --timeout: until every module is announced
   std::string log_dir;  ///< where the processes write their output; default: a temporary folder
+  /// boot's --keystore (docs/security.md); "": the file's `security: keystore:`, if any. With a
+  /// keystore the test's own participant authenticates as `operator_boot`.
+  std::string keystore{};
 };
 
 /// The watches a system handed out: their readers are closed when the system shuts down, before
