@@ -13,6 +13,12 @@
 #include "registry_tracked.hpp"
 
 namespace oscar {
+namespace {
+
+// The longest sender or module name a registry request may carry.
+constexpr std::size_t kMaxRequestNameChars = 256;
+
+}  // namespace
 
 Registry::Registry(const SystemSpec& system, DdsParticipant& participant)
     : system_(system), participant_(participant), config_(participant, "registry") {
@@ -297,7 +303,21 @@ void Registry::on_request(const RegistryRequest& r, const std::vector<std::strin
     if (find(m) && std::find(origin.begin(), origin.end(), m) == origin.end()) origin.push_back(m);
   }
   std::string error;
-  if (!origin.empty()) {
+  if (r.sender().size() > kMaxRequestNameChars || r.module_name().size() > kMaxRequestNameChars) {
+    // Refused before anything quotes them: a request is a sample anyone on the domain may write.
+    error = fmt::format(
+        "refused: a request's sender ({} bytes) and module name ({} bytes) may "
+        "have at most {} characters",
+        r.sender().size(), r.module_name().size(), kMaxRequestNameChars);
+    spdlog::warn("registry: {}", error);
+  } else if (r.kind() != REG_RESTART && r.kind() != REG_SHUTDOWN) {
+    error = fmt::format(
+        "refused: request kind {} is neither restart ({}) nor shutdown ({}), as "
+        "in idl/oscar/registry.idl",
+        static_cast<long long>(r.kind()), static_cast<int>(REG_RESTART),
+        static_cast<int>(REG_SHUTDOWN));
+    spdlog::warn("registry: {} (from '{}')", error, r.sender());
+  } else if (!origin.empty()) {
     // Without DDS Security the sender's name is a claim; the writer's process is not.
     error = fmt::format(
         "refused: '{}' may not {}: the request comes from the process of module '{}', and only "

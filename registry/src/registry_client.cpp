@@ -40,7 +40,7 @@ RegistryClient::RegistryClient(DdsParticipant& participant, std::string sender,
                                std::function<void(const SystemState&)> on_state)
     : sender_(std::move(sender)),
       on_state_(std::move(on_state)),
-      next_id_(static_cast<unsigned long long>(getpid()) << 24) {
+      id_base_(static_cast<unsigned long long>(getpid()) << 24) {
   io_.reset(new Endpoints{{participant, topics::system_state(),
                            [this](const SystemState& s, const auto&) {
                              if (on_state_) on_state_(s);
@@ -74,11 +74,10 @@ std::optional<SystemState> RegistryClient::latest() {
 void RegistryClient::request(RegistryRequestKind kind, const std::string& module,
                              std::chrono::milliseconds timeout) {
   RegistryRequest q;
-  unsigned long long id = 0;
-  {
-    std::lock_guard lock(mutex_);
-    id = ++next_id_;
-  }
+  // Unique in this process, not only in this client: the registry's replies reach every
+  // client, and one made after another would otherwise take the other's reply for its own.
+  static std::atomic<unsigned long long> requests_in_process{0};
+  const unsigned long long id = id_base_ + ++requests_in_process;
   q.id(id);
   q.sender(sender_);
   q.kind(kind);

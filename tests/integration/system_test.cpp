@@ -243,6 +243,33 @@ TEST(Registry, AtTheRestartLimitTheSystemStaysSuspendedByDefault) {
   });
 }
 
+// A request is a sample anyone on the domain may write: a kind outside the enum and over-long
+// names are refused with the rule, and nothing is restarted.
+TEST(Registry, RequestsOfAnUnknownKindOrWithOverlongNamesAreRefused) {
+  BootedSystem sys("bad_requests", kFiveModules);
+  const auto before = sys.running();
+  const auto refusal = [&](const std::string& sender, int kind, const std::string& module) {
+    RegistryClient client(sys.participant(), sender);
+    try {
+      client.request(static_cast<RegistryRequestKind>(kind), module);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_THAT(refusal("operator", 7, "camera"),
+              HasSubstr("refused: request kind 7 is neither restart (0) nor shutdown (1)"));
+  EXPECT_THAT(refusal(std::string(100000, 's'), REG_RESTART, "camera"),
+              HasSubstr("refused: a request's sender (100000 bytes) and module name (6 bytes) "
+                        "may have at most 256 characters"));
+  EXPECT_THAT(refusal("operator", REG_RESTART, std::string(300, 'm')),
+              HasSubstr("module name (300 bytes)"));
+  const auto after = sys.registry().latest();
+  ASSERT_TRUE(after);
+  EXPECT_EQ(after->state(), "running");
+  EXPECT_EQ(entry(*after, "camera")->incarnation(), entry(before, "camera")->incarnation());
+}
+
 // Restart limit 1 within 6 s: a failure after the window is restarted again; the count was
 // never reset, so the second failure gave the module up however long after the first it came.
 TEST(Registry, ARestartOlderThanTheWindowNoLongerCountsAgainstTheLimit) {

@@ -43,7 +43,7 @@ class RegistryClient {
   std::condition_variable changed_;
   std::optional<SystemState> latest_;
   std::map<unsigned long long, RegistryReply> replies_;
-  unsigned long long next_id_;
+  unsigned long long id_base_;     ///< this process's: its pid in the high bits
   std::unique_ptr<Endpoints> io_;  // last: its callbacks use the members above
 };
 
