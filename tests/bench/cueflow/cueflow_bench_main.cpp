@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <thread>
 
@@ -74,8 +75,10 @@ class Bench {
   Bench(int count, int warmup, int domain, std::string dir)
       : count_(count), warmup_(warmup), domain_(domain), dir_(std::move(dir)) {}
 
-  std::optional<Latency> framework(const Row& r, bool multicore) {
-    const auto report = file("oscar", r, multicore);
+  // With a `keystore`, both modules authenticate as their identities in it (module.src and
+  // module.sink) and their cue topic is protected as its governance says.
+  std::optional<Latency> framework(const Row& r, bool multicore, const std::string& keystore = "") {
+    const auto report = file(keystore.empty() ? "oscar" : "oscar_secured", r, multicore);
     const std::vector<std::string> sink{"-k", "bench_sink:sink",
                                         "-p", "sink.type=" + r.type,
                                         "-p", "sink.report=" + report,
@@ -90,11 +93,13 @@ class Bench {
       args.insert(args.end(), {"-m", cycle});
       procs.push_back(std::make_unique<Process>(args, log("multicore")));
     } else {
-      auto s = join({bin("oscar-run"), "--name", "sink", "--domain", dom()}, sink,
-                    {"-m", "single_step"});
+      std::vector<std::string> run{bin("oscar-run")};
+      if (!keystore.empty()) run = {"/usr/bin/env", "OSCAR_KEYSTORE=" + keystore, bin("oscar-run")};
+      auto s =
+          join(join(run, {"--name", "sink", "--domain", dom()}, {}), sink, {"-m", "single_step"});
       procs.push_back(std::make_unique<Process>(s, log("sink")));
-      std::this_thread::sleep_for(300ms);
-      auto p = join({bin("oscar-run"), "--name", "src", "--domain", dom()}, source, {"-m", cycle});
+      std::this_thread::sleep_for(keystore.empty() ? 300ms : 1000ms);  // + authentication
+      auto p = join(join(run, {"--name", "src", "--domain", dom()}, {}), source, {"-m", cycle});
       procs.push_back(std::make_unique<Process>(p, log("src")));
     }
     return await_report(report, limit(r));
@@ -144,6 +149,33 @@ class Bench {
   std::string dir_;
 };
 
+// The cue protections a keystore's governance may give cue topics (docs/security.md).
+const char* const kProtections[] = {"none", "sign", "encrypt"};
+
+// A keystore per cue protection for the two modules of the local constellation (src and sink),
+// made by `oscar security init` in `dir`; by protection.
+std::map<std::string, std::string> make_keystores(const std::filesystem::path& dir) {
+  std::map<std::string, std::string> out;
+  for (const auto* protection : kProtections) {
+    const auto file = dir / fmt::format("secured_{}.yaml", protection);
+    std::ofstream(file) << fmt::format(R"(system: bench_cueflow
+security: {{ cue_protection: {} }}
+modules:
+  - {{ name: src, kernels: [ {{ type: bench_source, name: src, params: {{ type: Bool }} }} ] }}
+  - {{ name: sink, kernels: [ {{ type: bench_sink, name: sink, params: {{ type: Bool }}, inputs: {{ in: src/out }} }} ] }}
+)",
+                                       protection);
+    const auto keystore = (dir / fmt::format("keys_{}", protection)).string();
+    Process init({bin("oscar-security"), "init", file.string(), "--keystore", keystore},
+                 (dir / fmt::format("keys_{}.log", protection)).string());
+    if (init.wait(60s) != 0) {
+      throw std::runtime_error("oscar security init failed: " + init.output());
+    }
+    out[protection] = keystore;
+  }
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -161,11 +193,16 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--types", types, "rows to run")->delimiter(',');
   app.add_option("--constellations", constellations, "multicore, local")->delimiter(',');
+  bool security = false;
+  app.add_flag("--security", security,
+               "local rows also with DDS Security (keystores made here), cue topics unprotected, "
+               "signed and encrypted, alternated with the plain runs");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 
   const auto dir = std::filesystem::temp_directory_path() / fmt::format("oscar_bench_{}", getpid());
   std::filesystem::create_directories(dir);
   Bench bench(count, warmup, domain, dir.string());
+  const auto keystores = security ? make_keystores(dir) : std::map<std::string, std::string>{};
   nlohmann::json rows = nlohmann::json::array();
   int failures = 0;
   if (!json) {
@@ -178,6 +215,7 @@ int main(int argc, char** argv) {
     for (const auto& c : constellations) {
       const bool multicore = c == "multicore";
       std::vector<Latency> ours_runs, raw_runs;
+      std::map<std::string, std::vector<Latency>> secured_runs;  // by cue protection
       for (int i = 1; i <= repeat; ++i) {
         std::cerr << fmt::format("bench cueflow: {} {} run {}/{} ({} cues)...\n", r.type, c, i,
                                  repeat, count);
@@ -191,6 +229,15 @@ int main(int argc, char** argv) {
         }
         ours_runs.push_back(*o);
         raw_runs.push_back(*w);
+        for (const auto& [protection, keystore] : multicore ? decltype(keystores){} : keystores) {
+          if (const auto s = bench.framework(r, false, keystore)) {
+            secured_runs[protection].push_back(*s);
+          } else {
+            std::cerr << fmt::format("bench cueflow: {} {} secured ({}): no report (logs in {})\n",
+                                     r.type, c, protection, dir.string());
+            ++failures;
+          }
+        }
       }
       if (ours_runs.empty()) continue;
       const auto ours = median_of(ours_runs);
@@ -217,6 +264,28 @@ int main(int argc, char** argv) {
                    "{:<13} {:>7} {:<10} {:>9.1f} {:>9.1f} {:>9.1f} {:>10.1f} {:>7.2f} {:>10.0f}\n",
                    r.type, r.bytes, c, ours.p50, ours.p90, ours.max, raw.p50, ratio, seed)
             << std::flush;
+      }
+      for (const auto& [protection, runs] : secured_runs) {
+        const auto s = median_of(runs);
+        const double vs_plain = ours.p50 > 0 ? s.p50 / ours.p50 : 0;
+        rows.push_back({{"type", r.type},
+                        {"bytes", r.bytes},
+                        {"constellation", c},
+                        {"security", protection},
+                        {"p50_us", s.p50},
+                        {"p90_us", s.p90},
+                        {"max_us", s.max},
+                        {"plain_p50_us", ours.p50},
+                        {"ratio_vs_plain", vs_plain},
+                        {"samples", s.samples},
+                        {"runs", runs.size()}});
+        if (!json) {
+          std::cout << fmt::format(
+                           "{:<13} {:>7} {:<10} {:>9.1f} {:>9.1f} {:>9.1f} {:>10} {:>7.2f}  "
+                           "(secured, cue topics: {}; ratio to OSCAR without security)\n",
+                           r.type, r.bytes, c, s.p50, s.p90, s.max, "", vs_plain, protection)
+                    << std::flush;
+        }
       }
     }
   }

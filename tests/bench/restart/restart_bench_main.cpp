@@ -1,6 +1,8 @@
 // oscar bench restart: how fast the registry notices a failure and has the system running
-// again (issue 3), and how long booting 20 modules on 3 test hosts takes. Prints a table, or
-// JSON with --json. Never decides pass/fail by time: it reports what it measured.
+// again (issue 3), and how long booting 20 modules on 3 test hosts takes. With --security, the
+// same again on systems booted with a keystore the benchmark makes (`oscar security init`),
+// alternated with the plain ones in one run, and the ratios. Prints a table, or JSON with
+// --json. Never decides pass/fail by time: it reports what it measured.
 #include <signal.h>
 #include <unistd.h>
 
@@ -67,9 +69,34 @@ Failures fail_modules(oscar::RegistryClient& registry, const std::vector<std::st
   return f;
 }
 
-// Boots `modules` sources/sinks over `hosts` test hosts (or this host) and returns what
-// oscar boot reports as its time to `running`.
-double boot_time_ms(int modules, bool netns, int domain) {
+// A keystore for the system in `file`, made by `oscar security init` in a folder of its own.
+std::string make_keystore(const std::string& file, const std::string& name) {
+  const auto keystore = oscar::test::temp_path(name + "_keys");
+  std::filesystem::remove_all(keystore);
+  oscar::test::Process init(
+      {oscar::sibling_program("oscar-security"), "init", file, "--keystore", keystore},
+      oscar::test::temp_path(name + "_keys") + ".log");
+  if (init.wait(60s) != 0)
+    throw std::runtime_error("oscar security init failed:\n" + init.output());
+  return keystore;
+}
+
+// boot's arguments for the system in `file` on `domain`, with `keystore` unless it is empty.
+std::vector<std::string> boot_command(const std::string& file, int domain,
+                                      const std::string& log_dir, const std::string& keystore) {
+  std::vector<std::string> argv{oscar::sibling_program("oscar-boot"),
+                                file,
+                                "--domain",
+                                std::to_string(domain),
+                                "--log-dir",
+                                log_dir};
+  if (!keystore.empty()) argv.insert(argv.end(), {"--keystore", keystore});
+  return argv;
+}
+
+// Boots `modules` sources/sinks over `hosts` test hosts (or this host), with a keystore if
+// `secured`, and returns what oscar boot reports as its time to `running`.
+double boot_time_ms(int modules, bool netns, int domain, bool secured) {
   std::unique_ptr<oscar::test::TestHosts> hosts;
   if (netns) hosts = std::make_unique<oscar::test::TestHosts>(3);
   std::string yaml = "system: boot20\nlease: 300ms\n";
@@ -93,11 +120,13 @@ double boot_time_ms(int modules, bool netns, int domain) {
   }
   const auto file = oscar::test::temp_path("bench_boot20") + ".yaml";
   std::ofstream(file) << yaml;
+  const auto keystore = secured ? make_keystore(file, "bench_boot20") : "";
   std::vector<std::string> argv;
   if (netns) argv = hosts->on(1);
-  argv.insert(argv.end(),
-              {oscar::sibling_program("oscar-boot"), file, "--domain", std::to_string(domain),
-               "--log-dir", oscar::test::temp_path("bench_boot20_logs"), "--duration", "1"});
+  const auto boot_argv =
+      boot_command(file, domain, oscar::test::temp_path("bench_boot20_logs"), keystore);
+  argv.insert(argv.end(), boot_argv.begin(), boot_argv.end());
+  argv.insert(argv.end(), {"--duration", "1"});
   oscar::test::Process boot(argv, oscar::test::temp_path("bench_boot20") + ".log");
   if (boot.wait(120s) != 0)
     throw std::runtime_error("boot of 20 modules failed:\n" + boot.output());
@@ -106,70 +135,132 @@ double boot_time_ms(int modules, bool netns, int domain) {
   if (!std::regex_search(out, m, std::regex("running after ([0-9]+) ms"))) {
     throw std::runtime_error("boot did not report its time:\n" + out);
   }
+  if (!keystore.empty()) std::filesystem::remove_all(keystore);
   return std::stod(m[1]);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"oscar bench restart: failure detection, restart and boot times of the registry"};
-  int kills = 50, hangs = 10;
-  bool json = false;
-  app.add_option("--kills", kills, "kill -9 failures to time")->check(CLI::PositiveNumber);
-  app.add_option("--hangs", hangs, "SIGSTOP hangs to time (0: none)")
-      ->check(CLI::NonNegativeNumber);
-  app.add_flag("--json", json, "print JSON");
-  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
-  try {
-    const int domain = 1 + getpid() % 200;
-    const auto file = oscar::test::temp_path("bench_restart") + ".yaml";
-    std::ofstream(file) << R"(system: bench_restart
+// The three-module system the failures are timed on.
+constexpr const char* kRestartSystem = R"(system: bench_restart
 lease: 300ms
 modules:
   - { name: a, kernels: [ { type: bench_source, name: a, params: { type: Bool } } ], mode: { continuous: 10ms }, restart: { max: 100000 } }
   - { name: b, kernels: [ { type: relay, name: b, params: { type: Bool }, inputs: { in: a/out } } ], mode: single_step, restart: { max: 100000 } }
   - { name: c, kernels: [ { type: bench_sink, name: c, params: { type: Bool }, inputs: { in: b/out } } ], mode: single_step, restart: { max: 100000 } }
 )";
-    oscar::test::Process boot(
-        {oscar::sibling_program("oscar-boot"), file, "--domain", std::to_string(domain),
-         "--log-dir", oscar::test::temp_path("bench_restart_logs")},
-        oscar::test::temp_path("bench_restart") + ".log");
-    oscar::DdsParticipant participant(domain, "bench-restart");
-    oscar::RegistryClient registry(participant, "bench");
-    const auto crashes = fail_modules(registry, {"a", "b", "c"}, kills, SIGKILL);
-    const auto hung =
-        hangs > 0 ? fail_modules(registry, {"a", "b", "c"}, hangs, SIGSTOP) : Failures{};
-    kill(boot.pid(), SIGINT);
-    boot.wait(60s);
 
+struct Run {
+  Failures crashes, hung;
+  std::vector<double> boot20_ms;
+};
+
+// Boots the three-module system (with a keystore if `secured`) and times `kills` crashes and
+// `hangs` hangs of its modules.
+void time_failures(Run& run, int kills, int hangs, int domain, bool secured) {
+  const auto name = std::string(secured ? "bench_restart_secured" : "bench_restart");
+  const auto file = oscar::test::temp_path(name) + ".yaml";
+  std::ofstream(file) << kRestartSystem;
+  const auto keystore = secured ? make_keystore(file, name) : "";
+  oscar::test::Process boot(
+      boot_command(file, domain, oscar::test::temp_path(name + "_logs"), keystore),
+      oscar::test::temp_path(name) + ".log");
+  oscar::NetworkConfig network;
+  if (secured) network.security = oscar::ParticipantSecurity{keystore, "operator"};
+  oscar::DdsParticipant participant(domain, "bench-restart", network);
+  oscar::RegistryClient registry(participant, "bench");
+  auto append = [](Failures& to, const Failures& f) {
+    to.detect_ms.insert(to.detect_ms.end(), f.detect_ms.begin(), f.detect_ms.end());
+    to.resume_ms.insert(to.resume_ms.end(), f.resume_ms.begin(), f.resume_ms.end());
+  };
+  append(run.crashes, fail_modules(registry, {"a", "b", "c"}, kills, SIGKILL));
+  if (hangs > 0) append(run.hung, fail_modules(registry, {"a", "b", "c"}, hangs, SIGSTOP));
+  kill(boot.pid(), SIGINT);
+  boot.wait(60s);
+  if (!keystore.empty()) std::filesystem::remove_all(keystore);
+}
+
+void print_json(const char* security, const Run& r, int kills, int hangs, int hosts) {
+  std::printf(
+      "{\"security\":\"%s\",\"kills\":%d,\"detect_ms_p50\":%.1f,\"detect_ms_p99\":%.1f,"
+      "\"resume_ms_p50\":%.1f,\"resume_ms_p99\":%.1f,\"hangs\":%d,\"hang_detect_ms_p50\":%.1f,"
+      "\"hang_detect_ms_p99\":%.1f,\"hang_resume_ms_p50\":%.1f,\"hang_resume_ms_p99\":%.1f,"
+      "\"boot20_ms\":%.0f,\"boot20_runs\":%zu,\"boot20_hosts\":%d,\"lease_ms\":300,"
+      "\"backoff_ms\":200}\n",
+      security, kills, percentile(r.crashes.detect_ms, 0.5), percentile(r.crashes.detect_ms, 0.99),
+      percentile(r.crashes.resume_ms, 0.5), percentile(r.crashes.resume_ms, 0.99), hangs,
+      percentile(r.hung.detect_ms, 0.5), percentile(r.hung.detect_ms, 0.99),
+      percentile(r.hung.resume_ms, 0.5), percentile(r.hung.resume_ms, 0.99),
+      percentile(r.boot20_ms, 0.5), r.boot20_ms.size(), hosts);
+}
+
+void print_rows(const char* label, const Run& r, int kills, int hangs) {
+  std::printf("%-34s %6d %14.1f %14.1f %14.1f %14.1f\n",
+              fmt::format("kill -9 (crash){}", label).c_str(), kills,
+              percentile(r.crashes.detect_ms, 0.5), percentile(r.crashes.detect_ms, 0.99),
+              percentile(r.crashes.resume_ms, 0.5), percentile(r.crashes.resume_ms, 0.99));
+  if (hangs > 0) {
+    std::printf("%-34s %6d %14.1f %14.1f %14.1f %14.1f\n",
+                fmt::format("SIGSTOP (hang){}", label).c_str(), hangs,
+                percentile(r.hung.detect_ms, 0.5), percentile(r.hung.detect_ms, 0.99),
+                percentile(r.hung.resume_ms, 0.5), percentile(r.hung.resume_ms, 0.99));
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"oscar bench restart: failure detection, restart and boot times of the registry"};
+  int kills = 50, hangs = 10, rounds = 1;
+  bool json = false, security = false;
+  app.add_option("--kills", kills, "kill -9 failures to time")->check(CLI::PositiveNumber);
+  app.add_option("--hangs", hangs, "SIGSTOP hangs to time (0: none)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("--security", security,
+               "also with DDS Security (a keystore made here), alternated with the plain runs");
+  app.add_option("--rounds", rounds,
+                 "rounds (each: the failures split over the rounds, and one boot of 20 modules "
+                 "per kind)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--json", json, "print JSON (one line per kind)");
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
+  try {
+    const int domain = 1 + getpid() % 200;
     const bool netns = oscar::test::TestHosts::unavailable().empty();
-    const double boot20 = boot_time_ms(20, netns, domain);
+    const int hosts = netns ? 3 : 1;
+    Run plain, secured;
+    // Plain and secured alternate round by round, so both see the same machine.
+    for (int round = 0; round < rounds; ++round) {
+      const int k = kills / rounds + (round < kills % rounds ? 1 : 0);
+      const int h = hangs / rounds + (round < hangs % rounds ? 1 : 0);
+      for (const bool with_keys : {false, true}) {
+        if (with_keys && !security) continue;
+        auto& run = with_keys ? secured : plain;
+        if (k > 0) time_failures(run, k, h, domain, with_keys);
+        run.boot20_ms.push_back(boot_time_ms(20, netns, domain, with_keys));
+        std::fprintf(stderr, "round %d/%d%s: boot of 20 modules %.0f ms\n", round + 1, rounds,
+                     with_keys ? " (secured)" : "", run.boot20_ms.back());
+      }
+    }
     if (json) {
-      std::printf(
-          "{\"kills\":%d,\"detect_ms_p50\":%.1f,\"detect_ms_p99\":%.1f,\"resume_ms_p50\":%.1f,"
-          "\"resume_ms_p99\":%.1f,\"hangs\":%d,\"hang_detect_ms_p50\":%.1f,"
-          "\"hang_detect_ms_p99\":%.1f,\"hang_resume_ms_p50\":%.1f,\"hang_resume_ms_p99\":%.1f,"
-          "\"boot20_ms\":%.0f,\"boot20_hosts\":%d,\"lease_ms\":300,\"backoff_ms\":200}\n",
-          kills, percentile(crashes.detect_ms, 0.5), percentile(crashes.detect_ms, 0.99),
-          percentile(crashes.resume_ms, 0.5), percentile(crashes.resume_ms, 0.99), hangs,
-          percentile(hung.detect_ms, 0.5), percentile(hung.detect_ms, 0.99),
-          percentile(hung.resume_ms, 0.5), percentile(hung.resume_ms, 0.99), boot20, netns ? 3 : 1);
+      print_json("none", plain, kills, hangs, hosts);
+      if (security) print_json("keystore", secured, kills, hangs, hosts);
       return 0;
     }
     std::printf("oscar bench restart: lease 300 ms, restart backoff 200 ms (the defaults)\n\n");
-    std::printf("%-22s %6s %14s %14s %14s %14s\n", "failure", "count", "detect p50 ms",
+    std::printf("%-34s %6s %14s %14s %14s %14s\n", "failure", "count", "detect p50 ms",
                 "detect p99 ms", "running p50 ms", "running p99 ms");
-    std::printf("%-22s %6d %14.1f %14.1f %14.1f %14.1f\n", "kill -9 (crash)", kills,
-                percentile(crashes.detect_ms, 0.5), percentile(crashes.detect_ms, 0.99),
-                percentile(crashes.resume_ms, 0.5), percentile(crashes.resume_ms, 0.99));
-    if (hangs > 0) {
-      std::printf("%-22s %6d %14.1f %14.1f %14.1f %14.1f\n", "SIGSTOP (hang)", hangs,
-                  percentile(hung.detect_ms, 0.5), percentile(hung.detect_ms, 0.99),
-                  percentile(hung.resume_ms, 0.5), percentile(hung.resume_ms, 0.99));
+    print_rows("", plain, kills, hangs);
+    if (security) print_rows(", secured", secured, kills, hangs);
+    const auto where =
+        netns ? "3 test hosts (network namespaces)" : "1 host (no root: no test hosts)";
+    std::printf("\nboot of 20 modules on %s, median of %d: %.0f ms to running\n", where, rounds,
+                percentile(plain.boot20_ms, 0.5));
+    if (security) {
+      const double b = percentile(secured.boot20_ms, 0.5);
+      std::printf(
+          "  secured: %.0f ms (%.2f x); restart p99 secured/plain: %.2f x\n", b,
+          b / percentile(plain.boot20_ms, 0.5),
+          percentile(secured.crashes.resume_ms, 0.99) / percentile(plain.crashes.resume_ms, 0.99));
     }
-    std::printf("\nboot of 20 modules on %d %s: %.0f ms to running\n", netns ? 3 : 1,
-                netns ? "test hosts (network namespaces)" : "host (no root: no test hosts)",
-                boot20);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "oscar bench restart: %s\n", e.what());
