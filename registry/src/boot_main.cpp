@@ -9,6 +9,7 @@
 #include <ctime>
 #include <filesystem>
 #include <functional>
+#include <future>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -24,6 +25,7 @@
 #include "oscar/cue_types.hpp"
 #include "oscar/kernel_registry.hpp"
 #include "oscar/process_util.hpp"
+#include "oscar/registry/host_check.hpp"
 #include "oscar/registry/launch_command.hpp"
 #include "oscar/registry/log_printer.hpp"
 #include "oscar/registry/registry_client.hpp"
@@ -47,6 +49,31 @@ void check_hosts(const oscar::SystemSpec& system) {
           "{}: host '{}': network namespace '{}' does not exist (create it: ip netns add {})",
           h.where, h.name, h.netns, h.netns));
     }
+  }
+}
+
+// Every ssh host at once, before anything starts anywhere: reachable, the same OSCAR, the same
+// system file, every program and plugin of its modules there (oscar-monitor --check).
+void check_ssh_hosts(const oscar::SystemSpec& system, const std::string& file) {
+  const auto monitor = oscar::sibling_program("oscar-monitor");
+  std::vector<std::future<std::optional<std::string>>> answers;
+  for (const auto& h : system.hosts) {
+    if (h.kind != oscar::HostSpec::Kind::kSsh) continue;
+    answers.push_back(std::async(std::launch::async, [&monitor, &file, h] {
+      // ssh gives up connecting after 10 s (ConnectTimeout); loading plugins takes well under.
+      const auto run =
+          oscar::run_command(oscar::host_check_command(h, file, monitor), std::chrono::seconds(30));
+      return oscar::explain_host_check(h, monitor, run.exit_code, run.output);
+    }));
+  }
+  std::vector<std::string> problems;
+  for (auto& a : answers) {
+    if (auto problem = a.get()) problems.push_back(std::move(*problem));
+  }
+  if (!problems.empty()) {
+    throw std::runtime_error(fmt::format("{} ssh host{} not ready, nothing started:\n  {}",
+                                         problems.size(), problems.size() == 1 ? " is" : "s are",
+                                         fmt::join(problems, "\n  ")));
   }
 }
 
@@ -155,6 +182,9 @@ int main(int argc, char** argv) {
     oscar::coordinator::SwarmSetup::from(system);
     const auto& local = system.local_host();
     check_hosts(system);
+    // Remote hosts read the file at the same path: an absolute one.
+    const auto remote_file = std::filesystem::absolute(file).lexically_normal().string();
+    check_ssh_hosts(system, remote_file);
     if (check) {
       std::printf("%s: system '%s', %zu modules on %zu hosts: ok\n", file.c_str(),
                   system.name.c_str(), system.modules.size(), system.hosts.size());
@@ -210,10 +240,18 @@ int main(int argc, char** argv) {
                    {oscar::sibling_program("oscar-registry"), "--system", file, "--host",
                     local.name, "--domain", dom});
     for (const auto& h : system.hosts) {
-      children.start(
-          "monitor-" + h.name, 1,
-          oscar::on_host(h, {oscar::sibling_program("oscar-monitor"), "--system", file, "--host",
-                             h.name, "--domain", dom, "--log-dir", log_dir + "/" + h.name}));
+      const bool remote = h.kind == oscar::HostSpec::Kind::kSsh;
+      std::vector<std::string> monitor{oscar::sibling_program("oscar-monitor"),
+                                       "--system",
+                                       remote ? remote_file : file,
+                                       "--host",
+                                       h.name,
+                                       "--domain",
+                                       dom,
+                                       "--log-dir",
+                                       log_dir + "/" + h.name};
+      if (remote) monitor.push_back("--over-ssh");
+      children.start("monitor-" + h.name, 1, oscar::on_host(h, monitor));
     }
     const auto state_is = [&](const char* state) {
       const auto s = registry.latest();
@@ -274,7 +312,18 @@ int main(int argc, char** argv) {
       log.flush(true);
       return 130;
     }
-    // Monitors exit when the registry tells them; what is left is stopped here.
+    // Monitors exit when the registry tells them; over ssh their last lines and exit code come
+    // back only if boot does not cut the connection first. What is left is stopped here.
+    wait_until(
+        [&] {
+          for (const auto& x : children.reap()) {
+            if (x.exit_code != 0) log.note("boot", fmt::format("{} {}", x.module, x.describe()));
+          }
+          return std::none_of(system.hosts.begin(), system.hosts.end(), [&](const auto& h) {
+            return children.pid_of("monitor-" + h.name).has_value();
+          });
+        },
+        std::chrono::seconds(3), stop, log);
     for (const auto& x : children.stop_all(std::chrono::milliseconds(5000))) {
       if (x.exit_code != 0) log.note("boot", fmt::format("{} {}", x.module, x.describe()));
     }

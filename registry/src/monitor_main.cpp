@@ -1,5 +1,6 @@
 // oscar-monitor: one per host (docs/boot.md). Starts module processes when the registry asks,
 // captures their output, reports how they end, and shows it is alive with a heartbeat.
+#include <poll.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -17,7 +18,10 @@
 #include <oscar/command_line.hpp>
 
 #include "janitor.hpp"
+#include "oscar/cue_types.hpp"
+#include "oscar/kernel_registry.hpp"
 #include "oscar/process_util.hpp"
+#include "oscar/registry/host_check.hpp"
 #include "oscar/registry/launch_command.hpp"
 #include "oscar/registry/supervisor.hpp"
 #include "oscar/registry/system_spec.hpp"
@@ -41,6 +45,13 @@ oscar::ProcessEvent event(const std::string& host, const std::string& module, un
   return e;
 }
 
+// sshd hands the session's command pipes (or sockets) for its output; when the connection ends
+// it closes their other ends, which poll() reports as a hang-up or error on stdout.
+bool connection_lost() {
+  pollfd out{1, 0, 0};
+  return poll(&out, 1, 0) == 1 && (out.revents & (POLLHUP | POLLERR)) != 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -51,7 +62,26 @@ int main(int argc, char** argv) {
   app.add_option("--host", host, "this host's name in the system file")->required();
   app.add_option("-d,--domain", domain, "DDS domain (default: the file's)");
   app.add_option("--log-dir", log_dir, "where module output goes (default /tmp/oscar/...)");
+  std::string check;
+  app.add_option("--check", check,
+                 "only check that this host can run its modules of the system file whose content "
+                 "has this fingerprint (oscar boot does, over ssh), print the problems, exit");
+  bool over_ssh = false;
+  app.add_flag("--over-ssh", over_ssh,
+               "runs as the command of an ssh session: when the connection ends, stop this "
+               "host's modules in order and exit");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
+  if (!check.empty()) {
+    std::printf("%s\n", oscar::check_banner().c_str());  // first, whatever else fails
+    oscar::register_standard_cue_types();
+    const auto problems = oscar::check_this_host(file, host, check, oscar::plugin_search_path(),
+                                                 oscar::sibling_program);
+    for (const auto& p : problems) std::printf("%s\n", p.c_str());
+    return problems.empty() ? 0 : 2;
+  }
+  // A lost connection closes the pipes sshd gave us: a write to them must not kill the monitor
+  // (SIGPIPE) before it has stopped its modules in order.
+  if (over_ssh) std::signal(SIGPIPE, SIG_IGN);
 
   const auto signals = oscar::block_stop_signals();
   spdlog::set_pattern("%H:%M:%S.%e %^%-5l%$ [monitor " + host + "] %v");
@@ -102,6 +132,10 @@ int main(int argc, char** argv) {
     bool exit_requested = false;
     while (!exit_requested) {
       if (oscar::wait_for_stop(signals, std::chrono::milliseconds(5))) break;
+      if (over_ssh && connection_lost()) {
+        spdlog::warn("the ssh connection to boot is gone: stopping this host's modules");
+        break;
+      }
       std::deque<oscar::LaunchRequest> batch;  // handled without holding the lock
       {
         std::lock_guard lock(mutex);
