@@ -185,6 +185,11 @@ int main(int argc, char** argv) {
     // Remote hosts read the file at the same path: an absolute one.
     const auto remote_file = std::filesystem::absolute(file).lexically_normal().string();
     check_ssh_hosts(system, remote_file);
+    stop.wait(std::chrono::milliseconds(0));  // Ctrl-C while the hosts were checked
+    if (stop.count() > 0) {
+      std::fprintf(stderr, "oscar boot: Ctrl-C: nothing started\n");
+      return 130;
+    }
     if (check) {
       std::printf("%s: system '%s', %zu modules on %zu hosts: ok\n", file.c_str(),
                   system.name.c_str(), system.modules.size(), system.hosts.size());
