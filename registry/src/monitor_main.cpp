@@ -13,6 +13,7 @@
 #include <thread>
 
 #include <oscar/registryPubSubTypes.h>
+#include <spdlog/sinks/basic_file_sink.h>
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 #include <oscar/command_line.hpp>
@@ -84,7 +85,8 @@ int main(int argc, char** argv) {
   if (over_ssh) std::signal(SIGPIPE, SIG_IGN);
 
   const auto signals = oscar::block_stop_signals();
-  spdlog::set_pattern("%H:%M:%S.%e %^%-5l%$ [monitor " + host + "] %v");
+  const auto pattern = "%H:%M:%S.%e %^%-5l%$ [monitor " + host + "] %v";
+  spdlog::set_pattern(pattern);
 
   try {
     auto system = oscar::SystemSpec::load(file);
@@ -94,6 +96,15 @@ int main(int argc, char** argv) {
       log_dir = fmt::format("/tmp/oscar/{}-{}/{}", system.name, system.domain, host);
     }
     oscar::Supervisor supervisor(log_dir);
+    if (over_ssh) {
+      // What this monitor says after the connection is gone (stopping the host's modules) would
+      // be lost with it: on the host, its log goes to a file too (no module name has a '-').
+      auto on_host_log =
+          std::make_shared<spdlog::sinks::basic_file_sink_mt>(log_dir + "/oscar-monitor.log");
+      on_host_log->set_pattern(pattern);
+      spdlog::default_logger()->sinks().push_back(on_host_log);
+      spdlog::flush_on(spdlog::level::info);
+    }
     const auto network = oscar::NetworkConfig::for_host(system.root, host);
     oscar::DdsParticipant participant(system.domain, "oscar-monitor:" + host, network);
     oscar::TopicWriter<oscar::ProcessEvent, oscar::ProcessEventPubSubType> events(
@@ -197,6 +208,8 @@ int main(int argc, char** argv) {
     beater.request_stop();
     beater.join();
     for (const auto& x : supervisor.stop_all(std::chrono::milliseconds(5000))) {
+      spdlog::log(x.exit_code == 0 ? spdlog::level::info : spdlog::level::warn, "{} (pid {}) {}",
+                  x.module, x.pid, x.describe());
       auto ev = event(host, x.module, x.incarnation, oscar::PROC_EXITED, x.pid);
       ev.exit_code(x.exit_code);
       ev.signal(x.signal);
