@@ -86,7 +86,7 @@ std::vector<std::string> check_this_host(const std::string& file, const std::str
     const auto system = SystemSpec::load(file);  // its relative paths resolve here as at boot
     system.host(host);
     for (const auto& m : system.modules) {
-      if (m.spec.host != host || m.standby) continue;
+      if (m.spec.host != host) continue;  // standby modules too: they may be started there
       const auto program = program_path(m.program);
       if (access(program.c_str(), X_OK) != 0) {
         problems.push_back(
@@ -122,19 +122,24 @@ std::optional<std::string> explain_host_check(const HostSpec& host, const std::s
   while (banner < lines.size() && !lines[banner].starts_with("oscar-monitor ")) ++banner;
   if (banner == lines.size()) {
     if (exit_code == -1) return fmt::format("{}: unreachable: no answer in time", who);
-    if (contains(output, "Permission denied")) {
+    // 255 is ssh's own failure; the remote command's codes are its own.
+    if (exit_code == 255 && contains(output, "Permission denied")) {
       return fmt::format(
           "{}: authentication refused ({}); is your key in its "
           "authorized_keys, or name it with ssh_options: [IdentityFile=...]?",
           who, ssh_said(output));
     }
-    if (contains(output, "Host key verification failed") ||
-        contains(output, "IDENTIFICATION HAS CHANGED")) {
+    if (exit_code == 255 && (contains(output, "Host key verification failed") ||
+                             contains(output, "IDENTIFICATION HAS CHANGED"))) {
       return fmt::format("{}: its host key is not trusted ({}); add it to known_hosts", who,
                          ssh_said(output));
     }
     if (exit_code == 255) return fmt::format("{}: unreachable ({})", who, ssh_said(output));
-    if (exit_code == 126 || exit_code == 127 || contains(output, "No such file")) {
+    if (exit_code == 126) {
+      return fmt::format("{}: cannot run {} there, it is not executable ({})", who, monitor,
+                         ssh_said(output));
+    }
+    if (exit_code == 127 || contains(output, "No such file")) {
       return fmt::format("{}: missing program {} (install this OSCAR build, {}, at the same path)",
                          who, monitor, oscar_version());
     }

@@ -51,6 +51,11 @@ TEST(HostCheck, SshFailuresNameTheHostAndTheCause) {
 }
 
 TEST(HostCheck, AMissingMonitorOrAnotherVersionIsNamed) {
+  EXPECT_THAT(
+      explain(126, "bash: line 1: /opt/oscar/bin/oscar-monitor: Permission denied\n"),
+      HasSubstr("host 'robot' (oscar@robot): cannot run /opt/oscar/bin/oscar-monitor there, "
+                "it is not executable (bash: line 1: /opt/oscar/bin/oscar-monitor: "
+                "Permission denied)"));
   EXPECT_THAT(explain(127, "sh: 1: /opt/oscar/bin/oscar-monitor: not found\n"),
               HasSubstr("host 'robot' (oscar@robot): missing program "
                         "/opt/oscar/bin/oscar-monitor (install this OSCAR build"));
