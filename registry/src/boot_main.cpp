@@ -246,15 +246,11 @@ int main(int argc, char** argv) {
                     local.name, "--domain", dom});
     for (const auto& h : system.hosts) {
       const bool remote = h.kind == oscar::HostSpec::Kind::kSsh;
-      std::vector<std::string> monitor{oscar::sibling_program("oscar-monitor"),
-                                       "--system",
-                                       remote ? remote_file : file,
-                                       "--host",
-                                       h.name,
-                                       "--domain",
-                                       dom,
-                                       "--log-dir",
-                                       log_dir + "/" + h.name};
+      const auto& host_file = remote ? remote_file : file;
+      std::vector<std::string> monitor{oscar::sibling_program("oscar-monitor"), "--system",
+                                       host_file};
+      monitor.insert(monitor.end(),
+                     {"--host", h.name, "--domain", dom, "--log-dir", log_dir + "/" + h.name});
       if (remote) monitor.push_back("--over-ssh");
       children.start("monitor-" + h.name, 1, oscar::on_host(h, monitor));
     }
