@@ -195,7 +195,7 @@ TEST_F(SshBoot, ThreeHostsCuesCrossThemAndCtrlCStopsEveryHostInOrder) {
 }
 
 TEST_F(SshBoot, RefusesHostsThatAreNotReadyNamingHostAndCauseBeforeStartingAnything) {
-  make_hosts(8);
+  make_hosts(10);
   const auto build = std::filesystem::canonical(test::build_dir()).string();
   const auto bin = build + "/bin";
   const auto plugins = build + "/lib/oscar/plugins";
@@ -209,13 +209,20 @@ TEST_F(SshBoot, RefusesHostsThatAreNotReadyNamingHostAndCauseBeforeStartingAnyth
   ssh_->serve(6, ssh_->mount_command(bin, {"oscar-monitor"}));
   ssh_->serve(7, ssh_->mount_command(plugins, {"liboscar_kernel_relay.so"}));
   ssh_->serve(8, ssh_->mount_command(folder_, {"system.yaml"}));
+  ssh_->serve(9);  // h9's host key is not in the known hosts boot is given
+  ssh_->serve(10, ssh_->mount_command(folder_, {}, {{"system.yaml", "system: another\n"}}));
   std::string hosts = fmt::format("  h1: {{ local: true, address: {} }}\n", hosts_->address(1));
-  for (int i = 2; i <= 8; ++i) {
-    hosts += fmt::format("  h{}: {}\n", i, ssh_->entry(i, i == 4 ? "stranger_key" : "client_key"));
+  for (int i = 2; i <= 10; ++i) {
+    hosts += fmt::format("  h{}: {}\n", i,
+                         ssh_->entry(i, i == 4 ? "stranger_key" : "client_key",
+                                     i == 9 ? "no_known_hosts" : "known_hosts"));
   }
+  // A relative path, resolved beside the system file on every host that has it.
+  std::filesystem::create_directories(folder_ + "/my_plugins");
   std::ofstream(file_) << fmt::format(R"(
 system: not_ready
 lease: 1s
+plugins: [my_plugins]
 hosts:
 {}modules:
   - name: src
@@ -234,7 +241,7 @@ hosts:
   const auto at = [&](int i) {
     return fmt::format("host 'h{}' (root@{}): ", i, hosts_->address(i));
   };
-  EXPECT_THAT(out, HasSubstr("6 ssh hosts are not ready, nothing started"));
+  EXPECT_THAT(out, HasSubstr("8 ssh hosts are not ready, nothing started"));
   EXPECT_THAT(out, ::testing::Not(HasSubstr("host 'h2'")));
   EXPECT_THAT(out, HasSubstr(at(3) + "unreachable (ssh: connect to host " + hosts_->address(3) +
                              " port 2222: Connection refused)"));
@@ -246,6 +253,9 @@ hosts:
   EXPECT_THAT(out, HasSubstr(at(7) + "module 'relay': "));
   EXPECT_THAT(out, ::testing::ContainsRegex("h7.*liboscar_kernel_relay|h7.*'relay'"));
   EXPECT_THAT(out, HasSubstr(at(8) + "the system file " + file_ + " is not there"));
+  EXPECT_THAT(out,
+              HasSubstr(at(9) + "its host key is not trusted (Host key verification failed.)"));
+  EXPECT_THAT(out, HasSubstr(at(10) + "the system file " + file_ + " differs from boot's"));
   // Nothing started: no registry, no monitor, no log folder.
   EXPECT_FALSE(std::filesystem::exists(log_dir_));
   EXPECT_TRUE(processes_with({file_}).empty());

@@ -46,6 +46,7 @@ class SshHosts {
     keygen(dir_ + "/client_key");
     keygen(dir_ + "/stranger_key");  // a key no server accepts
     std::filesystem::copy_file(dir_ + "/client_key.pub", dir_ + "/authorized_keys");
+    std::ofstream(dir_ + "/no_known_hosts").flush();
   }
   ~SshHosts() {
     servers_.clear();
@@ -85,12 +86,14 @@ class SshHosts {
   }
 
   /// The system file's entry for host i: `ssh:` root at its address, with the test's key and
-  /// known hosts in `ssh_options` (`key` "stranger_key" offers a key the server refuses).
-  std::string entry(int i, const std::string& key = "client_key") const {
+  /// known hosts in `ssh_options` (`key` "stranger_key" offers a key the server refuses,
+  /// `known_hosts` "no_known_hosts" trusts no host key).
+  std::string entry(int i, const std::string& key = "client_key",
+                    const std::string& known_hosts = "known_hosts") const {
     return fmt::format(
         "{{ ssh: root@{}, address: {}, ssh_options: [Port={}, IdentityFile={}/{}, "
-        "IdentitiesOnly=yes, UserKnownHostsFile={}/known_hosts, StrictHostKeyChecking=yes] }}",
-        hosts_.address(i), hosts_.address(i), kPort, dir_, key, dir_);
+        "IdentitiesOnly=yes, UserKnownHostsFile={}/{}, StrictHostKeyChecking=yes] }}",
+        hosts_.address(i), hosts_.address(i), kPort, dir_, key, dir_, known_hosts);
   }
 
   /// Shell commands that make host i see `dir` with the entries `hidden` left out and the files
