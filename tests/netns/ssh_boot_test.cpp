@@ -85,6 +85,7 @@ class SshBoot : public testing::Test {
     ssh_.reset();
     hosts_.reset();
     std::filesystem::remove_all(folder_);
+    if (!HasFailure()) std::filesystem::remove_all(log_dir_);  // kept to read after a failure
   }
 
   void make_hosts(int n) {
@@ -305,6 +306,35 @@ TEST_F(SshBoot, AKilledSshConnectionStopsThatHostsModules) {
   EXPECT_TRUE(boot_->wait(60s)) << boot_->output();
   // A monitor whose connection boot cut at the end finishes stopping on its own, after boot.
   EXPECT_TRUE(eventually([&] { return processes_with({file_}).empty(); }, 10s))
+      << "a process of the system is left:\n"
+      << command_lines(processes_with({file_}));
+}
+
+// A boot killed with SIGKILL takes its ssh clients with it (PR_SET_PDEATHSIG): each remote
+// monitor sees its connection end and stops its host's modules in order.
+TEST_F(SshBoot, AKilledBootStopsTheModulesOfItsSshHostsInOrder) {
+  make_hosts(3);
+  ssh_->serve(2);
+  ssh_->serve(3);
+  write_three_host_system();
+  boot();
+  ASSERT_TRUE(boot_says("running after", 90s)) << boot_->output();
+  const auto relay = module_processes("relay");
+  const auto sink = module_processes("sink");
+  ASSERT_EQ(relay.size(), 1u);
+  ASSERT_EQ(sink.size(), 1u);
+  ASSERT_EQ(kill(boot_->pid(), SIGKILL), 0);
+  EXPECT_TRUE(eventually([&] { return kill(relay[0], 0) != 0 && kill(sink[0], 0) != 0; }, 20s))
+      << "a module of an ssh host still runs";
+  for (const std::string module : {"relay", "sink"}) {
+    const auto log = log_dir_ + (module == "relay" ? "/h2" : "/h3") + "/oscar-monitor.log";
+    EXPECT_TRUE(eventually([&] { return read(log).find("] stopped") != std::string::npos; }, 10s))
+        << read(log);
+    EXPECT_THAT(read(log), HasSubstr("the ssh connection to boot is gone"));
+    EXPECT_THAT(read(log),
+                ::testing::ContainsRegex(module + R"( \(pid [0-9]+\) exited with code 0)"));
+  }
+  EXPECT_TRUE(eventually([&] { return processes_with({file_}).empty(); }, 20s))
       << "a process of the system is left:\n"
       << command_lines(processes_with({file_}));
 }
