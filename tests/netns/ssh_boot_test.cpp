@@ -170,7 +170,9 @@ TEST_F(SshBoot, ThreeHostsCuesCrossThemAndCtrlCStopsEveryHostInOrder) {
   // The registry stopped the modules one by one in reverse file order, each by its host's
   // monitor (SIGTERM, exit code 0): sink on h3, then relay on h2, then src on h1.
   const auto ended = [&](const std::string& host, const std::string& module) {
-    const auto log = read(log_dir_ + "/monitor-" + host + ".log");
+    // An ssh host's monitor keeps its own log there; h1's is the one boot keeps.
+    const auto log =
+        read(log_dir_ + (host == "h1" ? "/monitor-h1.log" : "/" + host + "/oscar-monitor.log"));
     std::smatch m;
     const std::regex line("([0-9:.]{12}) .*" + module + R"( \(pid [0-9]+\) exited with code 0)");
     EXPECT_TRUE(std::regex_search(log, m, line)) << host << ":\n" << log;
