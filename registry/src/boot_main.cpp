@@ -29,6 +29,7 @@
 #include "oscar/registry/launch_command.hpp"
 #include "oscar/registry/log_printer.hpp"
 #include "oscar/registry/registry_client.hpp"
+#include "oscar/registry/run_command.hpp"
 #include "oscar/registry/running_systems.hpp"
 #include "oscar/registry/supervisor.hpp"
 #include "oscar/registry/system_spec.hpp"

@@ -1,13 +1,7 @@
 #include "oscar/registry/host_check.hpp"
 
-#include <fcntl.h>
-#include <poll.h>
-#include <signal.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -162,61 +156,6 @@ std::optional<std::string> explain_host_check(const HostSpec& host, const std::s
   return fmt::format("{}: {}", who,
                      problems.empty() ? fmt::format("the check failed with exit code {}", exit_code)
                                       : fmt::format("{}", fmt::join(problems, "; ")));
-}
-
-CommandResult run_command(const std::vector<std::string>& argv, std::chrono::milliseconds timeout) {
-  if (argv.empty()) throw std::runtime_error("run_command: empty command");
-  int out[2];
-  if (pipe2(out, O_CLOEXEC) != 0) {
-    throw std::runtime_error(fmt::format("pipe: {}", std::strerror(errno)));
-  }
-  std::vector<std::string> args = argv;
-  std::vector<char*> cargs;
-  for (auto& a : args) cargs.push_back(a.data());
-  cargs.push_back(nullptr);
-  const pid_t pid = fork();
-  if (pid == 0) {
-    sigset_t none;
-    sigemptyset(&none);
-    sigprocmask(SIG_SETMASK, &none, nullptr);
-    setpgid(0, 0);  // Ctrl-C is boot's to handle
-    const int devnull = ::open("/dev/null", O_RDONLY);
-    if (devnull >= 0) dup2(devnull, 0);
-    dup2(out[1], 1);
-    dup2(out[1], 2);
-    execvp(cargs[0], cargs.data());
-    const auto message = fmt::format("{}: {}\n", cargs[0], std::strerror(errno));
-    (void)!::write(2, message.data(), message.size());
-    _exit(127);
-  }
-  ::close(out[1]);
-  if (pid < 0) {
-    ::close(out[0]);
-    throw std::runtime_error(fmt::format("fork: {}", std::strerror(errno)));
-  }
-  CommandResult result;
-  const auto until = std::chrono::steady_clock::now() + timeout;
-  bool timed_out = false;
-  char buffer[4096];
-  for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        until - std::chrono::steady_clock::now());
-    if (left.count() <= 0) {
-      timed_out = true;
-      break;
-    }
-    pollfd p{out[0], POLLIN, 0};
-    if (poll(&p, 1, static_cast<int>(left.count())) <= 0) continue;
-    const auto got = ::read(out[0], buffer, sizeof buffer);
-    if (got <= 0) break;
-    result.output.append(buffer, static_cast<std::size_t>(got));
-  }
-  ::close(out[0]);
-  if (timed_out) ::kill(pid, SIGKILL);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  result.exit_code = !timed_out && WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
 }
 
 }  // namespace oscar

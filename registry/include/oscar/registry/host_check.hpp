@@ -5,7 +5,6 @@
 /// modules need. Boot runs `oscar-monitor --check` there over ssh; the monitor runs
 /// check_this_host() and boot reads its answer with explain_host_check().
 
-#include <chrono>
 #include <optional>
 #include <string>
 #include <vector>
@@ -48,15 +47,5 @@ std::vector<std::string> host_check_command(const HostSpec& host, const std::str
 /// host key not trusted, version mismatch, missing program, or what the host reported.
 std::optional<std::string> explain_host_check(const HostSpec& host, const std::string& monitor,
                                               int exit_code, const std::string& output);
-
-/// Output and exit code of a command run to its end (stdin from /dev/null).
-struct CommandResult {
-  int exit_code = -1;  ///< -1: killed after the timeout, or by a signal
-  std::string output;  ///< stdout and stderr together
-};
-
-/// Runs `argv` and waits for it at most `timeout` (then kills it).
-/// @throws std::runtime_error if it cannot be started.
-CommandResult run_command(const std::vector<std::string>& argv, std::chrono::milliseconds timeout);
 
 }  // namespace oscar
