@@ -54,16 +54,29 @@ void check_hosts(const oscar::SystemSpec& system) {
 }
 
 // Every ssh host at once, before anything starts anywhere: reachable, the same OSCAR, the same
-// system file, every program and plugin of its modules there (oscar-monitor --check).
-void check_ssh_hosts(const oscar::SystemSpec& system, const std::string& file) {
+// system file (copied there first if asked), every program and plugin of its modules there
+// (oscar-monitor --check).
+void check_ssh_hosts(const oscar::SystemSpec& system, const std::string& file, bool copy) {
   const auto monitor = oscar::sibling_program("oscar-monitor");
+  const auto content = oscar::read_text_file(file);
   std::vector<std::future<std::optional<std::string>>> answers;
   for (const auto& h : system.hosts) {
     if (h.kind != oscar::HostSpec::Kind::kSsh) continue;
-    answers.push_back(std::async(std::launch::async, [&monitor, &file, h] {
+    answers.push_back(std::async(std::launch::async, [&, h]() -> std::optional<std::string> {
       // ssh gives up connecting after 10 s (ConnectTimeout); loading plugins takes well under.
-      const auto run =
-          oscar::run_command(oscar::host_check_command(h, file, monitor), std::chrono::seconds(30));
+      constexpr std::chrono::seconds kTimeout{30};
+      if (copy) {
+        const auto put =
+            oscar::run_command(oscar::copy_system_file_command(h, file), kTimeout, content);
+        if (put.exit_code == 255 || put.exit_code == -1) {
+          return oscar::explain_host_check(h, monitor, put.exit_code, put.output);
+        }
+        if (put.exit_code != 0) {
+          return fmt::format("host '{}' ({}): could not copy the system file to {} there: {}",
+                             h.name, h.ssh, file, put.output);
+        }
+      }
+      const auto run = oscar::run_command(oscar::host_check_command(h, file, monitor), kTimeout);
       return oscar::explain_host_check(h, monitor, run.exit_code, run.output);
     }));
   }
@@ -167,6 +180,9 @@ int main(int argc, char** argv) {
   app.add_option("--duration", duration_s, "stop after this many seconds (default: Ctrl-C)");
   app.add_option("--log-dir", log_dir, "where process output goes (default /tmp/oscar/...)");
   app.add_flag("--check", check, "check the system file and its modules, start nothing");
+  bool copy_system_file = false;
+  app.add_flag("--copy-system-file", copy_system_file,
+               "copy the system file to every ssh host, to the same path, before checking it");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 
   StopRequests stop(oscar::block_stop_signals());
@@ -185,7 +201,7 @@ int main(int argc, char** argv) {
     check_hosts(system);
     // Remote hosts read the file at the same path: an absolute one.
     const auto remote_file = std::filesystem::absolute(file).lexically_normal().string();
-    check_ssh_hosts(system, remote_file);
+    check_ssh_hosts(system, remote_file, copy_system_file);
     stop.wait(std::chrono::milliseconds(0));  // Ctrl-C while the hosts were checked
     if (stop.count() > 0) {
       std::fprintf(stderr, "oscar boot: Ctrl-C: nothing started\n");

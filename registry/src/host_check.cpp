@@ -108,6 +108,13 @@ std::vector<std::string> host_check_command(const HostSpec& host, const std::str
                         content_fingerprint(read_text_file(file))});
 }
 
+std::vector<std::string> copy_system_file_command(const HostSpec& host, const std::string& file) {
+  return on_host(host, {"sh", "-c",
+                        "mkdir -p \"$(dirname \"$1\")\" && cat > \"$1.oscar-copy\" && "
+                        "mv \"$1.oscar-copy\" \"$1\"",
+                        "oscar-copy", file});
+}
+
 std::optional<std::string> explain_host_check(const HostSpec& host, const std::string& monitor,
                                               int exit_code, const std::string& output) {
   const auto who = fmt::format("host '{}' ({})", host.name, host.ssh);

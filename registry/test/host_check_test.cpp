@@ -11,6 +11,7 @@
 
 #include "oscar/cue_types.hpp"
 #include "oscar/kernel_registry.hpp"
+#include "oscar/registry/run_command.hpp"
 
 namespace oscar {
 namespace {
@@ -151,6 +152,18 @@ TEST_F(ThisHost, ResolvesThePluginFoldersRelativeToTheSystemFile) {
   EXPECT_THAT(problems[0], HasSubstr("my_plugins"));
   std::filesystem::create_directories(dir_ / "my_plugins");
   EXPECT_THAT(check(yaml), ElementsAre());
+}
+
+TEST_F(ThisHost, CopyingTheSystemFileCreatesItsFolderAndReplacesAnOldCopy) {
+  HostSpec here;  // the same command as over ssh, run here
+  const auto file = (dir_ / "new folder" / "system.yaml").string();
+  for (const std::string content : {"system: first\n", "system: second\n"}) {
+    const auto put =
+        run_command(copy_system_file_command(here, file), std::chrono::seconds(10), content);
+    EXPECT_EQ(put.exit_code, 0) << put.output;
+    EXPECT_EQ(read_text_file(file), content);
+  }
+  EXPECT_FALSE(std::filesystem::exists(file + ".oscar-copy"));
 }
 
 }  // namespace

@@ -312,6 +312,22 @@ TEST_F(SshBoot, AKilledSshConnectionStopsThatHostsModules) {
       << command_lines(processes_with({file_}));
 }
 
+// With --copy-system-file boot puts its system file on each ssh host first: on h2 it is missing,
+// on h3 an old one differs (each sees its own file system); both then boot.
+TEST_F(SshBoot, CopiesTheSystemFileAlongWhenAsked) {
+  make_hosts(3);
+  ssh_->serve(2, ssh_->mount_command(folder_, {"system.yaml"}));
+  ssh_->serve(3, ssh_->mount_command(folder_, {}, {{"system.yaml", "system: old\n"}}));
+  write_three_host_system();
+  boot({"--copy-system-file"});
+  ASSERT_TRUE(boot_says("running after", 90s)) << boot_->output();
+  const std::regex counted(R"(\[sink\] LineSeg3DSeq: ([1-9][0-9]*) cues)");
+  EXPECT_TRUE(eventually([&] { return std::regex_search(boot_->output(), counted); }, 30s))
+      << boot_->output();
+  kill(boot_->pid(), SIGINT);
+  EXPECT_EQ(boot_->wait(60s), 0) << boot_->output();
+}
+
 // A boot killed with SIGKILL takes its ssh clients with it (PR_SET_PDEATHSIG): each remote
 // monitor sees its connection end and stops its host's modules in order.
 TEST_F(SshBoot, AKilledBootStopsTheModulesOfItsSshHostsInOrder) {

@@ -42,6 +42,11 @@ std::string check_banner();
 std::vector<std::string> host_check_command(const HostSpec& host, const std::string& file,
                                             const std::string& monitor);
 
+/// Boot's side of `--copy-system-file`: the command that writes the content it is given on its
+/// stdin to the same absolute path `file` on `host` (an ssh host), creating the folder and
+/// replacing what is there (through a temporary file beside it, so a reader never sees half).
+std::vector<std::string> copy_system_file_command(const HostSpec& host, const std::string& file);
+
 /// What boot says about a check's outcome: nothing (std::nullopt) when the host is ready,
 /// otherwise one message naming the host and the cause — unreachable, authentication refused,
 /// host key not trusted, version mismatch, missing program, or what the host reported.
