@@ -85,7 +85,10 @@ class SshBoot : public testing::Test {
     ssh_.reset();
     hosts_.reset();
     std::filesystem::remove_all(folder_);
-    if (!HasFailure()) std::filesystem::remove_all(log_dir_);  // kept to read after a failure
+    if (!HasFailure()) {  // kept to read after a failure
+      std::filesystem::remove_all(log_dir_);
+      std::filesystem::remove(test::temp_path("ssh_boot.log"));
+    }
   }
 
   void make_hosts(int n) {
