@@ -9,7 +9,7 @@ packages=(
   libeigen3-dev libopencv-dev libapriltag-dev libompl-dev libboost-dev libboost-graph-dev
   libgtest-dev libgmock-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
   nlohmann-json3-dev libexpected-dev libzstd-dev liblz4-dev zlib1g-dev
-  graphviz iproute2 procps gdb gdbserver nodejs npm
+  graphviz iproute2 procps gdb gdbserver openssh-client openssh-server nodejs npm
 )
 
 missing=()

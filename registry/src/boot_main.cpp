@@ -9,6 +9,7 @@
 #include <ctime>
 #include <filesystem>
 #include <functional>
+#include <future>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -24,9 +25,11 @@
 #include "oscar/cue_types.hpp"
 #include "oscar/kernel_registry.hpp"
 #include "oscar/process_util.hpp"
+#include "oscar/registry/host_check.hpp"
 #include "oscar/registry/launch_command.hpp"
 #include "oscar/registry/log_printer.hpp"
 #include "oscar/registry/registry_client.hpp"
+#include "oscar/registry/run_command.hpp"
 #include "oscar/registry/running_systems.hpp"
 #include "oscar/registry/supervisor.hpp"
 #include "oscar/registry/system_spec.hpp"
@@ -59,6 +62,44 @@ void check_identities(const oscar::SystemSpec& system, const std::string& keysto
   for (const auto& h : system.hosts) identities.push_back(sf::monitor_identity(h.name));
   for (const auto& m : system.modules) identities.push_back(sf::module_identity(m.spec.name));
   for (const auto& identity : identities) sf::dds_security_properties(keystore, identity);
+}
+
+// Every ssh host at once, before anything starts anywhere: reachable, the same OSCAR, the same
+// system file (copied there first if asked), every program and plugin of its modules there
+// (oscar-monitor --check).
+void check_ssh_hosts(const oscar::SystemSpec& system, const std::string& file, bool copy) {
+  const auto monitor = oscar::sibling_program("oscar-monitor");
+  const auto content = oscar::read_text_file(file);
+  std::vector<std::future<std::optional<std::string>>> answers;
+  for (const auto& h : system.hosts) {
+    if (h.kind != oscar::HostSpec::Kind::kSsh) continue;
+    answers.push_back(std::async(std::launch::async, [&, h]() -> std::optional<std::string> {
+      // ssh gives up connecting after 10 s (ConnectTimeout); loading plugins takes well under.
+      constexpr std::chrono::seconds kTimeout{30};
+      if (copy) {
+        const auto put =
+            oscar::run_command(oscar::copy_system_file_command(h, file), kTimeout, content);
+        if (put.exit_code == 255 || put.exit_code == -1) {
+          return oscar::explain_host_check(h, monitor, put.exit_code, put.output);
+        }
+        if (put.exit_code != 0) {
+          return fmt::format("host '{}' ({}): could not copy the system file to {} there: {}",
+                             h.name, h.ssh, file, put.output);
+        }
+      }
+      const auto run = oscar::run_command(oscar::host_check_command(h, file, monitor), kTimeout);
+      return oscar::explain_host_check(h, monitor, run.exit_code, run.output);
+    }));
+  }
+  std::vector<std::string> problems;
+  for (auto& a : answers) {
+    if (auto problem = a.get()) problems.push_back(std::move(*problem));
+  }
+  if (!problems.empty()) {
+    throw std::runtime_error(fmt::format("{} ssh host{} not ready, nothing started:\n  {}",
+                                         problems.size(), problems.size() == 1 ? " is" : "s are",
+                                         fmt::join(problems, "\n  ")));
+  }
 }
 
 std::string summary(const oscar::SystemState& s) {
@@ -153,6 +194,9 @@ int main(int argc, char** argv) {
                  "DDS Security keystore for every process (default: the file's security: "
                  "keystore:; docs/security.md)");
   app.add_flag("--check", check, "check the system file and its modules, start nothing");
+  bool copy_system_file = false;
+  app.add_flag("--copy-system-file", copy_system_file,
+               "copy the system file to every ssh host, to the same path, before checking it");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 
   StopRequests stop(oscar::block_stop_signals());
@@ -180,6 +224,14 @@ int main(int argc, char** argv) {
     oscar::coordinator::SwarmSetup::from(system);
     const auto& local = system.local_host();
     check_hosts(system);
+    // Remote hosts read the file at the same path: an absolute one.
+    const auto remote_file = std::filesystem::absolute(file).lexically_normal().string();
+    check_ssh_hosts(system, remote_file, copy_system_file);
+    stop.wait(std::chrono::milliseconds(0));  // Ctrl-C while the hosts were checked
+    if (stop.count() > 0) {
+      std::fprintf(stderr, "oscar boot: Ctrl-C: nothing started\n");
+      return 130;
+    }
     if (check) {
       std::printf("%s: system '%s', %zu modules on %zu hosts: ok\n", file.c_str(),
                   system.name.c_str(), system.modules.size(), system.hosts.size());
@@ -249,10 +301,18 @@ int main(int argc, char** argv) {
                    {oscar::sibling_program("oscar-registry"), "--system", file, "--host",
                     local.name, "--domain", dom});
     for (const auto& h : system.hosts) {
-      children.start(
-          "monitor-" + h.name, 1,
-          oscar::on_host(h, {oscar::sibling_program("oscar-monitor"), "--system", file, "--host",
-                             h.name, "--domain", dom, "--log-dir", log_dir + "/" + h.name}));
+      const bool remote = h.kind == oscar::HostSpec::Kind::kSsh;
+      const auto& host_file = remote ? remote_file : file;
+      std::vector<std::string> monitor{oscar::sibling_program("oscar-monitor"), "--system",
+                                       host_file};
+      if (remote && !keystore.empty()) {
+        // ssh passes no environment: the keystore (at the same path there) is said explicitly.
+        monitor.insert(monitor.begin(), {"env", "OSCAR_KEYSTORE=" + keystore});
+      }
+      monitor.insert(monitor.end(),
+                     {"--host", h.name, "--domain", dom, "--log-dir", log_dir + "/" + h.name});
+      if (remote) monitor.push_back("--over-ssh");
+      children.start("monitor-" + h.name, 1, oscar::on_host(h, monitor));
     }
     const auto state_is = [&](const char* state) {
       const auto s = registry.latest();
@@ -313,7 +373,18 @@ int main(int argc, char** argv) {
       log.flush(true);
       return 130;
     }
-    // Monitors exit when the registry tells them; what is left is stopped here.
+    // Monitors exit when the registry tells them; over ssh their last lines and exit code come
+    // back only if boot does not cut the connection first. What is left is stopped here.
+    wait_until(
+        [&] {
+          for (const auto& x : children.reap()) {
+            if (x.exit_code != 0) log.note("boot", fmt::format("{} {}", x.module, x.describe()));
+          }
+          return std::none_of(system.hosts.begin(), system.hosts.end(), [&](const auto& h) {
+            return children.pid_of("monitor-" + h.name).has_value();
+          });
+        },
+        std::chrono::seconds(3), stop, log);
     for (const auto& x : children.stop_all(std::chrono::milliseconds(5000))) {
       if (x.exit_code != 0) log.note("boot", fmt::format("{} {}", x.module, x.describe()));
     }

@@ -32,7 +32,15 @@ std::vector<std::string> on_host(const HostSpec& host, const std::vector<std::st
         if (!remote.empty()) remote += ' ';
         remote += shell_quote(a);
       }
-      return {"ssh", "-o", "BatchMode=yes", "-T", host.ssh, "--", remote};
+      // ssh takes the first value it gets for an option: the host's own options come before
+      // the defaults they may override (not BatchMode: nobody could type a password).
+      std::vector<std::string> out{"ssh", "-o", "BatchMode=yes"};
+      for (const auto& o : host.ssh_options) out.insert(out.end(), {"-o", o});
+      // A host that does not answer fails the check in 10 s; a connection that stops carrying
+      // anything ends within 3 s, and its monitor then stops the host's modules.
+      out.insert(out.end(), {"-o", "ConnectTimeout=10", "-o", "ServerAliveInterval=1", "-o",
+                             "ServerAliveCountMax=3", "-T", host.ssh, "--", remote});
+      return out;
     }
   }
   return argv;

@@ -1,5 +1,6 @@
 // oscar-monitor: one per host (docs/boot.md). Starts module processes when the registry asks,
 // captures their output, reports how they end, and shows it is alive with a heartbeat.
+#include <poll.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -12,12 +13,16 @@
 #include <thread>
 
 #include <oscar/registryPubSubTypes.h>
+#include <spdlog/sinks/basic_file_sink.h>
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 #include <oscar/command_line.hpp>
 
 #include "janitor.hpp"
+#include "oscar/cue_types.hpp"
+#include "oscar/kernel_registry.hpp"
 #include "oscar/process_util.hpp"
+#include "oscar/registry/host_check.hpp"
 #include "oscar/registry/launch_command.hpp"
 #include "oscar/registry/supervisor.hpp"
 #include "oscar/registry/system_spec.hpp"
@@ -42,6 +47,13 @@ oscar::ProcessEvent event(const std::string& host, const std::string& module, un
   return e;
 }
 
+// sshd hands the session's command pipes (or sockets) for its output; when the connection ends
+// it closes their other ends, which poll() reports as a hang-up or error on stdout.
+bool connection_lost() {
+  pollfd out{1, 0, 0};
+  return poll(&out, 1, 0) == 1 && (out.revents & (POLLHUP | POLLERR)) != 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -52,10 +64,30 @@ int main(int argc, char** argv) {
   app.add_option("--host", host, "this host's name in the system file")->required();
   app.add_option("-d,--domain", domain, "DDS domain (default: the file's)");
   app.add_option("--log-dir", log_dir, "where module output goes (default /tmp/oscar/...)");
+  std::string check;
+  app.add_option("--check", check,
+                 "only check that this host can run its modules of the system file whose content "
+                 "has this fingerprint (oscar boot does, over ssh), print the problems, exit");
+  bool over_ssh = false;
+  app.add_flag("--over-ssh", over_ssh,
+               "runs as the command of an ssh session: when the connection ends, stop this "
+               "host's modules in order and exit");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
+  if (!check.empty()) {
+    std::printf("%s\n", oscar::check_banner().c_str());  // first, whatever else fails
+    oscar::register_standard_cue_types();
+    const auto problems = oscar::check_this_host(file, host, check, oscar::plugin_search_path(),
+                                                 oscar::sibling_program);
+    for (const auto& p : problems) std::printf("%s\n", p.c_str());
+    return problems.empty() ? 0 : 2;
+  }
+  // A lost connection closes the pipes sshd gave us: a write to them must not kill the monitor
+  // (SIGPIPE) before it has stopped its modules in order.
+  if (over_ssh) std::signal(SIGPIPE, SIG_IGN);
 
   const auto signals = oscar::block_stop_signals();
-  spdlog::set_pattern("%H:%M:%S.%e %^%-5l%$ [monitor " + host + "] %v");
+  const auto pattern = "%H:%M:%S.%e %^%-5l%$ [monitor " + host + "] %v";
+  spdlog::set_pattern(pattern);
 
   try {
     auto system = oscar::SystemSpec::load(file);
@@ -65,6 +97,15 @@ int main(int argc, char** argv) {
       log_dir = fmt::format("/tmp/oscar/{}-{}/{}", system.name, system.domain, host);
     }
     oscar::Supervisor supervisor(log_dir);
+    if (over_ssh) {
+      // What this monitor says after the connection is gone (stopping the host's modules) would
+      // be lost with it: on the host, its log goes to a file too (no module name has a '-').
+      auto on_host_log =
+          std::make_shared<spdlog::sinks::basic_file_sink_mt>(log_dir + "/oscar-monitor.log");
+      on_host_log->set_pattern(pattern);
+      spdlog::default_logger()->sinks().push_back(on_host_log);
+      spdlog::flush_on(spdlog::level::info);
+    }
     const auto network = system.network_for(host, oscar::security_files::monitor_identity(host));
     oscar::DdsParticipant participant(system.domain, "oscar-monitor:" + host, network);
     oscar::TopicWriter<oscar::ProcessEvent, oscar::ProcessEventPubSubType> events(
@@ -103,6 +144,10 @@ int main(int argc, char** argv) {
     bool exit_requested = false;
     while (!exit_requested) {
       if (oscar::wait_for_stop(signals, std::chrono::milliseconds(5))) break;
+      if (over_ssh && connection_lost()) {
+        spdlog::warn("the ssh connection to boot is gone: stopping this host's modules");
+        break;
+      }
       std::deque<oscar::LaunchRequest> batch;  // handled without holding the lock
       {
         std::lock_guard lock(mutex);
@@ -164,6 +209,8 @@ int main(int argc, char** argv) {
     beater.request_stop();
     beater.join();
     for (const auto& x : supervisor.stop_all(std::chrono::milliseconds(5000))) {
+      spdlog::log(x.exit_code == 0 ? spdlog::level::info : spdlog::level::warn, "{} (pid {}) {}",
+                  x.module, x.pid, x.describe());
       auto ev = event(host, x.module, x.incarnation, oscar::PROC_EXITED, x.pid);
       ev.exit_code(x.exit_code);
       ev.signal(x.signal);

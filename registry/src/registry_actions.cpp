@@ -219,6 +219,9 @@ void Registry::shutdown() {
   for (const auto& [host, mon] : monitors_) {
     if (mon.alive) io_->send(LAUNCH_EXIT, host, mon.pid, "", 0);
   }
+  // The registry exits next: without this its monitors' exit requests were sometimes lost, and
+  // a monitor over ssh stayed until boot closed its connection.
+  io_->wait_until_delivered(std::chrono::seconds(1));
   set_system("stopped", "all modules stopped");
 }
 

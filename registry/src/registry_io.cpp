@@ -71,6 +71,12 @@ void Registry::Io::send(LaunchKind kind, const std::string& host, long monitor_p
   launch_.write(q);
 }
 
+void Registry::Io::wait_until_delivered(std::chrono::milliseconds timeout) {
+  const auto ms = timeout.count();
+  launch_.dds_writer().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(
+      static_cast<std::int32_t>(ms / 1000), static_cast<std::uint32_t>(ms % 1000) * 1000000u));
+}
+
 Registry::Clock::time_point Registry::Io::last_beat(const std::string& module,
                                                     unsigned incarnation) {
   std::lock_guard lock(handles_mutex_);

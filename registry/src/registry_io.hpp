@@ -20,6 +20,9 @@ class Registry::Io {
   /// A request to the monitor of `host`; `restore` is the configuration a start restores.
   void send(LaunchKind kind, const std::string& host, long monitor_pid, const std::string& module,
             unsigned incarnation, const std::string& restore = "");
+  /// Waits until every monitor has acknowledged the requests sent so far, at most `timeout`:
+  /// the registry's last requests (LAUNCH_EXIT) would be lost if it exited before.
+  void wait_until_delivered(std::chrono::milliseconds timeout);
   void reply(unsigned long long id, const std::string& error);
   void publish(const SystemState& state) { system_.write(state); }
   /// When the last heartbeat of that incarnation arrived (epoch if none did).

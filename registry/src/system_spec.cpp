@@ -40,7 +40,7 @@ HostSpec parse_host(const std::string& name, const YAML::Node& node, const std::
   h.where = yaml_where(file, node);
   const auto what = "hosts." + name;
   if (!node.IsMap()) fail(h.where, what + ": expected {local: true} | {netns: NAME} | {ssh: U@H}");
-  check_yaml_keys(node, file, what, {"local", "netns", "ssh", "address"});
+  check_yaml_keys(node, file, what, {"local", "netns", "ssh", "address", "ssh_options"});
   const int kinds = (node["local"] ? 1 : 0) + (node["netns"] ? 1 : 0) + (node["ssh"] ? 1 : 0);
   if (kinds != 1) fail(h.where, what + ": give exactly one of local, netns, ssh");
   if (node["netns"]) {
@@ -56,6 +56,23 @@ HostSpec parse_host(const std::string& name, const YAML::Node& node, const std::
   } else if (!node["local"].as<bool>()) {
     fail(h.where, what + ": local must be true (or use netns/ssh)");
   }
+  if (const auto options = node["ssh_options"]) {
+    if (h.kind != HostSpec::Kind::kSsh) fail(h.where, what + ": ssh_options go with ssh");
+    if (!options.IsSequence()) {
+      fail(yaml_where(file, options), what + ".ssh_options: a list of Key=Value");
+    }
+    for (const auto& o : options) {
+      const auto text = o.IsScalar() ? o.Scalar() : std::string();
+      const auto eq = text.find('=');
+      if (eq == 0 || eq == std::string::npos || text.find_first_of(" \t\n") < eq) {
+        fail(yaml_where(file, o),
+             fmt::format("{}.ssh_options '{}': expected Key=Value as after ssh -o (e.g. "
+                         "Port=2222)",
+                         what, text));
+      }
+      h.ssh_options.push_back(text);
+    }
+  }
   if (node["address"]) {
     h.address = node["address"].as<std::string>();
     in_addr a{};
@@ -63,6 +80,12 @@ HostSpec parse_host(const std::string& name, const YAML::Node& node, const std::
       fail(yaml_where(file, node["address"]),
            fmt::format("{}.address '{}' is not an IPv4 address", what, h.address));
     }
+  }
+  // Without an address the remote host's processes would use loopback and never meet the rest.
+  if (h.kind == HostSpec::Kind::kSsh && h.address.empty()) {
+    fail(h.where, fmt::format("{}: an ssh host needs address: (the IPv4 address DDS uses "
+                              "there, e.g. {{ssh: {}, address: 192.168.1.12}})",
+                              what, h.ssh));
   }
   return h;
 }
@@ -297,7 +320,7 @@ SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
       s.hosts.push_back(parse_host(kv.first.as<std::string>(), kv.second, file));
     }
   } else {
-    s.hosts.push_back(HostSpec{"localhost", HostSpec::Kind::kLocal, "", "", "", file});
+    s.hosts.push_back(HostSpec{"localhost", HostSpec::Kind::kLocal, "", "", "", file, {}});
   }
   const auto modules = root["modules"];
   if (!modules || !modules.IsSequence() || modules.size() == 0) {

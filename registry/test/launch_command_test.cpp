@@ -26,8 +26,11 @@ TEST(LaunchCommand, SshHostsGetOneQuotedRemoteCommand) {
   HostSpec h;
   h.kind = HostSpec::Kind::kSsh;
   h.ssh = "robot@marvin";
+  h.ssh_options = {"Port=2222", "IdentityFile=/keys/robot"};
   EXPECT_EQ(on_host(h, {"/opt/oscar/bin/oscar-monitor", "--system", "my system.yaml", "it's"}),
-            (Argv{"ssh", "-o", "BatchMode=yes", "-T", "robot@marvin", "--",
+            (Argv{"ssh", "-o", "BatchMode=yes", "-o", "Port=2222", "-o", "IdentityFile=/keys/robot",
+                  "-o", "ConnectTimeout=10", "-o", "ServerAliveInterval=1", "-o",
+                  "ServerAliveCountMax=3", "-T", "robot@marvin", "--",
                   "/opt/oscar/bin/oscar-monitor --system 'my system.yaml' 'it'\\''s'"}));
 }
 

@@ -186,6 +186,22 @@ TEST(SystemSpec, BadPolicyValuesAreErrors) {
               HasSubstr("without shell characters"));
 }
 
+TEST(SystemSpec, AnSshHostNeedsAnAddressAndTakesSshOptions) {
+  EXPECT_THAT(error_of("hosts: { a: { local: true }, b: { ssh: u@b } }\nmodules: []"),
+              HasSubstr("hosts.b: an ssh host needs address:"));
+  EXPECT_THAT(error_of("hosts: { b: { ssh: u@b, address: 10.0.0.2, ssh_options: [Port 22] } }\n"
+                       "modules: []"),
+              HasSubstr("hosts.b.ssh_options 'Port 22': expected Key=Value"));
+  EXPECT_THAT(error_of("hosts: { b: { netns: b, ssh_options: [Port=22] } }\nmodules: []"),
+              HasSubstr("hosts.b: ssh_options go with ssh"));
+  const auto s = parse(
+      "hosts: { a: { local: true }, b: { ssh: u@b, address: 10.0.0.2, ssh_options: [Port=2222, "
+      "IdentityFile=~/.ssh/robot] } }\nmodules: [ { name: m, host: b, kernels: [ { type: relay } "
+      "] } ]");
+  EXPECT_EQ(s.host("b").ssh_options,
+            (std::vector<std::string>{"Port=2222", "IdentityFile=~/.ssh/robot"}));
+}
+
 TEST(SystemSpec, CheckModulesRejectsAnUnknownKernelType) {
   register_standard_cue_types();
   const auto s = parse("modules: [ { name: m, kernels: [ { type: no_such_kernel, name: k } ] } ]");

@@ -124,11 +124,11 @@ TEST(Boot, ExitsWhenTheSystemIsShutDownFromAnotherTerminal) {
   EXPECT_TRUE(test::processes_mentioning(sys.file()).empty()) << "a process of the system is left";
 }
 
-// `src` runs on this host; `far`'s host never answers (its ssh hangs), so boot cannot finish.
+// `src` runs on this host; `far`'s monitor never answers (its ssh hangs), so boot cannot finish.
 constexpr const char* kUnreachableHost = R"(
 system: unreachable
 lease: 1s
-hosts: { here: { local: true }, far: { ssh: oscar@far.invalid } }
+hosts: { here: { local: true }, far: { ssh: oscar@far.invalid, address: 127.0.0.1 } }
 modules:
   - name: src
     host: here
@@ -140,12 +140,14 @@ modules:
     mode: single_step
 )";
 
-// An `ssh` first on boot's PATH that connects to nothing and never returns, as to a host that
-// does not answer.
+// An `ssh` first on boot's PATH that passes boot's check of the host (it runs the check here) but
+// then connects to nothing and never returns, as to a host that stops answering.
 std::string hanging_ssh() {
   const auto dir = test::temp_path("hanging_ssh");
   std::filesystem::create_directories(dir);
-  std::ofstream(dir + "/ssh") << "#!/bin/sh\nexec sleep 120\n";
+  std::ofstream(dir + "/ssh") << "#!/bin/sh\nfor last; do :; done\n"
+                                 "case \"$last\" in *' --check '*) exec sh -c \"$last\";; esac\n"
+                                 "exec sleep 120\n";
   std::filesystem::permissions(dir + "/ssh", std::filesystem::perms::owner_all);
   return dir + ":" + std::getenv("PATH");
 }

@@ -1,6 +1,6 @@
 #pragma once
 /// @file The command lines that start processes on a system's hosts: as they are (local), in a
-/// network namespace (`ip netns exec`), or over ssh (a template; tests only build it).
+/// network namespace (`ip netns exec`), or over ssh (docs/boot.md, "Booting over SSH").
 
 #include <functional>
 #include <string>
@@ -10,7 +10,8 @@
 
 namespace oscar {
 
-/// `argv` wrapped so it runs on `host`. For ssh the remote command is one shell-quoted string.
+/// `argv` wrapped so it runs on `host`. For ssh the remote command is one shell-quoted string,
+/// after the host's `ssh_options` (`-o Key=Value`) and keep-alives that end a dead connection.
 std::vector<std::string> on_host(const HostSpec& host, const std::vector<std::string>& argv);
 
 /// Maps one of OSCAR's program names (oscar-run, oscar-coordinator, oscar-applet) to the program

@@ -22,6 +22,8 @@ struct HostSpec {
   std::string ssh;      ///< kSsh: "user@host"
   std::string address;  ///< optional IPv4 address DDS uses on that host
   std::string where;    ///< "file:line"
+  /// kSsh: ssh client options, each "Key=Value" as after `ssh -o` (Port, IdentityFile, ...).
+  std::vector<std::string> ssh_options;
 };
 
 /// What the registry does when the module fails (docs/boot.md).
