@@ -31,18 +31,19 @@ int main(int argc, char** argv) {
       ->add_option("--queue-messages", options.queue.messages_per_channel,
                    "per client and channel: messages queued before the oldest is dropped")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, 1 << 20));
   std::size_t queue_mib = options.queue.bytes >> 20;
   foxglove
       ->add_option("--queue-mib", queue_mib,
                    "per client: MiB of messages queued before the oldest are dropped")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, 1 << 20));
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   options.queue.bytes = queue_mib << 20;
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {
+    oscar::bridge::check_listen_address(options.address);
     auto participant = tool.participant("oscar-bridge");
     oscar::bridge::FoxgloveBridge bridge(*participant, options);
     fmt::print(stderr, "oscar bridge: serving domain {} to Foxglove at ws://{}:{}\n",

@@ -20,6 +20,15 @@ namespace net = boost::asio;
 using tcp = net::ip::tcp;
 using Clock = std::chrono::steady_clock;
 
+void check_listen_address(const std::string& address) {
+  boost::system::error_code ec;
+  net::ip::make_address(address, ec);
+  if (ec) {
+    throw std::invalid_argument(
+        fmt::format("--address '{}': expected an IP address such as 127.0.0.1", address));
+  }
+}
+
 // Everything below runs on the one thread that runs io (Fast DDS threads only post to it).
 struct FoxgloveBridge::Impl final : SessionHost {
   BridgeOptions options;
@@ -40,18 +49,12 @@ struct FoxgloveBridge::Impl final : SessionHost {
                   [this, topic, payload, receive_ns] { on_sample(topic, payload, receive_ns); });
       }};
 
-  Impl(DdsParticipant& p, BridgeOptions o) : options(std::move(o)), participant(p) {
-    beast_listen();
-  }
+  Impl(DdsParticipant& p, BridgeOptions o) : options(std::move(o)), participant(p) { listen(); }
 
-  void beast_listen() {
+  void listen() {
+    check_listen_address(options.address);
     boost::system::error_code ec;
-    const auto address = net::ip::make_address(options.address, ec);
-    if (ec) {
-      throw std::invalid_argument(
-          fmt::format("--address '{}': expected an IP address such as 127.0.0.1", options.address));
-    }
-    const tcp::endpoint endpoint(address, options.port);
+    const tcp::endpoint endpoint(net::ip::make_address(options.address), options.port);
     acceptor.open(endpoint.protocol(), ec);
     if (!ec) acceptor.set_option(net::socket_base::reuse_address(true), ec);
     if (!ec) acceptor.bind(endpoint, ec);

@@ -23,6 +23,10 @@ struct BridgeOptions {
   std::chrono::milliseconds report_period{1000};  ///< how often drops are reported
 };
 
+/// @throws std::invalid_argument if `address` is no IP address (checked before anything joins
+///         the domain).
+void check_listen_address(const std::string& address);
+
 class FoxgloveBridge {
  public:
   /// Listens on options.address:options.port; serves once run() is called.
