@@ -15,6 +15,7 @@ namespace net = boost::asio;
 
 namespace {
 constexpr std::size_t kMaxClientMessageBytes = 1 << 20;
+constexpr std::size_t kMaxPendingStatuses = 16;  // a stalled client gets the newest
 
 std::string describe(const net::ip::tcp::socket& socket) {
   beast::error_code ec;
@@ -173,7 +174,8 @@ void Session::send_text(std::string text) {
 }
 
 void Session::set_status(StatusLevel level, std::string message) {
-  status_ = status_json(level, message);
+  statuses_.push_back(status_json(level, message));
+  if (statuses_.size() > kMaxPendingStatuses) statuses_.pop_front();
   write_next();
 }
 
@@ -205,14 +207,10 @@ void Session::write_next() {
   auto done = [self = shared_from_this()](beast::error_code ec, std::size_t) {
     self->on_write(ec);
   };
-  if (!texts_.empty() || status_) {
-    if (!texts_.empty()) {
-      writing_text_ = std::move(texts_.front());
-      texts_.pop_front();
-    } else {
-      writing_text_ = std::move(*status_);
-      status_.reset();
-    }
+  if (!texts_.empty() || !statuses_.empty()) {
+    auto& from = texts_.empty() ? statuses_ : texts_;
+    writing_text_ = std::move(from.front());
+    from.pop_front();
     writing_ = true;
     ws_.text(true);
     ws_.async_write(net::buffer(writing_text_), std::move(done));

@@ -54,7 +54,7 @@ class Session : public std::enable_shared_from_this<Session> {
   void forget_channel(std::uint32_t channel);
   /// Drops since the last call, by channel (reported in the log and to the client).
   std::map<std::uint32_t, std::uint64_t> new_drops();
-  /// Tells the client (a status message, replacing one not sent yet).
+  /// Tells the client (a status message; of those not sent yet, the newest 16 are kept).
   void set_status(StatusLevel level, std::string message);
   /// Closes the connection.
   void close();
@@ -81,7 +81,7 @@ class Session : public std::enable_shared_from_this<Session> {
   std::shared_ptr<boost::beast::http::response<boost::beast::http::string_body>> rejection_;
   ClientQueue queue_;
   std::deque<std::string> texts_;
-  std::optional<std::string> status_;
+  std::deque<std::string> statuses_;                        // not sent yet
   std::map<std::uint32_t, std::uint32_t> channel_of_;       // subscription -> channel
   std::map<std::uint32_t, std::uint32_t> subscription_of_;  // channel -> subscription
   std::map<std::uint32_t, std::uint64_t> reported_drops_;
