@@ -18,6 +18,7 @@ const { MessageReader } = require("@foxglove/omgidl-serialization");
 const args = { url: process.argv[process.argv.indexOf("--url") + 1] };
 const lateCommand = process.argv.slice(process.argv.indexOf("--late") + 1);
 const SIG = "oscar/cue/sig/out", CAM = "oscar/cue/cam/out", LATE = "oscar/cue/late/out";
+const STATE = "oscar/system/state";
 const SIG_PERIOD_MS = 20;
 
 const failures = [];
@@ -125,13 +126,26 @@ function imageComplete(m) {
 async function main() {
   // 1. Advertisements: every topic with its OMG IDL schema.
   const a = new Client("a");
-  await until(() => a.channels.has(SIG) && a.channels.has(CAM), 15000);
+  await until(() => a.channels.has(SIG) && a.channels.has(CAM) && a.channels.has(STATE), 15000);
   check(a.serverInfo && a.serverInfo.name === "oscar bridge", "serverInfo comes first, from the oscar bridge");
   if (!check(a.channels.has(SIG) && a.channels.has(CAM), `${SIG} and ${CAM} are advertised`)) return;
   const sig = a.channels.get(SIG), cam = a.channels.get(CAM);
   check(sig.encoding === "cdr" && sig.schemaEncoding === "omgidl" && sig.schemaName === "oscar::Bool",
         `${SIG}: cdr, omgidl, oscar::Bool (${sig.encoding}, ${sig.schemaEncoding}, ${sig.schemaName})`);
   check(cam.schemaName === "oscar::GvImage", `${CAM}: oscar::GvImage`);
+
+  // The system's state (the registry's, as `oscar ps` shows it) is a channel too.
+  if (check(a.channels.has(STATE) && a.channels.get(STATE).schemaName === "oscar::SystemState",
+            `${STATE} is advertised as oscar::SystemState`)) {
+    const stateSub = a.subscribe(STATE);
+    await until(() => a.received.get(stateSub).length > 0, 5000);
+    const state = (a.received.get(stateSub)[0] || {}).msg || {};
+    const modules = (state.modules || []).map((m) => `${m.name}:${m.status}`).sort().join(" ");
+    check(state.system === "viewed" && state.state === "running" &&
+          modules === "camera:running sources:running",
+          `the last system state arrives on subscribing and decodes: ${state.system} ${state.state}, ${modules}`);
+    a.client.unsubscribe(stateSub);
+  }
 
   // 2. Subscribe to a Bool and an image topic; decode with only the advertised schema.
   const sigSub = a.subscribe(SIG), camSub = a.subscribe(CAM);
