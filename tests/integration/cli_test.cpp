@@ -17,7 +17,7 @@ const char* const kTools[] = {
     "oscar-echo",    "oscar-graph",      "oscar-hz",   "oscar-info",   "oscar-log",
     "oscar-monitor", "oscar-new-module", "oscar-ps",   "oscar-record", "oscar-registry",
     "oscar-replay",  "oscar-restart",    "oscar-run",  "oscar-swarm",  "oscar-shutdown",
-    "oscar-topics"};
+    "oscar-topics",  "oscar-bridge"};
 
 struct Run {
   int exit_code;

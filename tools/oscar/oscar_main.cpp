@@ -33,6 +33,7 @@ const char* const kUsage =
     "  echo TOPIC            print a topic's samples readably (headers, fields)\n"
     "  hz TOPIC              a topic's rate and the min/max/std of its period\n"
     "  graph [-o FILE.svg]   the running system as a graph (modules, kernels, channels)\n"
+    "  bridge foxglove       serve the running system live to Foxglove (ws://127.0.0.1:8765)\n"
     "  new-module NAME ...   generate a module: kernel, CMake, README, unit test\n"
     "  security init|check|list SYSTEM.yaml\n"
     "                        the system's DDS Security keystore (--keystore DIR)\n"

@@ -60,6 +60,9 @@ class DdsParticipant {
     std::string qos;
     bool reliable = true;
     bool transient_local = false;
+    /// How many remote writers of the topic discovery sees now; 0 once all have gone (the
+    /// entry stays, so a topic's last type and QoS are still known).
+    int alive = 0;
   };
   /// Every topic with a remote writer, by name (what `oscar record` subscribes to).
   std::map<std::string, DiscoveredWriter> discovered_writers() const;

@@ -253,17 +253,29 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
   }
   void on_publisher_discovery(dds::DomainParticipant*,
                               eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
+    using Status = eprosima::fastrtps::rtps::WriterDiscoveryInfo::DISCOVERY_STATUS;
     note(info.info.topicName().to_string(), info.info.typeName().to_string());
-    if (info.status == eprosima::fastrtps::rtps::WriterDiscoveryInfo::DISCOVERED_WRITER) {
+    const auto topic = info.info.topicName().to_string();
+    const auto& guid = info.info.guid();
+    if (info.status == Status::DISCOVERED_WRITER) {
       const auto& q = info.info.m_qos;
       const bool reliable = q.m_reliability.kind == dds::RELIABLE_RELIABILITY_QOS;
       const bool transient_local = q.m_durability.kind == dds::TRANSIENT_LOCAL_DURABILITY_QOS;
       std::lock_guard lock(mutex_);
-      writers_[info.info.topicName().to_string()] = {
-          info.info.typeName().to_string(),
-          std::string(reliable ? "reliable" : "best_effort") +
-              (transient_local ? ", transient_local" : ", volatile"),
-          reliable, transient_local};
+      live_writers_[guid] = topic;
+      writers_[topic] = {info.info.typeName().to_string(),
+                         std::string(reliable ? "reliable" : "best_effort") +
+                             (transient_local ? ", transient_local" : ", volatile"),
+                         reliable, transient_local, count_alive(topic)};
+    } else if (info.status == Status::REMOVED_WRITER) {
+      std::lock_guard lock(mutex_);
+      const auto live = live_writers_.find(guid);
+      if (live == live_writers_.end()) return;
+      const auto gone_topic = live->second;
+      live_writers_.erase(live);
+      if (auto it = writers_.find(gone_topic); it != writers_.end()) {
+        it->second.alive = count_alive(gone_topic);
+      }
     }
   }
   std::map<std::string, DdsParticipant::DiscoveredWriter> writers() const {
@@ -288,6 +300,11 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
   }
 
  private:
+  int count_alive(const std::string& topic) const {
+    int n = 0;
+    for (const auto& [guid, t] : live_writers_) n += t == topic;
+    return n;
+  }
   void note(std::string topic, std::string type) {
     std::lock_guard lock(mutex_);
     types_[std::move(topic)] = std::move(type);
@@ -295,6 +312,7 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
   mutable std::mutex mutex_;
   std::map<std::string, std::string> types_;
   std::map<std::string, DdsParticipant::DiscoveredWriter> writers_;
+  std::map<eprosima::fastrtps::rtps::GUID_t, std::string> live_writers_;  // -> topic
   struct Participant {
     std::string name;
     std::vector<std::string> modules;  // the modules its process hosts, as it says

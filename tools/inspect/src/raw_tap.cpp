@@ -42,7 +42,9 @@ struct RawTap::Impl {
   Fn fn;
   std::mutex mutex;
   std::map<std::string, std::pair<std::string, dds::DataReader*>> readers;  // topic -> type
-  std::vector<std::unique_ptr<Listener>> listeners;
+  // One per topic ever subscribed, kept until the tap goes: a reader being deleted may still be
+  // in its listener on a Fast DDS thread.
+  std::map<std::string, std::unique_ptr<Listener>> listeners;
   Impl(DdsParticipant& p, Fn f) : participant(p), fn(std::move(f)) {}
 };
 
@@ -70,12 +72,21 @@ std::string RawTap::subscribe(const std::string& topic) {
                             : dds::VOLATILE_DURABILITY_QOS;
   q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
   q.history().depth = 64;
-  impl_->listeners.push_back(std::make_unique<Impl::Listener>(impl_->fn, topic));
+  auto& listener = impl_->listeners[topic];
+  if (!listener) listener = std::make_unique<Impl::Listener>(impl_->fn, topic);
   auto* reader = impl_->participant.subscriber().create_datareader(
-      &t, q, impl_->listeners.back().get(), dds::StatusMask::data_available());
+      &t, q, listener.get(), dds::StatusMask::data_available());
   if (!reader) throw std::runtime_error("cannot subscribe to " + topic);
   impl_->readers[topic] = {w->second.type, reader};
   return w->second.type;
+}
+
+void RawTap::unsubscribe(const std::string& topic) {
+  std::lock_guard lock(impl_->mutex);
+  const auto it = impl_->readers.find(topic);
+  if (it == impl_->readers.end()) return;
+  impl_->participant.subscriber().delete_datareader(it->second.second);
+  impl_->readers.erase(it);
 }
 
 std::string wait_for_writer(DdsParticipant& participant, const std::string& topic,

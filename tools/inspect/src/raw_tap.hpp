@@ -27,6 +27,9 @@ class RawTap {
   /// writer is; transient local if it is, so a last state is heard). Returns the type name, or
   /// "" if no writer of the topic has been discovered yet. Subscribing twice is a no-op.
   std::string subscribe(const std::string& topic);
+  /// Stops reading `topic` (deletes its reader); a no-op if not subscribed. Samples already
+  /// being handed over may still reach the callback while this returns.
+  void unsubscribe(const std::string& topic);
 
  private:
   struct Impl;

@@ -1,0 +1,58 @@
+// oscar bridge foxglove: serves the running system to Foxglove (docs/foxglove.md).
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+
+#include <fmt/format.h>
+
+#include <oscar/command_line.hpp>
+#include "foxglove_bridge.hpp"
+#include "oscar/registry/system_options.hpp"
+
+namespace {
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop = true; }
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"oscar bridge: serve the running system to a viewer"};
+  app.require_subcommand(1);
+  auto* foxglove = app.add_subcommand(
+      "foxglove",
+      "a Foxglove WebSocket server (protocol v1): every topic as a channel with its OMG IDL "
+      "schema and raw CDR messages");
+  oscar::SystemOptions tool;
+  tool.add_to(*foxglove);
+  oscar::bridge::BridgeOptions options;
+  foxglove->add_option("--address", options.address, "address to listen on")->capture_default_str();
+  foxglove->add_option("--port", options.port, "TCP port to listen on (0: any free port)")
+      ->capture_default_str();
+  foxglove
+      ->add_option("--queue-messages", options.queue.messages_per_channel,
+                   "per client and channel: messages queued before the oldest is dropped")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1 << 20));
+  std::size_t queue_mib = options.queue.bytes >> 20;
+  foxglove
+      ->add_option("--queue-mib", queue_mib,
+                   "per client: MiB of messages queued before the oldest are dropped")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1 << 20));
+  OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
+  options.queue.bytes = queue_mib << 20;
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  try {
+    oscar::bridge::check_listen_address(options.address);
+    auto participant = tool.participant("oscar-bridge");
+    oscar::bridge::FoxgloveBridge bridge(*participant, options);
+    fmt::print(stderr, "oscar bridge: serving domain {} to Foxglove at ws://{}:{}\n",
+               participant->domain(), options.address, bridge.port());
+    bridge.run(g_stop);
+    fmt::print(stderr, "oscar bridge: stopped\n");
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "oscar bridge: %s\n", e.what());
+    return 1;
+  }
+}

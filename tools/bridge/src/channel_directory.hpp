@@ -1,0 +1,49 @@
+#pragma once
+// ChannelDirectory: the bridge's channels, one per topic of the running system that a writer
+// publishes now and whose type has an IDL text; updated from what discovery shows, so a topic
+// that appears is advertised and one whose last writer went is unadvertised.
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "foxglove_protocol.hpp"
+#include "oscar/dds_participant.hpp"
+
+namespace oscar::bridge {
+
+class ChannelDirectory {
+ public:
+  /// `idl_texts`: the self-contained IDL text of each type by scoped name (oscar::idl_texts()).
+  explicit ChannelDirectory(const std::map<std::string, std::string>& idl_texts)
+      : idl_texts_(idl_texts) {}
+
+  struct Change {
+    std::vector<ChannelInfo> added;
+    std::vector<std::uint32_t> removed;
+    /// Topics seen for the first time whose type has no IDL text here (not advertised).
+    std::vector<std::string> unknown;
+  };
+  /// Compares the writers discovery shows now with the channels so far. A topic that comes
+  /// back with its old type gets its old channel id; with another type, a new one.
+  Change update(const std::map<std::string, DdsParticipant::DiscoveredWriter>& writers);
+
+  /// The channels advertised now.
+  std::vector<ChannelInfo> channels() const;
+  /// The channel advertised now with that id.
+  const ChannelInfo* find(std::uint32_t id) const;
+  /// The id of the channel advertised now for `topic`.
+  std::optional<std::uint32_t> id_of(const std::string& topic) const;
+
+ private:
+  const std::map<std::string, std::string>& idl_texts_;
+  std::map<std::string, ChannelInfo> live_;   // by topic
+  std::map<std::string, ChannelInfo> known_;  // every channel ever made, by topic
+  std::set<std::string> unknown_;             // topics reported as having no IDL
+  std::uint32_t next_id_ = 1;
+};
+
+}  // namespace oscar::bridge

@@ -1,0 +1,95 @@
+#pragma once
+// Session: one Foxglove client of the bridge, on the bridge's I/O thread. It completes the
+// WebSocket handshake (subprotocol foxglove.websocket.v1), keeps the client's subscriptions,
+// and writes one frame at a time: control messages (advertise, status) first, then messages
+// from its ClientQueue, so a client that reads slowly only loses its own oldest messages.
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core/flat_buffer.hpp>
+#include <boost/beast/core/tcp_stream.hpp>
+#include <boost/beast/http/message.hpp>
+#include <boost/beast/http/string_body.hpp>
+#include <boost/beast/websocket/stream.hpp>
+
+#include "client_queue.hpp"
+#include "foxglove_protocol.hpp"
+
+namespace oscar::bridge {
+
+class Session;
+
+/// What a session needs of the bridge that serves it.
+class SessionHost {
+ public:
+  virtual ~SessionHost() = default;
+  virtual std::vector<ChannelInfo> channels() const = 0;
+  virtual const ChannelInfo* channel(std::uint32_t id) const = 0;
+  /// A client subscribed to / left `channel`: the bridge reads a topic while anyone wants it.
+  virtual void want(std::uint32_t channel) = 0;
+  virtual void unwant(std::uint32_t channel) = 0;
+  /// The session's connection ended (after it released its subscriptions).
+  virtual void closed(const std::shared_ptr<Session>& session) = 0;
+  virtual const std::string& session_id() const = 0;
+};
+
+class Session : public std::enable_shared_from_this<Session> {
+ public:
+  Session(boost::asio::ip::tcp::socket socket, SessionHost& host, QueueLimits limits);
+  /// Reads the HTTP upgrade request and accepts the WebSocket.
+  void start();
+  /// Sends a JSON text message (never dropped).
+  void send_text(std::string text);
+  /// Queues a message of `channel` if this client subscribes to it.
+  void deliver(const ClientQueue::Message& message);
+  /// `channel` is no more: its subscription ends without a word (it was unadvertised).
+  void forget_channel(std::uint32_t channel);
+  /// Drops since the last call, by channel (reported in the log and to the client).
+  std::map<std::uint32_t, std::uint64_t> new_drops();
+  /// Tells the client (a status message; of those not sent yet, the newest 16 are kept).
+  void set_status(StatusLevel level, std::string message);
+  /// Closes the connection.
+  void close();
+  const std::string& peer() const { return peer_; }
+
+ private:
+  void on_request(boost::beast::error_code ec);
+  void reject(std::string why);
+  void on_accept(boost::beast::error_code ec);
+  void read();
+  void on_read(boost::beast::error_code ec, std::size_t bytes);
+  void handle(const std::string& text);
+  void subscribe(std::uint32_t subscription, std::uint32_t channel);
+  void unsubscribe(std::uint32_t subscription);
+  void write_next();
+  void on_write(boost::beast::error_code ec);
+  void end();
+
+  boost::beast::websocket::stream<boost::beast::tcp_stream> ws_;
+  SessionHost& host_;
+  std::string peer_;
+  boost::beast::flat_buffer buffer_;
+  std::optional<boost::beast::http::request<boost::beast::http::string_body>> request_;
+  std::shared_ptr<boost::beast::http::response<boost::beast::http::string_body>> rejection_;
+  ClientQueue queue_;
+  std::deque<std::string> texts_;
+  std::deque<std::string> statuses_;                        // not sent yet
+  std::map<std::uint32_t, std::uint32_t> channel_of_;       // subscription -> channel
+  std::map<std::uint32_t, std::uint32_t> subscription_of_;  // channel -> subscription
+  std::map<std::uint32_t, std::uint64_t> reported_drops_;
+  bool open_ = false, writing_ = false, ended_ = false;
+  // What is being written lives until its write completes.
+  std::string writing_text_;
+  std::array<std::uint8_t, 13> writing_header_{};
+  std::shared_ptr<const std::vector<std::uint8_t>> writing_payload_;
+};
+
+}  // namespace oscar::bridge

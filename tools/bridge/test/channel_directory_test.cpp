@@ -1,0 +1,58 @@
+#include "channel_directory.hpp"
+
+#include <gtest/gtest.h>
+
+namespace oscar::bridge {
+namespace {
+
+using Writers = std::map<std::string, DdsParticipant::DiscoveredWriter>;
+
+DdsParticipant::DiscoveredWriter writer(const std::string& type, int alive = 1) {
+  DdsParticipant::DiscoveredWriter w;
+  w.type = type;
+  w.alive = alive;
+  return w;
+}
+
+const std::map<std::string, std::string> kIdl{{"oscar::Bool", "bool idl"},
+                                              {"oscar::GvImage", "image idl"}};
+
+TEST(ChannelDirectory, AdvertisesTopicsWithALiveWriterAndAnIdl) {
+  ChannelDirectory d(kIdl);
+  const auto change = d.update({{"oscar/cue/sig/out", writer("oscar::Bool")},
+                                {"oscar/cue/cam/out", writer("oscar::GvImage")},
+                                {"oscar/cue/old/out", writer("oscar::Bool", 0)},
+                                {"rt/chatter", writer("oscar::Bool")},
+                                {"oscar/cue/odd/out", writer("other::Type")}});
+  ASSERT_EQ(change.added.size(), 2u);
+  EXPECT_TRUE(change.removed.empty());
+  EXPECT_EQ(change.unknown, std::vector<std::string>{"oscar/cue/odd/out"});
+  const auto sig = d.id_of("oscar/cue/sig/out");
+  ASSERT_TRUE(sig);
+  ASSERT_NE(d.find(*sig), nullptr);
+  EXPECT_EQ(d.find(*sig)->schema, "bool idl");
+  EXPECT_EQ(d.find(*sig)->schema_name, "oscar::Bool");
+  EXPECT_FALSE(d.id_of("oscar/cue/old/out"));
+  EXPECT_TRUE(d.update({{"oscar/cue/odd/out", writer("other::Type")}}).unknown.empty())
+      << "an unknown type is reported once";
+}
+
+TEST(ChannelDirectory, FollowsTopicsThatGoAndComeBack) {
+  ChannelDirectory d(kIdl);
+  d.update({{"oscar/cue/sig/out", writer("oscar::Bool")}});
+  const auto id = *d.id_of("oscar/cue/sig/out");
+  auto change = d.update({{"oscar/cue/sig/out", writer("oscar::Bool", 0)}});
+  EXPECT_EQ(change.removed, std::vector<std::uint32_t>{id});
+  EXPECT_EQ(d.find(id), nullptr);
+  EXPECT_TRUE(d.channels().empty());
+  change = d.update({{"oscar/cue/sig/out", writer("oscar::Bool")}});
+  ASSERT_EQ(change.added.size(), 1u);
+  EXPECT_EQ(change.added[0].id, id) << "same topic and type: the same channel id";
+  change = d.update({{"oscar/cue/sig/out", writer("oscar::GvImage")}});
+  EXPECT_EQ(change.removed, std::vector<std::uint32_t>{id});
+  ASSERT_EQ(change.added.size(), 1u);
+  EXPECT_NE(change.added[0].id, id) << "another type: another channel";
+}
+
+}  // namespace
+}  // namespace oscar::bridge
