@@ -85,6 +85,10 @@ TEST(IdentityPolicy, OnlyCoordinatorRegistryAndBootConfigureAndOnlyTheRegistryLa
   EXPECT_THAT(writers_of(all, "oscar/coordinator/plan"),
               ::testing::ElementsAre("module.coordinator"));
   EXPECT_THAT(writers_of(all, "oscar/sched/hello"), ::testing::ElementsAre("module.helpers"));
+  // Jobs and world changes for the swarm: the coordinator's and other applets, and the operator
+  // acting with boot's authority (`oscar swarm submit`); not boot itself.
+  EXPECT_THAT(writers_of(all, "oscar/swarm/request"),
+              ::testing::ElementsAre("operator_boot", "module.coordinator", "module.helpers"));
 }
 
 TEST(IdentityPolicy, TheOperatorOnlyReads) {
