@@ -84,7 +84,7 @@ HostSpec parse_host(const std::string& name, const YAML::Node& node, const std::
   // Without an address the remote host's processes would use loopback and never meet the rest.
   if (h.kind == HostSpec::Kind::kSsh && h.address.empty()) {
     fail(h.where, fmt::format("{}: an ssh host needs address: (the IPv4 address DDS uses "
-                              "there, e.g. {{ssh: {}, address: 192.168.1.12}})",
+                              "there: {{ssh: {}, address: <that host's IPv4 address>}})",
                               what, h.ssh));
   }
   return h;

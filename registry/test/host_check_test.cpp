@@ -24,7 +24,7 @@ HostSpec robot() {
   h.name = "robot";
   h.kind = HostSpec::Kind::kSsh;
   h.ssh = "oscar@robot";
-  h.address = "10.0.0.2";
+  h.address = "10.77.0.2";
   return h;
 }
 
@@ -35,7 +35,7 @@ std::string explain(int exit_code, const std::string& output) {
 
 TEST(HostCheck, AHostThatAnswersWithTheSameVersionAndNoProblemIsReady) {
   EXPECT_EQ(explain(0, check_banner() + "\n"), "ready");
-  EXPECT_EQ(explain(0, "Warning: Permanently added '[10.0.0.2]:22' (ED25519)\n" + check_banner()),
+  EXPECT_EQ(explain(0, "Warning: Permanently added '[10.77.0.2]:22' (ED25519)\n" + check_banner()),
             "ready");
 }
 
@@ -103,7 +103,7 @@ class ThisHost : public testing::Test {
 };
 
 constexpr const char* kSystem = R"(
-hosts: { here: { local: true }, robot: { ssh: oscar@robot, address: 10.0.0.2 } }
+hosts: { here: { local: true }, robot: { ssh: oscar@robot, address: 10.77.0.2 } }
 modules:
   - { name: a, host: robot, kernels: [ { type: relay, params: { type: Bool } } ] }
   - { name: b, host: here, kernels: [ { type: no_such_kernel } ] }

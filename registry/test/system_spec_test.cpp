@@ -189,13 +189,13 @@ TEST(SystemSpec, BadPolicyValuesAreErrors) {
 TEST(SystemSpec, AnSshHostNeedsAnAddressAndTakesSshOptions) {
   EXPECT_THAT(error_of("hosts: { a: { local: true }, b: { ssh: u@b } }\nmodules: []"),
               HasSubstr("hosts.b: an ssh host needs address:"));
-  EXPECT_THAT(error_of("hosts: { b: { ssh: u@b, address: 10.0.0.2, ssh_options: [Port 22] } }\n"
+  EXPECT_THAT(error_of("hosts: { b: { ssh: u@b, address: 10.77.0.2, ssh_options: [Port 22] } }\n"
                        "modules: []"),
               HasSubstr("hosts.b.ssh_options 'Port 22': expected Key=Value"));
   EXPECT_THAT(error_of("hosts: { b: { netns: b, ssh_options: [Port=22] } }\nmodules: []"),
               HasSubstr("hosts.b: ssh_options go with ssh"));
   const auto s = parse(
-      "hosts: { a: { local: true }, b: { ssh: u@b, address: 10.0.0.2, ssh_options: [Port=2222, "
+      "hosts: { a: { local: true }, b: { ssh: u@b, address: 10.77.0.2, ssh_options: [Port=2222, "
       "IdentityFile=~/.ssh/robot] } }\nmodules: [ { name: m, host: b, kernels: [ { type: relay } "
       "] } ]");
   EXPECT_EQ(s.host("b").ssh_options,
