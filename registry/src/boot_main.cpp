@@ -319,6 +319,7 @@ int main(int argc, char** argv) {
       return s && s->state() == state;
     };
     bool registry_gone = false;
+    bool registry_ended_orderly = false;  // exit code 0, asked by someone other than boot
     const auto registry_exited = [&] {
       for (const auto& x : children.reap()) {
         // Code 0 is an orderly end (oscar shutdown, SIGTERM), also when its 'stopped' state
@@ -326,7 +327,10 @@ int main(int argc, char** argv) {
         if (x.exit_code != 0) {
           log.note("boot", fmt::format("{} {}", x.module, x.describe()), oscar::LOG_ERROR);
         }
-        registry_gone = registry_gone || x.module == "registry";
+        if (x.module == "registry") {
+          registry_gone = true;
+          registry_ended_orderly = x.exit_code == 0;
+        }
       }
       return registry_gone;
     };
@@ -356,7 +360,9 @@ int main(int argc, char** argv) {
                  stop, log);
     }
     const int stops_before = stop.count();
-    if (state_is("stopped")) {
+    // The registry may exit before its 'stopped' state reaches boot; boot asked it for nothing,
+    // so an orderly exit was asked from elsewhere.
+    if (state_is("stopped") || (registry_gone && registry_ended_orderly && stop.count() == 0)) {
       log.note("boot", "the system was shut down (oscar shutdown)");
     } else if (!registry_gone) {
       // SIGTERM asks the registry for what `oscar shutdown` asks: stop the modules in reverse
