@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "boost_geometry.hpp"
 #include "oscar/swarm/scheduler.hpp"
 #include "oscar/swarm/trajectory_planner.hpp"
 #include "scheduler_state.hpp"
@@ -133,9 +134,13 @@ bool Scheduler::try_schedule(const JobSpec& spec, TransactionId tx, const std::o
                          t_max, t_fh);
     return false;
   }
-  const auto locations =
+  auto locations =
       at ? std::vector<Point>{*at}
          : sample_locations(spec.area, world_.static_obstacles, settings_.location_samples);
+  if (!at) {
+    const auto parked = parked_in(spec.area);
+    locations.insert(locations.end(), parked.begin(), parked.end());
+  }
   bool any_location = false;
   bool any_slot = false;
   for (const auto& p : locations) {
@@ -163,6 +168,22 @@ bool Scheduler::try_schedule(const JobSpec& spec, TransactionId tx, const std::o
         fmt::format("job '{}': no collision-free trajectory for any location and slot", spec.id);
   }
   return false;
+}
+
+std::vector<Point> Scheduler::parked_in(const Polygon& area) const {
+  std::vector<Point> places;
+  for (const auto& node : nodes_) {
+    if (node->broken || node->working.points().empty()) continue;
+    const auto& last = node->working.points().back();
+    const Point p(last.x, last.y);
+    if (!boost::geometry::covered_by(p, area)) continue;
+    if (std::any_of(world_.static_obstacles.begin(), world_.static_obstacles.end(),
+                    [&](const Polygon& o) { return boost::geometry::covered_by(p, o); })) {
+      continue;
+    }
+    places.push_back(p);
+  }
+  return places;
 }
 
 std::vector<Slot> Scheduler::qualifying_slots(const JobSpec& spec, const Point& p,

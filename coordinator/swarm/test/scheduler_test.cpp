@@ -109,6 +109,23 @@ TEST(Scheduler, InfeasibleJobIsAValueWithAReason) {
   EXPECT_EQ(none.reason, "job 'J2': no node is in planning");
 }
 
+// Two robots stand in a 1 m square, 0.35 m either side of its one sample (its middle): each
+// blocks the sample for the other. The robot standing in the area does the job where it stands.
+TEST(Scheduler, ARobotParkedInTheAreaDoesTheJobWhereItStandsWhenTheSamplesAreBlocked) {
+  Scheduler s({}, {.present = 0, .frozen_horizon = 1, .location_samples = 1});
+  s.add_node({"a", 0.3, 1, 0.15, 0.5, 0, 0});
+  s.add_node({"b", 0.3, 1, 0.85, 0.5, 0, 0});
+  s.add_node({"far", 0.3, 1, 10, 10, 0, 0});
+  const auto r = s.schedule(job("J", square(0, 0, 1, 1), 2, 30, 3));
+  ASSERT_TRUE(r.ok) << r.reason;
+  ASSERT_EQ(r.jobs.size(), 1u);
+  const auto& done = r.jobs.front();
+  EXPECT_TRUE(done.node == "a" || done.node == "b") << done.node;
+  const auto& stand = s.node(done.node);
+  EXPECT_DOUBLE_EQ(done.x, stand.x);
+  EXPECT_DOUBLE_EQ(done.y, stand.y);
+}
+
 TEST(Scheduler, UnscheduleReplansTheTrajectoryAroundTheGap) {
   Scheduler s = worked_example();
   const auto r = s.schedule(job("J1", square(4, 2, 6, 4), 10, 60, 10));
