@@ -22,8 +22,10 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 
 #include "keystore.hpp"
+#include "keystore_layout.hpp"
 #include "oscar/configPubSubTypes.h"
 #include "oscar/security_files.hpp"
+#include "pki.hpp"
 #include "process.hpp"  // tests/common: test_domain()
 
 // Fast DDS's security plugins keep OpenSSL objects to the end of the process. Debian's libcrypto
@@ -167,6 +169,22 @@ class SecureParticipants : public ::testing::Test {
                                                   const char* keystore = "keystore") {
     return security_files::dds_security_properties(root_ / keystore, identity);
   }
+  // A keystore `name` holding only module.listener's identity folder (its files copied), with
+  // its certificate issued again by the first keystore's identity CA, valid until `validity`
+  // from now (negative: expired).
+  static void reissue_listener(const std::string& name, std::chrono::hours validity) {
+    const auto from = root_ / "keystore";
+    const auto folder = root_ / name / "identities" / "module.listener";
+    fs::remove_all(root_ / name);
+    fs::create_directories(folder.parent_path());
+    fs::copy(from / "identities" / "module.listener", folder, fs::copy_options::recursive);
+    const auto ca = pki::read_cert(layout::ca_cert_file(from, layout::kIdentityCaName));
+    const auto ca_key = pki::read_key(layout::ca_key_file(from, layout::kIdentityCaName));
+    const auto key = pki::read_key(folder / "key.pem");
+    const auto cert = pki::issue(*key, "module.listener", ca.get(), *ca_key, validity, false);
+    fs::remove(folder / "cert.pem");
+    pki::write_cert(folder / "cert.pem", *cert);
+  }
   static void send(dds::DataWriter& writer, const std::string& message) {
     LogRecord record;
     record.message(message);
@@ -244,6 +262,34 @@ TEST_F(SecureParticipants, AParticipantOfAnotherCaOrWithoutSecurityNeverMatches)
   EXPECT_EQ(status.current_count, 1) << "a reader other than the genuine one matched";
   EXPECT_EQ(first_message(*impostor_reader, 500ms), "") << "a foreign CA's identity got data";
   EXPECT_EQ(first_message(*plain_reader, 500ms), "") << "an unauthenticated reader got data";
+}
+
+// The listener's certificate issued again by the same CA: valid for another hour, the copied
+// identity matches and receives (the copy is sound); expired an hour ago, it receives nothing,
+// whether Fast DDS refuses it when the participant is made or in the handshake.
+TEST_F(SecureParticipants, AnExpiredCertificateIsRefused) {
+  reissue_listener("renewed", std::chrono::hours(1));
+  reissue_listener("expired", std::chrono::hours(-1));
+  Participant talker(0, as("module.talker"));
+  ASSERT_TRUE(talker.ok());
+  auto* writer = talker.writer(kCueTopic);
+  ASSERT_NE(writer, nullptr);
+  {
+    Participant renewed(1, as("module.listener", "renewed"));
+    ASSERT_TRUE(renewed.ok()) << "Fast DDS refused a valid re-issued certificate";
+    auto* reader = renewed.reader(kCueTopic);
+    ASSERT_NE(reader, nullptr);
+    ASSERT_TRUE(matched_within(*writer, 15s)) << "the renewed identity did not match";
+    send(*writer, "for the renewed listener");
+    EXPECT_EQ(first_message(*reader, 10s), "for the renewed listener");
+  }
+  Participant expired(2, as("module.listener", "expired"));
+  if (!expired.ok()) return;  // refused when the participant was made
+  auto* reader = expired.reader(kCueTopic);
+  ASSERT_NE(reader, nullptr);
+  std::this_thread::sleep_for(3s);
+  send(*writer, "for nobody expired");
+  EXPECT_EQ(first_message(*reader, 1s), "") << "an expired certificate's participant got data";
 }
 
 }  // namespace
