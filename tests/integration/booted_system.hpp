@@ -61,6 +61,18 @@ class BootedSystem : public testing::SystemUnderTest {
   }
 };
 
+/// A keystore for the system `yaml` in `keystore`, made by `oscar security init` (each test makes
+/// its own: nothing secret is committed).
+inline void make_keystore(const std::string& name, const std::string& yaml,
+                          const std::filesystem::path& keystore) {
+  const auto file = temp_path(name + "_keys") + ".yaml";
+  std::ofstream(file) << yaml;
+  Process init({bin("oscar-security"), "init", file, "--keystore", keystore.string()},
+               temp_path(name + "_keys.log"));
+  ASSERT_EQ(init.wait(std::chrono::seconds(60)), 0) << init.output();
+  std::filesystem::remove(file);
+}
+
 inline const ModuleEntry* entry(const SystemState& s, const std::string& module) {
   for (const auto& m : s.modules()) {
     if (m.name() == module) return &m;

@@ -277,5 +277,51 @@ mode: { continuous: 50ms }
   std::filesystem::remove(file);
 }
 
+// The application with every process authenticated (docs/security.md, "Secure boot"):
+// CobraControl in the coordinator still triggers the cameras (its commands pass the
+// permissions), and the read-only operator identity reads correct poses.
+TEST(Landmarks, RunSecuredWithEveryProcessAuthenticated) {
+  const auto yaml = landmark_system("landmarks-1host.yaml");
+  const auto keystore = test::temp_path("landmarks_keystore");
+  std::filesystem::remove_all(keystore);
+  test::make_keystore("landmarks_secured", yaml, keystore);
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  {
+    testing::BootOptions options;
+    options.keystore = keystore;
+    test::BootedSystem sys("landmarks_secured", yaml, options);
+    sys.running();
+    NetworkConfig as_operator;
+    as_operator.security = ParticipantSecurity{keystore, "operator"};
+    DdsParticipant p(sys.domain(), "test:landmarks", as_operator);
+    Watch<LandmarkPose> poses;
+    TopicReader<LandmarkPose, LandmarkPosePubSubType> pose_reader(
+        p, "oscar/cue/pose/pose", watch_qos(), [&](const LandmarkPose& c, const auto&) {
+          std::lock_guard lock(poses.mutex);
+          poses.cues.push_back(c);
+        });
+    std::vector<LandmarkPose> got;
+    EXPECT_TRUE(eventually(
+        [&] {
+          for (auto& c : poses.take()) got.push_back(std::move(c));
+          return got.size() >= 5;
+        },
+        30s))
+        << "poses: " << got.size() << "\n"
+        << sys.boot_output();
+    for (const auto& c : got) {
+      EXPECT_TRUE(c.valid());
+      EXPECT_EQ(c.estimates(), 2u);
+      const Eigen::Vector3d t(c.pose().t()[0], c.pose().t()[1], c.pose().t()[2]);
+      const Eigen::Vector3d truth(c.truth().target().t()[0], c.truth().target().t()[1],
+                                  c.truth().target().t()[2]);
+      EXPECT_LT((t - truth).norm(), 0.01);  // 1 cm
+    }
+    EXPECT_THAT(sys.boot_output(), ::testing::HasSubstr("secured with keystore"));
+    EXPECT_EQ(sys.shut_down(), 0) << sys.boot_output();
+  }
+  std::filesystem::remove_all(keystore);
+}
+
 }  // namespace
 }  // namespace oscar

@@ -51,16 +51,6 @@ modules:
 )";
 }
 
-// Runs `oscar security init` on the system `yaml` into `keystore`.
-void init_keystore(const std::string& name, const std::string& yaml, const fs::path& keystore) {
-  const auto file = test::temp_path(name + "_keys") + ".yaml";
-  std::ofstream(file) << yaml;
-  test::Process init({test::bin("oscar-security"), "init", file, "--keystore", keystore.string()},
-                     test::temp_path(name + "_keys.log"));
-  ASSERT_EQ(init.wait(60s), 0) << init.output();
-  fs::remove(file);
-}
-
 NetworkConfig as(const fs::path& keystore, const std::string& identity) {
   NetworkConfig network;
   network.security = ParticipantSecurity{keystore.string(), identity};
@@ -78,7 +68,7 @@ class SecureSystem : public ::testing::Test {
   void SetUp() override {
     keystore_ = test::temp_path("secure_keystore");
     fs::remove_all(keystore_);
-    init_keystore("secure", secured_system(), keystore_);
+    test::make_keystore("secure", secured_system(), keystore_);
     if (HasFatalFailure()) return;
     testing::BootOptions options;
     options.keystore = keystore_.string();
@@ -148,7 +138,7 @@ TEST_F(SecureSystem, AParticipantWithoutCredentialsSeesNothingAndReachesNothing)
 TEST_F(SecureSystem, AParticipantOfAnotherCaIsNotAuthenticated) {
   const auto foreign = test::temp_path("secure_foreign_keystore");
   fs::remove_all(foreign);
-  init_keystore("foreign", secured_system(), foreign);
+  test::make_keystore("foreign", secured_system(), foreign);
   {
     DdsParticipant stranger(system_->domain(), "stranger", as(foreign, "operator_boot"));
     testing::CueWatch<Bool> cues(stranger, "signal/out");
