@@ -38,7 +38,7 @@ const char* const kUsage =
     "  security init|check|list SYSTEM.yaml\n"
     "                        the system's DDS Security keystore (--keystore DIR)\n"
     "  bench <what> ...      benchmarks: cueflow, restart, applets, swarm, record, replay,\n"
-    "                        landmarks, stalls\n"
+    "                        landmarks, bridge, stalls\n"
     "\n"
     "`oscar <command> --help` shows a command's options.\n";
 
@@ -60,7 +60,8 @@ int main(int argc, char** argv) {
   if (program == "oscar-bench") {
     if (argc < 3) {
       std::fputs(
-          "usage: oscar bench <cueflow|restart|applets|swarm|record|replay|landmarks|stalls> "
+          "usage: oscar bench "
+          "<cueflow|restart|applets|swarm|record|replay|landmarks|bridge|stalls> "
           "[args...]\n",
           stderr);
       return 2;

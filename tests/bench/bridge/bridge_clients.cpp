@@ -1,0 +1,102 @@
+#include "bridge_clients.hpp"
+
+#include <sys/socket.h>
+#include <sys/time.h>
+
+#include <cstring>
+
+#include <boost/asio/connect.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/websocket.hpp>
+#include <nlohmann/json.hpp>
+
+namespace oscar::bench {
+namespace {
+
+namespace beast = boost::beast;
+namespace websocket = beast::websocket;
+using tcp = boost::asio::ip::tcp;
+
+constexpr std::size_t kEncapsulation = 4;  // CDR_LE: 00 01 00 00
+constexpr std::size_t kFrameHeader = 13;   // opcode, subscription id (u32), receive time (u64)
+constexpr int kReceiveTimeoutS = 5;        // a read that waits longer ends the client
+
+template <class T>
+T little_endian(const std::uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);  // x86-64 is little-endian, as the bridge writes
+  return v;
+}
+
+// The id of the channel advertised for `topic` in an "advertise" message, or -1.
+long channel_of(const std::string& text, const std::string& topic) {
+  const auto j = nlohmann::json::parse(text, nullptr, false);
+  if (!j.is_object() || j.value("op", "") != "advertise") return -1;
+  for (const auto& c : j["channels"]) {
+    if (c.value("topic", "") == topic) return c["id"].get<long>();
+  }
+  return -1;
+}
+
+}  // namespace
+
+std::uint64_t first_stamp(const std::uint8_t* cdr, std::size_t size) {
+  // After the encapsulation: the sequence's length (u32), then its first u64 aligned to 8.
+  if (size < kEncapsulation + 16 || cdr[0] != 0 || cdr[1] != 1) return 0;
+  const auto* body = cdr + kEncapsulation;
+  if (little_endian<std::uint32_t>(body) == 0) return 0;
+  return little_endian<std::uint64_t>(body + 8);
+}
+
+ClientResult run_client(int port, const std::string& topic,
+                        std::chrono::steady_clock::time_point measure_from,
+                        const std::atomic<bool>& stop) {
+  ClientResult result;
+  try {
+    boost::asio::io_context io;
+    websocket::stream<tcp::socket> ws(io);
+    ws.next_layer().connect(
+        {boost::asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port)});
+    const timeval timeout{kReceiveTimeoutS, 0};
+    setsockopt(ws.next_layer().native_handle(), SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
+    ws.set_option(websocket::stream_base::decorator([](websocket::request_type& request) {
+      request.set(beast::http::field::sec_websocket_protocol, "foxglove.websocket.v1");
+    }));
+    ws.handshake("127.0.0.1:" + std::to_string(port), "/");
+    bool subscribed = false;
+    beast::flat_buffer buffer;
+    while (!stop) {
+      buffer.clear();
+      ws.read(buffer);
+      const auto* data = static_cast<const std::uint8_t*>(buffer.data().data());
+      const auto size = buffer.size();
+      if (ws.got_text()) {
+        const auto channel =
+            subscribed ? -1 : channel_of(beast::buffers_to_string(buffer.data()), topic);
+        if (channel >= 0) {
+          ws.text(true);
+          ws.write(boost::asio::buffer(nlohmann::json{
+              {"op", "subscribe"}, {"subscriptions", {{{"id", 1}, {"channelId", channel}}}}}
+                                           .dump()));
+          subscribed = true;
+        }
+        continue;
+      }
+      const auto now = std::chrono::system_clock::now();
+      if (size <= kFrameHeader || data[0] != 0x01) continue;
+      const auto stamp = first_stamp(data + kFrameHeader, size - kFrameHeader);
+      if (stamp == 0 || std::chrono::steady_clock::now() < measure_from) continue;
+      const auto arrival =
+          std::chrono::duration_cast<std::chrono::nanoseconds>(now.time_since_epoch()).count();
+      result.delays_us.push_back(static_cast<double>(arrival - static_cast<long long>(stamp)) /
+                                 1e3);
+    }
+    ws.close(websocket::close_code::normal);
+  } catch (const std::exception& e) {
+    if (!stop) result.error = e.what();
+  }
+  return result;
+}
+
+}  // namespace oscar::bench

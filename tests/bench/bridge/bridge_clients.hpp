@@ -1,0 +1,31 @@
+#pragma once
+// Foxglove WebSocket clients for `oscar bench bridge`: each connects to the bridge with the
+// protocol's subprotocol, subscribes to one topic's channel once it is advertised, and takes
+// the delay of every message it is delivered: its arrival (system clock) minus the cue's first
+// stamp (when its producer made it), read from the CDR payload.
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace oscar::bench {
+
+/// The first stamp of a cue's header (header.stamps[0], ns since the Unix epoch) in the CDR of a
+/// cue whose first member is its header (`sequence<unsigned long long> stamps` first), or 0 if
+/// the bytes are not little-endian plain CDR with at least one stamp.
+std::uint64_t first_stamp(const std::uint8_t* cdr, std::size_t size);
+
+struct ClientResult {
+  std::vector<double> delays_us;  ///< one per message, arrival minus the cue's first stamp
+  std::string error;              ///< why the client stopped early, or ""
+};
+
+/// Connects to ws://127.0.0.1:`port`, subscribes to `topic` and records delays until `stop`;
+/// messages before `measure_from` (steady clock) are not counted (the warm-up).
+ClientResult run_client(int port, const std::string& topic,
+                        std::chrono::steady_clock::time_point measure_from,
+                        const std::atomic<bool>& stop);
+
+}  // namespace oscar::bench
