@@ -264,7 +264,8 @@ int main(int argc, char** argv) {
   app.add_option("--types", types, "rows to run")->delimiter(',');
   app.add_option("--constellations", constellations,
                  "multicore, local, remote (two test hosts in network namespaces; root)")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->check(CLI::IsMember({"multicore", "local", "remote"}));
   oscar::bench::UdpSettings udp;
   app.add_option("--udp-buffer-bytes", udp.buffer_bytes,
                  "remote: UDP socket buffers of both sides (default OSCAR's 4 MiB; 0: the "
