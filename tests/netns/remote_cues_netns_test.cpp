@@ -1,10 +1,12 @@
 // Cues between two test hosts over UDP (issue 21 item 2, the remote constellation of `oscar bench
-// cueflow`): a producer on host 1 sends a few hundred 768x576 images and 100-line LineSeg3DSeqs
-// to a consumer on host 2, with shared memory off, so every byte crosses the veth between the
+// cueflow`): a producer on host 1 sends a few hundred 768x576 images, 100-line LineSeg3DSeqs and
+// Bools to a consumer on host 2, with shared memory off, so every byte crosses the veth between the
 // namespaces. The consumer checks that the sequence numbers have no gap or duplicate and that
 // each payload's checksum is the producer's. Root only; skipped otherwise.
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -43,32 +45,29 @@ TEST(RemoteCues, ArriveCompleteAndUncorruptedOverUdpBetweenTwoHosts) {
   test::TestHosts hosts(2);
   // Domains 141-149 are this test family's; the hosts' own network hears no one else anyway.
   const auto domain = std::to_string(141 + getpid() % 9);
-  const auto image_report = test::temp_path("remote_cues_image") + ".json";
-  const auto lines_report = test::temp_path("remote_cues_lines") + ".json";
-  std::filesystem::remove(image_report);
-  std::filesystem::remove(lines_report);
+  // One source and one checking sink per type, side by side in one module on each host.
+  const std::pair<std::string, std::string> kinds[] = {
+      {"image", "GvImage"}, {"lines", "LineSeg3DSeq"}, {"flag", "Bool"}};
+  std::string sinks, sources;
+  std::map<std::string, std::string> reports;  // by type
+  for (const auto& [name, type] : kinds) {
+    reports[type] = test::temp_path("remote_cues_" + name) + ".json";
+    std::filesystem::remove(reports[type]);
+    sinks += fmt::format(
+        "  - {{ type: bench_sink, name: {}_sink, inputs: {{ in: {}/out }},\n"
+        "      params: {{ type: {}, verify: true, expect: {}, report: '{}' }} }}\n",
+        name, name, type, kCues, reports[type]);
+    sources +=
+        fmt::format("  - {{ type: bench_source, name: {}, params: {{ type: {}, count: {} }} }}\n",
+                    name, type, kCues);
+  }
   const auto sink_file = test::temp_path("remote_cues_sink") + ".yaml";
   const auto source_file = test::temp_path("remote_cues_src") + ".yaml";
   std::ofstream(sink_file) << fmt::format(
-      R"(name: sink
-network: {}
-mode: single_step
-kernels:
-  - {{ type: bench_sink, name: image_sink, inputs: {{ in: image/out }},
-      params: {{ type: GvImage, verify: true, expect: {}, report: '{}' }} }}
-  - {{ type: bench_sink, name: lines_sink, inputs: {{ in: lines/out }},
-      params: {{ type: LineSeg3DSeq, verify: true, expect: {}, report: '{}' }} }}
-)",
-      network(hosts, 2), kCues, image_report, kCues, lines_report);
+      "name: sink\nnetwork: {}\nmode: single_step\nkernels:\n{}", network(hosts, 2), sinks);
   std::ofstream(source_file) << fmt::format(
-      R"(name: src
-network: {}
-mode: {{ continuous: 20ms }}
-kernels:
-  - {{ type: bench_source, name: image, params: {{ type: GvImage, count: {} }} }}
-  - {{ type: bench_source, name: lines, params: {{ type: LineSeg3DSeq, count: {} }} }}
-)",
-      network(hosts, 1), kCues, kCues);
+      "name: src\nnetwork: {}\nmode: {{ continuous: 20ms }}\nkernels:\n{}", network(hosts, 1),
+      sources);
 
   const auto before = received_bytes(hosts, 2);
   auto argv = hosts.on(2);
@@ -81,8 +80,11 @@ kernels:
   // 300 cues at 20 ms: 6 s. A sink that missed the first cues (sent before the writer matched
   // it) never counts 300: it reports what it has when stopped, twice that time later.
   const auto until = std::chrono::steady_clock::now() + 2 * kCues * 20ms + 3s;
-  while (!(std::filesystem::exists(image_report) && std::filesystem::exists(lines_report)) &&
-         std::chrono::steady_clock::now() < until) {
+  const auto all_reported = [&] {
+    return std::all_of(reports.begin(), reports.end(),
+                       [](const auto& r) { return std::filesystem::exists(r.second); });
+  };
+  while (!all_reported() && std::chrono::steady_clock::now() < until) {
     std::this_thread::sleep_for(100ms);
   }
   std::this_thread::sleep_for(500ms);  // a duplicate after the last cue would be counted
@@ -90,8 +92,7 @@ kernels:
   source.stop();
   const auto crossed = received_bytes(hosts, 2) - before;
 
-  for (const auto& [file, type] :
-       {std::pair{image_report, "GvImage"}, {lines_report, "LineSeg3DSeq"}}) {
+  for (const auto& [type, file] : reports) {
     SCOPED_TRACE(type);
     std::ifstream in(file);
     ASSERT_TRUE(in) << "no report; sink:\n" << sink.output() << "\nsource:\n" << source.output();
