@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <fstream>
+#include <map>
 
 #include <fmt/format.h>
 #include <oscar/kernel_registry.hpp>
+
+#include "bench_pattern.hpp"  // modules/bench_source
 
 namespace oscar::modules {
 
@@ -14,18 +17,20 @@ void BenchSink::Params::describe(ParamSpec& spec) {
   spec.field("expect", expect, "write the report after this many cues; 0 = at the end").at_least(0);
   spec.field("warmup", warmup, "cues left out of the latency figures").at_least(0);
   spec.field("log_every", log_every, "log a progress line this often; 0s = never");
+  spec.field("verify", verify, "check each payload's checksum against bench_source's pattern");
 }
 
 struct BenchSink::Ports {
   virtual ~Ports() = default;
-  virtual void consume(Cycle& cycle, Stats& stats, std::int64_t warmup) = 0;
+  virtual void consume(Cycle& cycle, Stats& stats, const Params& params) = 0;
 };
 
 namespace {
 template <class T>
 struct TypedPorts final : BenchSink::Ports {
   explicit TypedPorts(KernelSetup& setup) : in(setup.input<T>("in", {.depth = 16})) {}
-  void consume(Cycle& cycle, BenchSink::Stats& s, std::int64_t warmup) override {
+  void consume(Cycle& cycle, BenchSink::Stats& s, const BenchSink::Params& params) override {
+    const auto warmup = params.warmup;
     for (const auto& r : in.take_new()) {
       const auto& h = r.cue->header();
       if (s.received > 0 && h.seq() <= s.last_seq) {
@@ -33,8 +38,13 @@ struct TypedPorts final : BenchSink::Ports {
         continue;
       }
       if (s.received > 0 && h.seq() > s.last_seq + 1) s.gaps += h.seq() - s.last_seq - 1;
+      if (s.received == 0) s.first_seq = h.seq();
       s.last_seq = h.seq();
       ++s.received;
+      if (params.verify) {
+        ++s.verified;
+        s.corrupt += bench_pattern::checksum(*r.cue) != expected(*r.cue);
+      }
       const auto n = h.stamps().size();
       s.stamps_min = s.received == 1 ? n : std::min<std::uint64_t>(s.stamps_min, n);
       s.stamps_max = std::max<std::uint64_t>(s.stamps_max, n);
@@ -44,7 +54,20 @@ struct TypedPorts final : BenchSink::Ports {
       s.process_ns.push_back(cycle.now() - generated);
     }
   }
+  // bench_source's checksum for the shape of `cue`, computed once per shape.
+  std::uint64_t expected(const T& cue) {
+    std::uint64_t shape = 0;
+    if constexpr (std::is_same_v<T, LineSeg3DSeq>) shape = cue.lines().size();
+    if constexpr (std::is_same_v<T, GvImage>) {
+      shape =
+          static_cast<std::uint16_t>(cue.dx()) * 65536ull + static_cast<std::uint16_t>(cue.dy());
+    }
+    const auto [it, added] = expected_by_shape.try_emplace(shape, 0);
+    if (added) it->second = bench_pattern::expected_checksum(cue);
+    return it->second;
+  }
   Input<T>& in;
+  std::map<std::uint64_t, std::uint64_t> expected_by_shape;
 };
 
 struct Percentiles {
@@ -71,7 +94,7 @@ BenchSink::BenchSink(KernelSetup& setup) {
 BenchSink::~BenchSink() = default;
 
 void BenchSink::process(Cycle& cycle) {
-  ports_->consume(cycle, stats_, params_.warmup);
+  ports_->consume(cycle, stats_, params_);
   if (params_.log_every.count() > 0 && cycle.now() - last_log_ >= params_.log_every.count()) {
     if (last_log_ != 0) {
       const double seconds = static_cast<double>(cycle.now() - last_log_) / 1e9;
@@ -80,10 +103,11 @@ void BenchSink::process(Cycle& cycle) {
               static_cast<std::ptrdiff_t>(std::min<std::size_t>(
                   stats_.delivery_ns.size(), stats_.received - received_at_last_log_)),
           stats_.delivery_ns.end());
-      cycle.log().info("{}: {} cues ({:.1f} Hz), last seq {}, gaps {}, latency p50 {:.0f} us, {} stamps",
-                       params_.type, stats_.received,
-                       static_cast<double>(stats_.received - received_at_last_log_) / seconds,
-                       stats_.last_seq, stats_.gaps, percentiles_us(recent).p50, stats_.stamps_max);
+      cycle.log().info(
+          "{}: {} cues ({:.1f} Hz), last seq {}, gaps {}, latency p50 {:.0f} us, {} stamps",
+          params_.type, stats_.received,
+          static_cast<double>(stats_.received - received_at_last_log_) / seconds, stats_.last_seq,
+          stats_.gaps, percentiles_us(recent).p50, stats_.stamps_max);
     }
     last_log_ = cycle.now();
     received_at_last_log_ = stats_.received;
@@ -106,12 +130,13 @@ std::string BenchSink::report() const {
   const auto d = percentiles_us(stats_.delivery_ns);
   const auto p = percentiles_us(stats_.process_ns);
   return fmt::format(
-      R"({{"type":"{}","received":{},"gaps":{},"duplicates":{},"last_seq":{},"stamps_min":{},)"
+      R"({{"type":"{}","received":{},"gaps":{},"duplicates":{},"first_seq":{},"last_seq":{},)"
+      R"("verified":{},"corrupt":{},"stamps_min":{},)"
       R"("stamps_max":{},"samples":{},"delivery_us":{{"p50":{:.2f},"p90":{:.2f},"max":{:.2f}}},)"
       R"("process_us":{{"p50":{:.2f},"p90":{:.2f},"max":{:.2f}}}}})",
-      params_.type, stats_.received, stats_.gaps, stats_.duplicates, stats_.last_seq,
-      stats_.stamps_min, stats_.stamps_max, stats_.delivery_ns.size(), d.p50, d.p90, d.max, p.p50,
-      p.p90, p.max);
+      params_.type, stats_.received, stats_.gaps, stats_.duplicates, stats_.first_seq,
+      stats_.last_seq, stats_.verified, stats_.corrupt, stats_.stamps_min, stats_.stamps_max,
+      stats_.delivery_ns.size(), d.p50, d.p90, d.max, p.p50, p.p90, p.max);
 }
 
 void BenchSink::write_report() const {

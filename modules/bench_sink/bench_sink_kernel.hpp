@@ -11,10 +11,11 @@
 
 namespace oscar::modules {
 
-/// Consumes benchmark cues: counts them, counts sequence gaps and duplicates, and measures the
-/// one-way latency from the header's first stamp to the cue's arrival at the input (delivery)
-/// and to the start of the cycle that processes it. Writes a JSON report when `expect` cues
-/// have arrived and when deactivated.
+/// Consumes benchmark cues: counts them, counts sequence gaps and duplicates, with `verify`
+/// counts cues whose payload is not bench_source's (by checksum), and measures the one-way latency
+/// from the header's first stamp to the cue's arrival at the input (delivery) and to the start of
+/// the cycle that processes it. Writes a JSON report when `expect` cues have arrived and when
+/// deactivated.
 class BenchSink final : public Kernel {
  public:
   struct Params {
@@ -23,10 +24,12 @@ class BenchSink final : public Kernel {
     std::int64_t expect = 0;  ///< write the report once this many cues arrived; 0 = at the end
     std::int64_t warmup = 0;  ///< cues to leave out of the latency figures
     std::chrono::nanoseconds log_every{0};  ///< log a progress line this often; 0 = never
+    bool verify = false;  ///< check each payload's checksum against bench_source's pattern
     void describe(ParamSpec& spec);
   };
   struct Stats {
-    std::uint64_t received = 0, gaps = 0, duplicates = 0, last_seq = 0;
+    std::uint64_t received = 0, gaps = 0, duplicates = 0, first_seq = 0, last_seq = 0;
+    std::uint64_t verified = 0, corrupt = 0;  ///< payloads checked; of those, not as sent
     std::vector<std::int64_t> delivery_ns, process_ns;
     std::uint64_t stamps_min = 0, stamps_max = 0;  ///< header stamp count (fusion depth)
   };

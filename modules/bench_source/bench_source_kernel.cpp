@@ -2,6 +2,8 @@
 
 #include <oscar/kernel_registry.hpp>
 
+#include "bench_pattern.hpp"
+
 namespace oscar::modules {
 
 void BenchSource::Params::describe(ParamSpec& spec) {
@@ -25,34 +27,6 @@ struct TypedPorts final : BenchSource::Ports {
   Output<T>& out;
   T prototype;
 };
-
-LineSeg3DSeq make_lines(int n) {
-  LineSeg3DSeq cue;
-  for (int i = 0; i < n; ++i) {
-    LineSeg3D l;
-    l.sx(i);
-    l.sy(0.5 * i);
-    l.sz(1.0);
-    l.ex(i + 1.0);
-    l.ey(0.5 * i);
-    l.ez(1.0);
-    cue.lines().push_back(l);
-  }
-  return cue;
-}
-
-GvImage make_image(int dx, int dy) {
-  GvImage cue;
-  cue.dx(static_cast<std::int16_t>(dx));
-  cue.dy(static_cast<std::int16_t>(dy));
-  cue.image().resize(static_cast<std::size_t>(dx) * static_cast<std::size_t>(dy));
-  for (int y = 0; y < dy; ++y) {
-    for (int x = 0; x < dx; ++x) {
-      cue.image()[static_cast<std::size_t>(y) * dx + x] = static_cast<std::uint8_t>((x + y) & 0xff);
-    }
-  }
-  return cue;
-}
 }  // namespace
 
 BenchSource::BenchSource(KernelSetup& setup) {
@@ -62,9 +36,10 @@ BenchSource::BenchSource(KernelSetup& setup) {
     b.value(true);
     ports_ = std::make_unique<TypedPorts<Bool>>(setup, b);
   } else if (params_.type == "LineSeg3DSeq") {
-    ports_ = std::make_unique<TypedPorts<LineSeg3DSeq>>(setup, make_lines(params_.lines));
+    ports_ = std::make_unique<TypedPorts<LineSeg3DSeq>>(setup, bench_pattern::lines(params_.lines));
   } else {
-    ports_ = std::make_unique<TypedPorts<GvImage>>(setup, make_image(params_.dx, params_.dy));
+    ports_ =
+        std::make_unique<TypedPorts<GvImage>>(setup, bench_pattern::image(params_.dx, params_.dy));
   }
 }
 

@@ -20,6 +20,7 @@
 #include <fastdds/dds/log/Log.hpp>
 #include "dds/guarded_type.hpp"
 #include "dds/participant_identity.hpp"
+#include "dds/udp_tuning.hpp"
 #include "dds/wire_bounds.hpp"
 #include "oscar/raw_cdr_type.hpp"
 #include "oscar/security_files.hpp"
@@ -79,6 +80,14 @@ dds::DomainParticipantQos participant_qos(const std::string& name, const Network
   transport.use_builtin_transports = false;
   auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
   udp->interfaceWhiteList = net.interfaces;
+  const auto tuning = internal::udp_tuning_from_env();
+  if (tuning.buffer_bytes != 0) {
+    // Room for a 442 KB image in one burst (udp_tuning.hpp); the kernel caps it at
+    // net.core.{w,r}mem_max, which is read-only inside a network namespace.
+    udp->sendBufferSize = tuning.buffer_bytes;
+    udp->receiveBufferSize = tuning.buffer_bytes;
+  }
+  if (tuning.max_message_bytes != 0) udp->maxMessageSize = tuning.max_message_bytes;
   transport.user_transports.push_back(udp);
   if (net.shared_memory) {
     auto shm = std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>();

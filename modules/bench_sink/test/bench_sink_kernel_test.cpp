@@ -1,5 +1,7 @@
 #include "bench_sink_kernel.hpp"
 
+#include "bench_pattern.hpp"  // modules/bench_source
+
 #include <filesystem>
 #include <fstream>
 
@@ -50,6 +52,45 @@ TEST(BenchSink, MeasuresLatencyFromTheFirstStampAndWritesAReport) {
   EXPECT_GE(report["delivery_us"]["p50"].get<double>(), 1000.0);
   EXPECT_GE(report["process_us"]["max"].get<double>(), 3000.0);
   EXPECT_LT(report["process_us"]["max"].get<double>(), 3100.0);
+}
+
+TEST(BenchSink, VerifyCountsImagesWhosePayloadIsNotTheSources) {
+  KernelHarness h("bench_sink", YAML::Load("{type: GvImage, verify: true}"));
+  auto image = bench_pattern::image(64, 48);
+  image.header().seq(1);
+  h.feed("in", image);
+  image.header().seq(2);
+  image.image()[1000] ^= 0x01;  // one bit flipped
+  h.feed("in", image);
+  image.header().seq(3);
+  image.image()[1000] ^= 0x01;
+  image.image().pop_back();  // one byte short
+  h.feed("in", image);
+  h.step();
+  auto& sink = dynamic_cast<BenchSink&>(h.kernel());
+  EXPECT_EQ(sink.stats().verified, 3u);
+  EXPECT_EQ(sink.stats().corrupt, 2u);
+  EXPECT_EQ(sink.stats().first_seq, 1u);
+  EXPECT_THAT(sink.report(), testing::HasSubstr(R"("verified":3,"corrupt":2)"));
+}
+
+TEST(BenchSink, VerifyAcceptsTheSourcesLinesAndBool) {
+  KernelHarness lines("bench_sink", YAML::Load("{type: LineSeg3DSeq, verify: true}"));
+  auto seq = bench_pattern::lines(100);
+  seq.header().seq(1);
+  lines.feed("in", seq);
+  seq.header().seq(2);
+  seq.lines()[99].ez(1.5);
+  lines.feed("in", seq);
+  lines.step();
+  EXPECT_EQ(dynamic_cast<BenchSink&>(lines.kernel()).stats().corrupt, 1u);
+  KernelHarness flag("bench_sink", YAML::Load("{type: Bool, verify: true}"));
+  auto b = numbered(1, 100);
+  b.value(true);
+  flag.feed("in", b);
+  flag.step();
+  EXPECT_EQ(dynamic_cast<BenchSink&>(flag.kernel()).stats().verified, 1u);
+  EXPECT_EQ(dynamic_cast<BenchSink&>(flag.kernel()).stats().corrupt, 0u);
 }
 
 }  // namespace

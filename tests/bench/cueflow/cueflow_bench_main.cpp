@@ -1,6 +1,7 @@
 // oscar bench cueflow: seed 004 Abb. 8 (cue transfer time of Bool, LineSeg3DSeq with 100 lines
-// and a 768x576 GvImage) for the multi-core and local constellations, against raw Fast DDS with
-// the same type, QoS and transport, measured in the same run. Prints a table, or JSON (--json).
+// and a 768x576 GvImage) for the multi-core, local and remote constellations, against raw Fast
+// DDS with the same type, QoS and transport, measured in the same run. Prints a table, or JSON
+// (--json).
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +16,7 @@
 #include <oscar/command_line.hpp>
 
 #include "process.hpp"  // tests/common
+#include "remote_hosts.hpp"
 
 namespace {
 using namespace std::chrono_literals;
@@ -25,11 +27,12 @@ struct Row {
   std::size_t bytes;
   double seed_multicore_us, seed_local_us;
   int period_us;
+  double seed_remote_us;
 };
 const Row kRows[] = {
-    {"Bool", 1, 86, 1736, 2000},
-    {"LineSeg3DSeq", 4800, 254, 5782, 2000},
-    {"GvImage", 442368, 7851, 140157, 10000},
+    {"Bool", 1, 86, 1736, 2000, 1820},
+    {"LineSeg3DSeq", 4800, 254, 5782, 2000, 10544},
+    {"GvImage", 442368, 7851, 140157, 10000, 497219},
 };
 
 struct Latency {
@@ -127,7 +130,74 @@ class Bench {
     return await_report(report, limit(r));
   }
 
+  // The remote constellation: the sink on host 2, the source on host 1 (remote_hosts.hpp). Each
+  // run checks that the cues crossed the veth into host 2, so not by shared memory.
+  std::optional<Latency> framework_remote(const Row& r, const oscar::bench::RemoteHosts& hosts) {
+    const auto report = remote_file("oscar", r);
+    const auto sink = fmt::format(
+        "{{name: sink, network: {}, mode: single_step, kernels: [{{type: bench_sink, name: sink, "
+        "inputs: {{in: src/out}}, params: {{type: {}, report: '{}', expect: {}, warmup: {}}}}}]}}",
+        hosts.network(2), r.type, report, count_ + warmup_, warmup_);
+    const auto source = fmt::format(
+        "{{name: src, network: {}, mode: {{continuous: {}us}}, kernels: [{{type: bench_source, "
+        "name: src, params: {{type: {}}}}}]}}",
+        hosts.network(1), r.period_us, r.type);
+    const auto sink_file = dir_ + "/remote_sink.yaml", source_file = dir_ + "/remote_src.yaml";
+    std::ofstream(sink_file) << sink << "\n";
+    std::ofstream(source_file) << source << "\n";
+    return across(r, hosts, report,
+                  join(hosts.on(2), {bin("oscar-run"), sink_file, "--domain", dom()}, {}),
+                  join(hosts.on(1), {bin("oscar-run"), source_file, "--domain", dom()}, {}));
+  }
+
+  std::optional<Latency> raw_remote(const Row& r, const oscar::bench::RemoteHosts& hosts) {
+    const auto report = remote_file("raw", r);
+    const std::vector<std::string> common{"--type", r.type,        "--domain",
+                                          dom(),    "--period-us", std::to_string(r.period_us)};
+    const std::vector<std::string> sub{"sub",
+                                       "--report",
+                                       report,
+                                       "--expect",
+                                       std::to_string(count_ + warmup_),
+                                       "--warmup",
+                                       std::to_string(warmup_),
+                                       "--network",
+                                       hosts.network(2)};
+    const std::vector<std::string> pub{"pub", "--count", std::to_string(10 * (count_ + warmup_)),
+                                       "--network", hosts.network(1)};
+    return across(r, hosts, report,
+                  join(hosts.on(2), {bin("oscar-bench-raw")}, join(sub, common, {})),
+                  join(hosts.on(1), {bin("oscar-bench-raw")}, join(pub, common, {})));
+  }
+
  private:
+  std::optional<Latency> across(const Row& r, const oscar::bench::RemoteHosts& hosts,
+                                const std::string& report, const std::vector<std::string>& sink,
+                                const std::vector<std::string>& source) {
+    const auto before = hosts.received(2);
+    std::vector<std::unique_ptr<Process>> procs;
+    procs.push_back(std::make_unique<Process>(sink, log("remote_sink")));
+    std::this_thread::sleep_for(300ms);
+    procs.push_back(std::make_unique<Process>(source, log("remote_src")));
+    auto latency = await_report(report, limit(r));
+    procs.clear();
+    const auto after = hosts.received(2);
+    const auto cues = static_cast<std::uint64_t>(count_ + warmup_);
+    if (latency &&
+        (after.packets - before.packets < cues || after.bytes - before.bytes < cues * r.bytes)) {
+      std::cerr << fmt::format(
+          "bench cueflow: {} remote: only {} packets, {} bytes came into host 2 for {} cues: not "
+          "over UDP\n",
+          r.type, after.packets - before.packets, after.bytes - before.bytes, cues);
+      return std::nullopt;
+    }
+    return latency;
+  }
+  std::string remote_file(const char* who, const Row& r) {
+    auto f = fmt::format("{}/{}_{}_remote.json", dir_, who, r.type);
+    std::filesystem::remove(f);
+    return f;
+  }
   static std::vector<std::string> join(std::vector<std::string> a,
                                        const std::vector<std::string>& b,
                                        const std::vector<std::string>& c) {
@@ -183,7 +253,7 @@ int main(int argc, char** argv) {
   bool json = false;
   int count = 1000, warmup = 50, domain = 90, repeat = 3;
   std::vector<std::string> types{"Bool", "LineSeg3DSeq", "GvImage"};
-  std::vector<std::string> constellations{"multicore", "local"};
+  std::vector<std::string> constellations{"multicore", "local", "remote"};
   app.add_flag("--json", json, "print JSON instead of a table");
   app.add_option("--count", count, "measured cues per row (after the warm-up)")
       ->check(CLI::PositiveNumber);
@@ -192,7 +262,16 @@ int main(int argc, char** argv) {
   app.add_option("--repeat", repeat, "runs per row, OSCAR and raw alternating; medians reported")
       ->check(CLI::PositiveNumber);
   app.add_option("--types", types, "rows to run")->delimiter(',');
-  app.add_option("--constellations", constellations, "multicore, local")->delimiter(',');
+  app.add_option("--constellations", constellations,
+                 "multicore, local, remote (two test hosts in network namespaces; root)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"multicore", "local", "remote"}));
+  oscar::bench::UdpSettings udp;
+  app.add_option("--udp-buffer-bytes", udp.buffer_bytes,
+                 "remote: UDP socket buffers of both sides (default OSCAR's 4 MiB; 0: the "
+                 "system's)");
+  app.add_option("--udp-max-message-bytes", udp.max_message_bytes,
+                 "remote: largest UDP datagram (default and 0: Fast DDS's 65500)");
   bool security = false;
   app.add_flag("--security", security,
                "local rows also with DDS Security (keystores made here), cue topics unprotected, "
@@ -203,6 +282,15 @@ int main(int argc, char** argv) {
   std::filesystem::create_directories(dir);
   Bench bench(count, warmup, domain, dir.string());
   const auto keystores = security ? make_keystores(dir) : std::map<std::string, std::string>{};
+  std::unique_ptr<oscar::bench::RemoteHosts> hosts;
+  if (std::find(constellations.begin(), constellations.end(), "remote") != constellations.end()) {
+    if (const auto why = oscar::bench::RemoteHosts::unavailable(); !why.empty()) {
+      std::cerr << "bench cueflow: remote rows skipped: " << why << "\n";
+      std::erase(constellations, "remote");
+    } else {
+      hosts = std::make_unique<oscar::bench::RemoteHosts>(udp);
+    }
+  }
   nlohmann::json rows = nlohmann::json::array();
   int failures = 0;
   if (!json) {
@@ -213,14 +301,14 @@ int main(int argc, char** argv) {
   for (const auto& r : kRows) {
     if (std::find(types.begin(), types.end(), r.type) == types.end()) continue;
     for (const auto& c : constellations) {
-      const bool multicore = c == "multicore";
+      const bool multicore = c == "multicore", remote = c == "remote";
       std::vector<Latency> ours_runs, raw_runs;
       std::map<std::string, std::vector<Latency>> secured_runs;  // by cue protection
       for (int i = 1; i <= repeat; ++i) {
         std::cerr << fmt::format("bench cueflow: {} {} run {}/{} ({} cues)...\n", r.type, c, i,
                                  repeat, count);
-        const auto o = bench.framework(r, multicore);
-        const auto w = bench.raw(r, multicore);
+        const auto o = remote ? bench.framework_remote(r, *hosts) : bench.framework(r, multicore);
+        const auto w = remote ? bench.raw_remote(r, *hosts) : bench.raw(r, multicore);
         if (!o || !w) {
           std::cerr << fmt::format("bench cueflow: {} {}: no report from {} (logs in {})\n", r.type,
                                    c, o ? "raw Fast DDS" : "OSCAR", dir.string());
@@ -229,7 +317,8 @@ int main(int argc, char** argv) {
         }
         ours_runs.push_back(*o);
         raw_runs.push_back(*w);
-        for (const auto& [protection, keystore] : multicore ? decltype(keystores){} : keystores) {
+        for (const auto& [protection, keystore] :
+             multicore || remote ? decltype(keystores){} : keystores) {
           if (const auto s = bench.framework(r, false, keystore)) {
             secured_runs[protection].push_back(*s);
           } else {
@@ -242,7 +331,8 @@ int main(int argc, char** argv) {
       if (ours_runs.empty()) continue;
       const auto ours = median_of(ours_runs);
       const auto raw = median_of(raw_runs);
-      const double seed = multicore ? r.seed_multicore_us : r.seed_local_us;
+      const double seed =
+          multicore ? r.seed_multicore_us : (remote ? r.seed_remote_us : r.seed_local_us);
       // The ratio of medians: each run's p50 is a median already, runs alternate OSCAR and raw.
       const double ratio = raw.p50 > 0 ? ours.p50 / raw.p50 : 0;
       rows.push_back({{"type", r.type},

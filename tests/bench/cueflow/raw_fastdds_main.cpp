@@ -5,6 +5,8 @@
 //   oscar-bench-raw pub  --type T --count N --period-us P --domain D
 //   oscar-bench-raw sub  --type T --expect N --warmup W --report FILE --domain D
 //   oscar-bench-raw both --type T --count N --period-us P --expect N --warmup W --report FILE
+// --network '{interfaces: [...], peers: [...], shared_memory: false}' gives another transport
+// profile (a `network:` map of docs/network.md), as OSCAR's modules of the remote constellation.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -15,6 +17,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
 #include <CLI/CLI.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
@@ -32,7 +35,7 @@ namespace fdds = eprosima::fastdds::dds;
 namespace {
 
 struct Options {
-  std::string type = "Bool", report;
+  std::string type = "Bool", report, network;
   int count = 1000, expect = 1000, warmup = 50, period_us = 2000, domain = 0;
 };
 
@@ -116,7 +119,8 @@ class Sub final : public fdds::DataReaderListener {
 
 template <class T>
 int run(const std::string& mode, const Options& o) {
-  oscar::DdsParticipant participant(o.domain, "oscar-bench-raw:" + mode);
+  oscar::DdsParticipant participant(o.domain, "oscar-bench-raw:" + mode,
+                                    oscar::NetworkConfig::from_yaml(YAML::Load(o.network)));
   auto& topic =
       participant.topic("oscar/bench/raw/" + o.type, oscar::cue_type_info<T>().new_topic_type());
   std::unique_ptr<Sub<T>> sub;
@@ -172,6 +176,7 @@ int main(int argc, char** argv) {
   app.add_option("--period-us", o.period_us);
   app.add_option("--report", o.report);
   app.add_option("--domain", o.domain);
+  app.add_option("--network", o.network, "transport profile, a YAML `network:` map");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     oscar::register_standard_cue_types();
