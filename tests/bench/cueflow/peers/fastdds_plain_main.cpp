@@ -1,9 +1,9 @@
 // oscar-bench-fastdds-plain: Fast DDS 2.9 data sharing with loaned samples, the zero-copy path
 // Fast DDS offers, for `oscar bench cueflow --all`. Each row's cue is a plain fixed-size type
 // (plain_cues.idl); the writer loans a sample from the data-sharing pool in shared memory, fills
-// and stamps it and writes it; the reader waits on a wait set and takes loaned samples (no copy,
-// no serialisation). QoS as oscar-bench-raw (reliable, keep last 16, volatile), participants on
-// OSCAR's loopback profile.
+// and stamps it and writes it; the reader (a listener, or a thread on a wait set: --delivery)
+// takes loaned samples (no copy, no serialisation). QoS as oscar-bench-raw (reliable, keep last 16,
+// volatile), participants on OSCAR's loopback profile.
 //   oscar-bench-fastdds-plain sub --type T --expect N --warmup W --report FILE --domain D
 //   oscar-bench-fastdds-plain pub --type T --count N --period-us P --domain D
 #include <cstdio>
@@ -14,6 +14,7 @@
 #include <fastdds/dds/core/condition/WaitSet.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <oscar/dds_participant.hpp>
 
@@ -35,8 +36,31 @@ Q with_cue_qos(Q q) {
   return q;
 }
 
+// Takes the loaned samples the reader holds (pointers into the writer's pool) and logs them.
 template <class T>
-void subscribe(fdds::DataReader& reader, LatencyLog& log) {
+class Taker final : public fdds::DataReaderListener {
+ public:
+  explicit Taker(LatencyLog& log) : log_(log) {}
+  void on_data_available(fdds::DataReader* reader) override { take_all(*reader); }
+  void take_all(fdds::DataReader& reader) {
+    fdds::LoanableSequence<T> cues;
+    fdds::SampleInfoSeq infos;
+    while (reader.take(cues, infos) == ReturnCode_t::RETCODE_OK) {
+      const auto now = steady_ns();
+      for (fdds::LoanableCollection::size_type i = 0; i < infos.length(); ++i) {
+        if (infos[i].valid_data) log_.add(now - cues[i].stamp_ns());
+      }
+      reader.return_loan(cues, infos);
+    }
+  }
+
+ private:
+  LatencyLog& log_;
+};
+
+// The wait-set delivery: this thread blocks on the reader's data-available status.
+template <class T>
+void wait_and_take(fdds::DataReader& reader, Taker<T>& taker, const LatencyLog& log) {
   fdds::WaitSet waitset;
   auto& condition = reader.get_statuscondition();
   condition.set_enabled_statuses(fdds::StatusMask::data_available());
@@ -44,19 +68,10 @@ void subscribe(fdds::DataReader& reader, LatencyLog& log) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (!log.done() && std::chrono::steady_clock::now() < until) {
     fdds::ConditionSeq active;
-    if (waitset.wait(active, eprosima::fastrtps::Duration_t(0, 100'000'000)) !=
+    if (waitset.wait(active, eprosima::fastrtps::Duration_t(0, 100'000'000)) ==
         ReturnCode_t::RETCODE_OK) {
-      continue;
-    }
-    reader.get_status_changes();
-    fdds::LoanableSequence<T> cues;
-    fdds::SampleInfoSeq infos;
-    while (reader.take(cues, infos) == ReturnCode_t::RETCODE_OK) {
-      const auto now = steady_ns();
-      for (fdds::LoanableCollection::size_type i = 0; i < infos.length(); ++i) {
-        if (infos[i].valid_data) log.add(now - cues[i].stamp_ns());
-      }
-      reader.return_loan(cues, infos);
+      reader.get_status_changes();
+      taker.take_all(reader);
     }
   }
 }
@@ -85,14 +100,17 @@ void publish(fdds::DataWriter& writer, const PeerOptions& o, const LatencyLog* l
 }
 
 template <class T, class PubSubType>
-int run(const PeerOptions& o) {
+int run(const PeerOptions& o, const std::string& delivery) {
   oscar::DdsParticipant participant(o.domain, "oscar-bench-fastdds-plain:" + o.mode);
   auto& topic = participant.topic("oscar/bench/plain/" + o.type, new PubSubType());
   LatencyLog log(o);
+  Taker<T> taker(log);
+  const bool listener = delivery == "listener";
   fdds::DataReader* reader = nullptr;
   if (o.mode != "pub") {
     reader = participant.subscriber().create_datareader(
-        &topic, with_cue_qos(fdds::DATAREADER_QOS_DEFAULT), nullptr, fdds::StatusMask::none());
+        &topic, with_cue_qos(fdds::DATAREADER_QOS_DEFAULT), listener ? &taker : nullptr,
+        listener ? fdds::StatusMask::data_available() : fdds::StatusMask::none());
   }
   fdds::DataWriter* writer = nullptr;
   if (o.mode != "sub") {
@@ -104,7 +122,14 @@ int run(const PeerOptions& o) {
   } else {
     std::thread publisher;
     if (writer) publisher = std::thread([&] { publish<T>(*writer, o, &log); });
-    subscribe<T>(*reader, log);
+    if (listener) {
+      const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+      while (!log.done() && std::chrono::steady_clock::now() < until) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+    } else {
+      wait_and_take(*reader, taker, log);
+    }
     if (publisher.joinable()) publisher.join();
     log.write_report();
   }
@@ -119,13 +144,16 @@ int main(int argc, char** argv) {
   CLI::App app{"oscar-bench-fastdds-plain: Fast DDS data sharing with loaned plain samples"};
   PeerOptions o;
   add_peer_options(app, o);
+  std::string delivery = "listener";
+  app.add_option("--delivery", delivery, "a listener (the default) or a thread on a wait set")
+      ->check(CLI::IsMember({"waitset", "listener"}));
   CLI11_PARSE(app, argc, argv);
   install_stop_handler();
   try {
     using namespace oscar_bench;
-    if (o.type == "Bool") return run<PlainBool, PlainBoolPubSubType>(o);
-    if (o.type == "LineSeg3DSeq") return run<PlainLines, PlainLinesPubSubType>(o);
-    return run<PlainImage, PlainImagePubSubType>(o);
+    if (o.type == "Bool") return run<PlainBool, PlainBoolPubSubType>(o, delivery);
+    if (o.type == "LineSeg3DSeq") return run<PlainLines, PlainLinesPubSubType>(o, delivery);
+    return run<PlainImage, PlainImagePubSubType>(o, delivery);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "oscar-bench-fastdds-plain: %s\n", e.what());
     return 2;
