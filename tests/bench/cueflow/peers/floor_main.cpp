@@ -1,5 +1,5 @@
 // oscar-bench-floor: the floor under every transport of `oscar bench cueflow --all`. The
-// publisher memcpy's the payload into a shared-memory slot, stamps it and wakes the subscriber
+// publisher stamps the payload, memcpy's it into a shared-memory slot and wakes the subscriber
 // with a futex; the subscriber copies the payload out and notes the arrival. No queue, no
 // discovery, no serialisation: what one copy and one wake-up cost on this machine. `both` runs
 // the two as threads of one process (the multicore row), `pub` and `sub` as two processes.
@@ -93,8 +93,9 @@ void publish(Slot& slot, std::size_t bytes, const PeerOptions& o, const LatencyL
   const std::vector<unsigned char> payload(bytes, 0x80);
   Pacer pacer(o.period_us);
   for (int i = 1; i <= o.count && !(log && log->done()) && !stop_requested(); ++i) {
+    const auto stamp = steady_ns();  // before the copy: the floor is a copying transport
     std::memcpy(slot.data, payload.data(), bytes);
-    slot.stamp_ns = steady_ns();
+    slot.stamp_ns = stamp;
     slot.seq.fetch_add(1, std::memory_order_release);
     futex(&slot.seq, FUTEX_WAKE, 1, nullptr);
     pacer.wait();

@@ -71,6 +71,7 @@ class LatencyLog {
 
   void add(std::int64_t latency_ns) {
     std::lock_guard lock(mutex_);
+    if (done_) return;  // what arrives after the last expected cue is not counted
     ++received_;
     if (received_ > o_.warmup) latency_ns_.push_back(latency_ns);
     if (received_ >= o_.expect) done_ = true;
