@@ -48,6 +48,12 @@ TEST(CueflowReport, FastestIsTheLowestP50ThenTheLowestP90) {
   EXPECT_EQ(fastest(tried), "listener,async,shm");
 }
 
+TEST(CueflowReport, FasterComparesP50ThenP90) {
+  EXPECT_TRUE(faster({10, 90, 0, 0, 1}, {11, 20, 0, 0, 1}));
+  EXPECT_TRUE(faster({10, 20, 0, 0, 1}, {10, 30, 0, 0, 1}));
+  EXPECT_FALSE(faster({10, 30, 0, 0, 1}, {10, 30, 0, 0, 1}));
+}
+
 TEST(CueflowReport, FastestIsNoneWhenNothingDelivered) {
   EXPECT_EQ(fastest({}), std::nullopt);
   EXPECT_EQ(fastest({{"waitset,sync,shm", {}}}), std::nullopt);
