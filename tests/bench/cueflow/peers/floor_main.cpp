@@ -1,7 +1,7 @@
 // oscar-bench-floor: the floor under every transport of `oscar bench cueflow --all`. The
 // publisher stamps the payload, memcpy's it into a shared-memory slot and wakes the subscriber
 // with a futex; the subscriber copies the payload out and notes the arrival. No queue, no
-// discovery, no serialisation: what one copy and one wake-up cost on this machine. `both` runs
+// discovery, no serialisation: what two copies and one wake-up cost on this machine. `both` runs
 // the two as threads of one process (the multicore row), `pub` and `sub` as two processes.
 //   oscar-bench-floor sub --type T --expect N --warmup W --report FILE --domain D
 //   oscar-bench-floor pub --type T --count N --period-us P --domain D
