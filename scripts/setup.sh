@@ -10,6 +10,7 @@ packages=(
   libgtest-dev libgmock-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
   nlohmann-json3-dev libexpected-dev libzstd-dev liblz4-dev zlib1g-dev
   graphviz iproute2 procps gdb gdbserver openssh-client openssh-server nodejs npm
+  cyclonedds-dev cyclonedds-tools libiceoryx-posh-dev iceoryx
 )
 
 missing=()

@@ -71,7 +71,7 @@ struct TypedPorts final : BenchSink::Ports {
 };
 
 struct Percentiles {
-  double p50 = 0, p90 = 0, max = 0;
+  double p50 = 0, p90 = 0, p99 = 0, max = 0;
 };
 Percentiles percentiles_us(std::vector<std::int64_t> v) {
   if (v.empty()) return {};
@@ -80,7 +80,7 @@ Percentiles percentiles_us(std::vector<std::int64_t> v) {
     return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))] /
            1e3;
   };
-  return {at(0.5), at(0.9), v.back() / 1e3};
+  return {at(0.5), at(0.9), at(0.99), v.back() / 1e3};
 }
 }  // namespace
 
@@ -131,12 +131,12 @@ std::string BenchSink::report() const {
   const auto p = percentiles_us(stats_.process_ns);
   return fmt::format(
       R"({{"type":"{}","received":{},"gaps":{},"duplicates":{},"first_seq":{},"last_seq":{},)"
-      R"("verified":{},"corrupt":{},"stamps_min":{},)"
-      R"("stamps_max":{},"samples":{},"delivery_us":{{"p50":{:.2f},"p90":{:.2f},"max":{:.2f}}},)"
+      R"("verified":{},"corrupt":{},"stamps_min":{},"stamps_max":{},"samples":{},)"
+      R"("delivery_us":{{"p50":{:.2f},"p90":{:.2f},"p99":{:.2f},"max":{:.2f}}},)"
       R"("process_us":{{"p50":{:.2f},"p90":{:.2f},"max":{:.2f}}}}})",
       params_.type, stats_.received, stats_.gaps, stats_.duplicates, stats_.first_seq,
       stats_.last_seq, stats_.verified, stats_.corrupt, stats_.stamps_min, stats_.stamps_max,
-      stats_.delivery_ns.size(), d.p50, d.p90, d.max, p.p50, p.p90, p.max);
+      stats_.delivery_ns.size(), d.p50, d.p90, d.p99, d.max, p.p50, p.p90, p.max);
 }
 
 void BenchSink::write_report() const {

@@ -1,13 +1,17 @@
 // oscar bench cueflow: seed 004 Abb. 8 (cue transfer time of Bool, LineSeg3DSeq with 100 lines
 // and a 768x576 GvImage) for the multi-core, local and remote constellations, against raw Fast
-// DDS with the same type, QoS and transport, measured in the same run. Prints a table, or JSON
-// (--json).
+// DDS with the same type and QoS, measured in the same run: multi-core and local in its fastest
+// configuration (a pre-pass tries delivery, publish mode and transport per row), remote over UDP
+// between two test hosts. --all adds the peers (Fast DDS data sharing, Cyclone DDS, iceoryx, a
+// memcpy + futex floor) to the multi-core and local rows, each its own program in peers/. Prints
+// a table, or JSON (--json). docs/benchmarks.md explains the rows.
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
 #include <optional>
+#include <span>
 #include <thread>
 
 #include <fmt/format.h>
@@ -15,6 +19,8 @@
 #include <nlohmann/json.hpp>
 #include <oscar/command_line.hpp>
 
+#include "cueflow_report.hpp"
+#include "peers/peer_list.hpp"
 #include "process.hpp"  // tests/common
 #include "remote_hosts.hpp"
 
@@ -35,28 +41,11 @@ const Row kRows[] = {
     {"GvImage", 442368, 7851, 140157, 10000, 497219},
 };
 
-struct Latency {
-  double p50 = 0, p90 = 0, max = 0;
-  long samples = 0;
-};
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : v[v.size() / 2];
-}
-
-// The median of each figure over repeated runs.
-Latency median_of(const std::vector<Latency>& runs) {
-  std::vector<double> p50, p90, max;
-  long samples = 0;
-  for (const auto& r : runs) {
-    p50.push_back(r.p50);
-    p90.push_back(r.p90);
-    max.push_back(r.max);
-    samples += r.samples;
-  }
-  return {median(p50), median(p90), median(max), samples};
-}
+using oscar::bench::kPeers;
+using oscar::bench::Latency;
+using oscar::bench::median_of;
+using oscar::bench::Peer;
+using oscar::bench::start_roudi;
 
 std::string bin(const std::string& name) {
   return (std::filesystem::read_symlink("/proc/self/exe").parent_path() / name).string();
@@ -68,9 +57,8 @@ std::optional<Latency> await_report(const std::string& file, std::chrono::second
     if (std::chrono::steady_clock::now() > until) return std::nullopt;
     std::this_thread::sleep_for(20ms);
   }
-  const auto j = nlohmann::json::parse(std::ifstream(file));
-  const auto& d = j["delivery_us"];
-  return Latency{d["p50"], d["p90"], d["max"], j["samples"]};
+  std::this_thread::sleep_for(20ms);  // written in one go, but let it land
+  return oscar::bench::parse_report(nlohmann::json::parse(std::ifstream(file)));
 }
 
 class Bench {
@@ -108,26 +96,32 @@ class Bench {
     return await_report(report, limit(r));
   }
 
-  std::optional<Latency> raw(const Row& r, bool multicore) {
-    const auto report = file("raw", r, multicore);
-    const std::vector<std::string> common{"--type", r.type,        "--domain",
-                                          dom(),    "--period-us", std::to_string(r.period_us)};
+  // One run of a minimal program (oscar-bench-raw or a peer; `args` its configuration): `both`
+  // for the multicore constellation, else `sub` and, 300 ms later, `pub`. `count` overrides the
+  // measured cues (the pre-pass runs fewer).
+  std::optional<Latency> program(const std::string& name, const std::vector<std::string>& args,
+                                 const Row& r, bool multicore, int count = 0) {
+    if (count == 0) count = count_;
+    const auto report = file(name.c_str(), r, multicore);
+    auto common =
+        join({"--type", r.type, "--domain", dom(), "--period-us", std::to_string(r.period_us)},
+             args, {});
     const std::vector<std::string> sub{"--report", report,
-                                       "--expect", std::to_string(count_ + warmup_),
+                                       "--expect", std::to_string(count + warmup_),
                                        "--warmup", std::to_string(warmup_)};
-    const std::vector<std::string> pub{"--count", std::to_string(10 * (count_ + warmup_))};
+    const std::vector<std::string> pub{"--count", std::to_string(10 * (count + warmup_))};
     std::vector<std::unique_ptr<Process>> procs;
     if (multicore) {
       procs.push_back(std::make_unique<Process>(
-          join(join({bin("oscar-bench-raw"), "both"}, common, sub), pub, {}), log("raw")));
+          join(join({bin(name), "both"}, common, sub), pub, {}), log(name + "_both")));
     } else {
-      procs.push_back(std::make_unique<Process>(join({bin("oscar-bench-raw"), "sub"}, common, sub),
-                                                log("raw_sub")));
+      procs.push_back(
+          std::make_unique<Process>(join({bin(name), "sub"}, common, sub), log(name + "_sub")));
       std::this_thread::sleep_for(300ms);
-      procs.push_back(std::make_unique<Process>(join({bin("oscar-bench-raw"), "pub"}, common, pub),
-                                                log("raw_pub")));
+      procs.push_back(
+          std::make_unique<Process>(join({bin(name), "pub"}, common, pub), log(name + "_pub")));
     }
-    return await_report(report, limit(r));
+    return await_report(report, limit(r, count));
   }
 
   // The remote constellation: the sink on host 2, the source on host 1 (remote_hosts.hpp). Each
@@ -211,9 +205,10 @@ class Bench {
     std::filesystem::remove(f);
     return f;
   }
-  std::string log(const char* who) const { return fmt::format("{}/{}.log", dir_, who); }
-  std::chrono::seconds limit(const Row& r) const {
-    return std::chrono::seconds(30 + (count_ + warmup_) * r.period_us / 1'000'000 * 3);
+  std::string log(const std::string& who) const { return fmt::format("{}/{}.log", dir_, who); }
+  std::chrono::seconds limit(const Row& r, int count = 0) const {
+    return std::chrono::seconds(30 +
+                                ((count ? count : count_) + warmup_) * r.period_us / 1'000'000 * 3);
   }
   int count_, warmup_, domain_;
   std::string dir_;
@@ -246,12 +241,20 @@ modules:
   return out;
 }
 
+nlohmann::json system_row(const std::string& system, const Row& r, const std::string& c,
+                          const Latency& l, std::size_t runs) {
+  return {{"system", system},     {"type", r.type},  {"bytes", r.bytes}, {"constellation", c},
+          {"p50_us", l.p50},      {"p90_us", l.p90}, {"p99_us", l.p99},  {"max_us", l.max},
+          {"samples", l.samples}, {"runs", runs}};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"oscar bench cueflow: one-way cue latency, OSCAR vs raw Fast DDS (seed 004 Abb. 8)"};
-  bool json = false;
-  int count = 1000, warmup = 50, domain = 90, repeat = 3;
+  bool json = false, all = false;
+  int count = 1000, warmup = 50, domain = 90, repeat = 3, prepass = 200;
+  std::string raw_config = "auto";
   std::vector<std::string> types{"Bool", "LineSeg3DSeq", "GvImage"};
   std::vector<std::string> constellations{"multicore", "local", "remote"};
   app.add_flag("--json", json, "print JSON instead of a table");
@@ -272,6 +275,15 @@ int main(int argc, char** argv) {
                  "system's)");
   app.add_option("--udp-max-message-bytes", udp.max_message_bytes,
                  "remote: largest UDP datagram (default and 0: Fast DDS's 65500)");
+  app.add_option("--raw-config", raw_config,
+                 "raw Fast DDS configuration 'delivery,publish,transport' (waitset|listener, "
+                 "sync|async, shm|udp), or auto: the fastest of all in a pre-pass per row "
+                 "(multicore and local)");
+  app.add_option("--prepass-count", prepass,
+                 "measured cues per configuration and round of the pre-pass")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--all", all,
+               "add the peers: Fast DDS data sharing, Cyclone DDS, iceoryx, memcpy + futex floor");
   bool security = false;
   app.add_flag("--security", security,
                "local rows also with DDS Security (keystores made here), cue topics unprotected, "
@@ -291,24 +303,68 @@ int main(int argc, char** argv) {
       hosts = std::make_unique<oscar::bench::RemoteHosts>(udp);
     }
   }
+  std::vector<Peer> peers;
+  std::unique_ptr<Process> roudi;
+  for (const auto& peer : all ? std::span(kPeers) : std::span<const Peer>()) {
+    if (!std::filesystem::exists(bin(peer.program))) {
+      std::cerr << fmt::format("bench cueflow: {} not built (its package missing), no {} rows\n",
+                               peer.program, peer.system);
+    } else if (peer.system != std::string("iceoryx") || (roudi = start_roudi(dir))) {
+      peers.push_back(peer);
+    }
+  }
   nlohmann::json rows = nlohmann::json::array();
+  std::vector<std::string> peer_lines;
   int failures = 0;
   if (!json) {
-    std::cout << fmt::format("{:<13} {:>7} {:<10} {:>9} {:>9} {:>9} {:>10} {:>7} {:>10}\n", "type",
-                             "bytes", "constell.", "p50 us", "p90 us", "max us", "raw p50", "ratio",
-                             "seed us");
+    std::cout << fmt::format(
+        "{:<13} {:>7} {:<10} {:>9} {:>9} {:>9} {:>9} {:>10} {:>7} {:>10}  {}\n", "type", "bytes",
+        "constell.", "p50 us", "p90 us", "p99 us", "max us", "raw p50", "ratio", "seed us",
+        "raw config");
   }
   for (const auto& r : kRows) {
     if (std::find(types.begin(), types.end(), r.type) == types.end()) continue;
     for (const auto& c : constellations) {
       const bool multicore = c == "multicore", remote = c == "remote";
+      // Remote: the raw program over the test hosts' UDP, in Fast DDS's default configuration.
+      std::string config = remote ? "listener,sync,udp" : raw_config;
+      if (config == "auto") {
+        // Two rounds over all configurations, each keeping its better run: a hiccup of the
+        // machine during one short run does not decide the baseline.
+        std::map<std::string, Latency> tried;
+        for (int round = 0; round < 2; ++round) {
+          for (const auto& candidate : oscar::bench::raw_configs()) {
+            const auto l = bench.program(
+                "oscar-bench-raw", oscar::bench::raw_config_args(candidate), r, multicore, prepass);
+            if (!l) continue;
+            const auto kept = tried.find(candidate);
+            if (kept == tried.end() || oscar::bench::faster(*l, kept->second)) {
+              tried[candidate] = *l;
+            }
+          }
+        }
+        std::string tally;
+        for (const auto& [candidate, l] : tried)
+          tally += fmt::format(" {} {:.1f};", candidate, l.p50);
+        const auto best = oscar::bench::fastest(tried);
+        std::cerr << fmt::format("bench cueflow: {} {} pre-pass (p50 us):{} fastest {}\n", r.type,
+                                 c, tally, best.value_or("none"));
+        if (!best) {
+          ++failures;
+          continue;
+        }
+        config = *best;
+      }
+      const auto raw_args = oscar::bench::raw_config_args(config);
       std::vector<Latency> ours_runs, raw_runs;
       std::map<std::string, std::vector<Latency>> secured_runs;  // by cue protection
+      std::map<std::string, std::vector<Latency>> peer_runs;     // by system
       for (int i = 1; i <= repeat; ++i) {
         std::cerr << fmt::format("bench cueflow: {} {} run {}/{} ({} cues)...\n", r.type, c, i,
                                  repeat, count);
         const auto o = remote ? bench.framework_remote(r, *hosts) : bench.framework(r, multicore);
-        const auto w = remote ? bench.raw_remote(r, *hosts) : bench.raw(r, multicore);
+        const auto w = remote ? bench.raw_remote(r, *hosts)
+                              : bench.program("oscar-bench-raw", raw_args, r, multicore);
         if (!o || !w) {
           std::cerr << fmt::format("bench cueflow: {} {}: no report from {} (logs in {})\n", r.type,
                                    c, o ? "raw Fast DDS" : "OSCAR", dir.string());
@@ -327,6 +383,15 @@ int main(int argc, char** argv) {
             ++failures;
           }
         }
+        for (const auto& peer : remote ? std::vector<Peer>{} : peers) {  // on one host only
+          if (const auto l = bench.program(peer.program, {}, r, multicore)) {
+            peer_runs[peer.system].push_back(*l);
+          } else {
+            std::cerr << fmt::format("bench cueflow: {} {} {}: no report (logs in {})\n",
+                                     peer.system, r.type, c, dir.string());
+            ++failures;
+          }
+        }
       }
       if (ours_runs.empty()) continue;
       const auto ours = median_of(ours_runs);
@@ -335,32 +400,38 @@ int main(int argc, char** argv) {
           multicore ? r.seed_multicore_us : (remote ? r.seed_remote_us : r.seed_local_us);
       // The ratio of medians: each run's p50 is a median already, runs alternate OSCAR and raw.
       const double ratio = raw.p50 > 0 ? ours.p50 / raw.p50 : 0;
-      rows.push_back({{"type", r.type},
+      rows.push_back({{"system", "oscar"},
+                      {"type", r.type},
                       {"bytes", r.bytes},
                       {"constellation", c},
                       {"p50_us", ours.p50},
                       {"p90_us", ours.p90},
+                      {"p99_us", ours.p99},
                       {"max_us", ours.max},
                       {"raw_p50_us", raw.p50},
                       {"raw_p90_us", raw.p90},
+                      {"raw_p99_us", raw.p99},
                       {"raw_max_us", raw.max},
+                      {"raw_config", config},
                       {"ratio", ratio},
                       {"samples", ours.samples},
                       {"runs", ours_runs.size()},
                       {"seed_us", seed}});
       if (!json) {
-        std::cout
-            << fmt::format(
-                   "{:<13} {:>7} {:<10} {:>9.1f} {:>9.1f} {:>9.1f} {:>10.1f} {:>7.2f} {:>10.0f}\n",
-                   r.type, r.bytes, c, ours.p50, ours.p90, ours.max, raw.p50, ratio, seed)
-            << std::flush;
+        std::cout << fmt::format(
+                         "{:<13} {:>7} {:<10} {:>9.1f} {:>9.1f} {:>9.1f} {:>9.1f} {:>10.1f} "
+                         "{:>7.2f} {:>10.0f}  {}\n",
+                         r.type, r.bytes, c, ours.p50, ours.p90, ours.p99, ours.max, raw.p50, ratio,
+                         seed, config)
+                  << std::flush;
       }
       for (const auto* protection : kProtections) {  // in order of cost
         if (!secured_runs.contains(protection)) continue;
         const auto& runs = secured_runs[protection];
         const auto s = median_of(runs);
         const double vs_plain = ours.p50 > 0 ? s.p50 / ours.p50 : 0;
-        rows.push_back({{"type", r.type},
+        rows.push_back({{"system", "oscar"},
+                        {"type", r.type},
                         {"bytes", r.bytes},
                         {"constellation", c},
                         {"security", protection},
@@ -373,15 +444,43 @@ int main(int argc, char** argv) {
                         {"runs", runs.size()}});
         if (!json) {
           std::cout << fmt::format(
-                           "{:<13} {:>7} {:<10} {:>9.1f} {:>9.1f} {:>9.1f} {:>10} {:>7.2f}  "
+                           "{:<13} {:>7} {:<10} {:>9.1f} {:>9.1f} {:>9} {:>9.1f} {:>10} {:>7.2f}  "
                            "(secured, cue topics: {}; ratio to OSCAR without security)\n",
-                           r.type, r.bytes, c, s.p50, s.p90, s.max, "", vs_plain, protection)
+                           r.type, r.bytes, c, s.p50, s.p90, "", s.max, "", vs_plain, protection)
                     << std::flush;
+        }
+      }
+      if (!all) continue;
+      auto add = [&](const std::string& system, const Latency& l, std::size_t runs,
+                     const std::string& note) {
+        if (system != "oscar") {  // OSCAR's row is above, with its ratio
+          auto row = system_row(system, r, c, l, runs);
+          if (!note.empty()) row["config"] = note;
+          rows.push_back(row);
+        }
+        peer_lines.push_back(fmt::format(
+            "{:<20} {:<13} {:>7} {:<10} {:>9.1f} {:>9.1f} {:>9.1f} {:>9.1f} {:>7.2f}  {}", system,
+            r.type, r.bytes, c, l.p50, l.p90, l.p99, l.max, ours.p50 > 0 ? l.p50 / ours.p50 : 0,
+            note));
+      };
+      add("oscar", ours, ours_runs.size(), "");
+      add("fastdds", raw, raw_runs.size(), config);
+      for (const auto& peer : peers) {
+        if (peer_runs.contains(peer.system)) {
+          add(peer.system, median_of(peer_runs[peer.system]), peer_runs[peer.system].size(), "");
         }
       }
     }
   }
-  if (json) std::cout << nlohmann::json{{"rows", rows}}.dump() << "\n";
+  if (json) {
+    std::cout << nlohmann::json{{"rows", rows}}.dump() << "\n";
+  } else if (all) {
+    std::cout << fmt::format("\n{:<20} {:<13} {:>7} {:<10} {:>9} {:>9} {:>9} {:>9} {:>7}  {}\n",
+                             "system", "type", "bytes", "constell.", "p50 us", "p90 us", "p99 us",
+                             "max us", "/oscar", "config");
+    for (const auto& line : peer_lines) std::cout << line << "\n";
+  }
+  roudi.reset();
   if (failures == 0) std::filesystem::remove_all(dir);
   return failures == 0 ? 0 : 1;
 }
