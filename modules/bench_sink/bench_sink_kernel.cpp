@@ -50,6 +50,8 @@ struct TypedPorts final : BenchSink::Ports {
       s.stamps_max = std::max<std::uint64_t>(s.stamps_max, n);
       if (static_cast<std::int64_t>(s.received) <= warmup || n == 0) continue;
       const auto generated = static_cast<std::int64_t>(h.stamps().front());
+      if (s.delivery_ns.empty()) s.first_generated_ns = generated;
+      s.last_generated_ns = generated;
       s.delivery_ns.push_back(r.received - generated);
       s.process_ns.push_back(cycle.now() - generated);
     }
@@ -131,12 +133,14 @@ std::string BenchSink::report() const {
   const auto p = percentiles_us(stats_.process_ns);
   return fmt::format(
       R"({{"type":"{}","received":{},"gaps":{},"duplicates":{},"first_seq":{},"last_seq":{},)"
-      R"("verified":{},"corrupt":{},"stamps_min":{},"stamps_max":{},"samples":{},)"
+      R"("verified":{},"corrupt":{},"stamps_min":{},"stamps_max":{},"samples":{},"span_s":{:.6f},)"
       R"("delivery_us":{{"p50":{:.2f},"p90":{:.2f},"p99":{:.2f},"max":{:.2f}}},)"
       R"("process_us":{{"p50":{:.2f},"p90":{:.2f},"max":{:.2f}}}}})",
       params_.type, stats_.received, stats_.gaps, stats_.duplicates, stats_.first_seq,
       stats_.last_seq, stats_.verified, stats_.corrupt, stats_.stamps_min, stats_.stamps_max,
-      stats_.delivery_ns.size(), d.p50, d.p90, d.p99, d.max, p.p50, p.p90, p.max);
+      stats_.delivery_ns.size(),
+      static_cast<double>(stats_.last_generated_ns - stats_.first_generated_ns) / 1e9, d.p50, d.p90,
+      d.p99, d.max, p.p50, p.p90, p.max);
 }
 
 void BenchSink::write_report() const {

@@ -32,6 +32,8 @@ class BenchSink final : public Kernel {
     std::uint64_t verified = 0, corrupt = 0;  ///< payloads checked; of those, not as sent
     std::vector<std::int64_t> delivery_ns, process_ns;
     std::uint64_t stamps_min = 0, stamps_max = 0;  ///< header stamp count (fusion depth)
+    /// When the first and the last measured cue were made: what the source achieved.
+    std::int64_t first_generated_ns = 0, last_generated_ns = 0;
   };
   explicit BenchSink(KernelSetup& setup);
   ~BenchSink() override;

@@ -85,7 +85,9 @@ class Taker final : public fdds::DataReaderListener {
     fdds::SampleInfo info;
     while (reader.take_next_sample(&cue_, &info) == ReturnCode_t::RETCODE_OK) {
       const auto now = oscar::wall_now();
-      if (info.valid_data) log_.add(now - oscar::generation_stamp(cue_.header()));
+      if (info.valid_data) {
+        log_.add(now - oscar::generation_stamp(cue_.header()), cue_.header().seq());
+      }
     }
   }
 

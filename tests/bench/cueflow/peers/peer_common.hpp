@@ -2,7 +2,7 @@
 // What every program of `oscar bench cueflow` shares (oscar-bench-raw and the peers of --all):
 // the command line (pub/sub/both, --type, --count, --expect, --warmup, --period-us, --report,
 // --domain), the payload size of each row, the clock and the report the bench reads:
-//   {"type":T,"received":N,"samples":N,"delivery_us":{"p50":..,"p90":..,"p99":..,"max":..}}
+//   {"type":T,"received":N,"gaps":N,"samples":N,"delivery_us":{"p50":..,"p90":..,"p99":..,"max":..}}
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -69,11 +69,20 @@ class LatencyLog {
  public:
   explicit LatencyLog(const PeerOptions& o) : o_(o) { latency_ns_.reserve(o.expect); }
 
-  void add(std::int64_t latency_ns) {
+  /// With the cue's sequence number (`seq` > 0) the log also counts the cues missing between
+  /// two that arrived (`gaps` in the report; the throughput search's loss).
+  void add(std::int64_t latency_ns, std::uint64_t seq = 0) {
+    const auto now = std::chrono::steady_clock::now();
     std::lock_guard lock(mutex_);
     if (done_) return;  // what arrives after the last expected cue is not counted
+    if (seq > 0 && last_seq_ > 0 && seq > last_seq_ + 1) gaps_ += seq - last_seq_ - 1;
+    if (seq > last_seq_) last_seq_ = seq;
     ++received_;
-    if (received_ > o_.warmup) latency_ns_.push_back(latency_ns);
+    if (received_ > o_.warmup) {
+      if (latency_ns_.empty()) first_ = now;
+      last_ = now;
+      latency_ns_.push_back(latency_ns);
+    }
     if (received_ >= o_.expect) done_ = true;
   }
   bool done() const { return done_; }
@@ -84,15 +93,18 @@ class LatencyLog {
     std::sort(v.begin(), v.end());
     const auto us = [&](double q) { return quantile(v, q) / 1e3; };
     std::ofstream(o_.report) << fmt::format(
-        R"({{"type":"{}","received":{},"samples":{},"delivery_us":{{"p50":{:.2f},"p90":{:.2f},"p99":{:.2f},"max":{:.2f}}}}})"
+        R"({{"type":"{}","received":{},"gaps":{},"samples":{},"span_s":{:.6f},"delivery_us":{{"p50":{:.2f},"p90":{:.2f},"p99":{:.2f},"max":{:.2f}}}}})"
         "\n",
-        o_.type, received_, v.size(), us(0.5), us(0.9), us(0.99), v.empty() ? 0.0 : v.back() / 1e3);
+        o_.type, received_, gaps_, v.size(), std::chrono::duration<double>(last_ - first_).count(),
+        us(0.5), us(0.9), us(0.99), v.empty() ? 0.0 : v.back() / 1e3);
   }
 
  private:
   const PeerOptions& o_;
   std::mutex mutex_;
   int received_ = 0;
+  std::uint64_t last_seq_ = 0, gaps_ = 0;
+  std::chrono::steady_clock::time_point first_{}, last_{};  // arrivals of the measured cues
   std::vector<std::int64_t> latency_ns_;
   std::atomic<bool> done_ = false;
 };

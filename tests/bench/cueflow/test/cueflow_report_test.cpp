@@ -1,6 +1,8 @@
 // The arithmetic of `oscar bench cueflow` (cueflow_report.hpp and peer_common.hpp), no timing.
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include "cueflow_report.hpp"
 #include "peers/peer_common.hpp"
 
@@ -64,6 +66,62 @@ TEST(CueflowReport, RawConfigBecomesTheProgramsOptions) {
             (std::vector<std::string>{"--delivery", "waitset", "--publish", "async", "--transport",
                                       "udp"}));
   EXPECT_THROW(raw_config_args("waitset,async"), std::invalid_argument);
+}
+
+TEST(CueflowReport, TheAchievedRateIsTheMeasuredCuesOverTheirSpan) {
+  const auto l = parse_report(nlohmann::json::parse(
+      R"({"samples":1001,"span_s":2.0,"delivery_us":{"p50":1,"p90":2,"max":3}})"));
+  EXPECT_DOUBLE_EQ(l.rate_hz(), 500);
+  EXPECT_DOUBLE_EQ(Latency{}.rate_hz(), 0) << "no span: no rate";
+}
+
+TEST(CueflowReport, ReadsGapsAndTakesNoneAsZero) {
+  EXPECT_EQ(parse_report(nlohmann::json::parse(
+                             R"({"samples":5,"gaps":3,"delivery_us":{"p50":1,"p90":2,"max":3}})"))
+                .gaps,
+            3);
+  EXPECT_EQ(parse_report(
+                nlohmann::json::parse(R"({"samples":5,"delivery_us":{"p50":1,"p90":2,"max":3}})"))
+                .gaps,
+            0);
+}
+
+// A link that loses cues above 3000 Hz: doubling from 500 passes 500..2000 and fails 4000;
+// three bisections try 3000 (passes), 3500 and 3250 (fail).
+TEST(Throughput, DoublesUntilALossThenBisects) {
+  const auto t = highest_lossless_rate(500, 100000, 3, [](double rate) -> std::optional<Trial> {
+    if (rate > 3000) return std::nullopt;
+    return Trial{rate / 100, rate * 0.9};  // the CPU % of that trial, the rate it achieved
+  });
+  EXPECT_DOUBLE_EQ(t.rate_hz, 3000);
+  EXPECT_DOUBLE_EQ(t.at.cpu_pct, 30);
+  EXPECT_DOUBLE_EQ(t.at.achieved_hz, 2700);
+  EXPECT_EQ(t.tried, (std::vector<double>{500, 1000, 2000, 4000, 3000, 3500, 3250}));
+}
+
+TEST(Throughput, StopsAtTheCapAndSaysNothingPassedWhenTheFirstTrialLoses) {
+  const auto all =
+      highest_lossless_rate(500, 2000, 3, [](double) -> std::optional<Trial> { return Trial{}; });
+  EXPECT_DOUBLE_EQ(all.rate_hz, 2000);
+  EXPECT_EQ(all.tried.size(), 3u);
+  const auto none =
+      highest_lossless_rate(500, 2000, 3, [](double) -> std::optional<Trial> { return {}; });
+  EXPECT_DOUBLE_EQ(none.rate_hz, 0);
+  EXPECT_EQ(none.tried, std::vector<double>{500});
+}
+
+TEST(PeerCommon, CountsTheCuesMissingBetweenTwoThatArrived) {
+  PeerOptions o;
+  o.expect = 10;
+  o.warmup = 0;
+  o.report = ::testing::TempDir() + "/peer_gaps.json";
+  LatencyLog log(o);
+  for (const std::uint64_t seq : {3, 4, 7, 8, 12}) log.add(1000, seq);
+  log.write_report();
+  const auto j = nlohmann::json::parse(std::ifstream(o.report));
+  EXPECT_EQ(j["gaps"], 5);  // 5, 6, 9, 10, 11; nothing before the first that arrived
+  EXPECT_EQ(j["received"], 5);
+  EXPECT_GE(j["span_s"].get<double>(), 0.0);
 }
 
 TEST(PeerCommon, QuantileClampsToTheLastValue) {
