@@ -5,8 +5,6 @@
 // between two test hosts. --all adds the peers (Fast DDS data sharing, Cyclone DDS, iceoryx, a
 // memcpy + futex floor) to the multi-core and local rows, each its own program in peers/. Prints
 // a table, or JSON (--json). docs/benchmarks.md explains the rows.
-#include <sys/resource.h>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -23,199 +21,23 @@
 #include <oscar/command_line.hpp>
 
 #include "cueflow_report.hpp"
+#include "cueflow_runs.hpp"
 #include "peers/peer_list.hpp"
-#include "process.hpp"  // tests/common
-#include "remote_hosts.hpp"
 
 namespace {
 using namespace std::chrono_literals;
 using oscar::test::Process;
 
-struct Row {
-  std::string type;
-  std::size_t bytes;
-  double seed_multicore_us, seed_local_us;
-  int period_us;
-  double seed_remote_us;
-};
-const Row kRows[] = {
-    {"Bool", 1, 86, 1736, 2000, 1820},
-    {"LineSeg3DSeq", 4800, 254, 5782, 2000, 10544},
-    {"GvImage", 442368, 7851, 140157, 10000, 497219},
-};
-
+using oscar::bench::await_report;
+using oscar::bench::Bench;
+using oscar::bench::bin;
 using oscar::bench::kPeers;
+using oscar::bench::kRows;
 using oscar::bench::Latency;
 using oscar::bench::median_of;
 using oscar::bench::Peer;
+using oscar::bench::Row;
 using oscar::bench::start_roudi;
-
-std::string bin(const std::string& name) {
-  return (std::filesystem::read_symlink("/proc/self/exe").parent_path() / name).string();
-}
-
-std::optional<Latency> await_report(const std::string& file, std::chrono::seconds limit) {
-  const auto until = std::chrono::steady_clock::now() + limit;
-  while (!std::filesystem::exists(file)) {
-    if (std::chrono::steady_clock::now() > until) return std::nullopt;
-    std::this_thread::sleep_for(20ms);
-  }
-  std::this_thread::sleep_for(20ms);  // written in one go, but let it land
-  return oscar::bench::parse_report(nlohmann::json::parse(std::ifstream(file)));
-}
-
-class Bench {
- public:
-  Bench(int count, int warmup, int domain, std::string dir)
-      : count_(count), warmup_(warmup), domain_(domain), dir_(std::move(dir)) {}
-
-  // With a `keystore`, both modules authenticate as their identities in it (module.src and
-  // module.sink) and their cue topic is protected as its governance says.
-  std::optional<Latency> framework(const Row& r, bool multicore, const std::string& keystore = "") {
-    const auto report = file(keystore.empty() ? "oscar" : "oscar_secured", r, multicore);
-    const std::vector<std::string> sink{"-k", "bench_sink:sink",
-                                        "-p", "sink.type=" + r.type,
-                                        "-p", "sink.report=" + report,
-                                        "-p", fmt::format("sink.expect={}", count_ + warmup_),
-                                        "-p", fmt::format("sink.warmup={}", warmup_),
-                                        "-i", "sink.in=src/out"};
-    const std::vector<std::string> source{"-k", "bench_source:src", "-p", "src.type=" + r.type};
-    const auto cycle = fmt::format("continuous:{}us", r.period_us);
-    std::vector<std::unique_ptr<Process>> procs;
-    if (multicore) {
-      auto args = join({bin("oscar-run"), "--name", "bench", "--domain", dom()}, source, sink);
-      args.insert(args.end(), {"-m", cycle});
-      procs.push_back(std::make_unique<Process>(args, log("multicore")));
-    } else {
-      std::vector<std::string> run{bin("oscar-run")};
-      if (!keystore.empty()) run = {"/usr/bin/env", "OSCAR_KEYSTORE=" + keystore, bin("oscar-run")};
-      auto s =
-          join(join(run, {"--name", "sink", "--domain", dom()}, {}), sink, {"-m", "single_step"});
-      procs.push_back(std::make_unique<Process>(s, log("sink")));
-      std::this_thread::sleep_for(keystore.empty() ? 300ms : 1000ms);  // + authentication
-      auto p = join(join(run, {"--name", "src", "--domain", dom()}, {}), source, {"-m", cycle});
-      procs.push_back(std::make_unique<Process>(p, log("src")));
-    }
-    return await_report(report, limit(r));
-  }
-
-  // One run of a minimal program (oscar-bench-raw or a peer; `args` its configuration): `both`
-  // for the multicore constellation, else `sub` and, 300 ms later, `pub`. `count` overrides the
-  // measured cues (the pre-pass runs fewer).
-  std::optional<Latency> program(const std::string& name, const std::vector<std::string>& args,
-                                 const Row& r, bool multicore, int count = 0) {
-    if (count == 0) count = count_;
-    const auto report = file(name.c_str(), r, multicore);
-    auto common =
-        join({"--type", r.type, "--domain", dom(), "--period-us", std::to_string(r.period_us)},
-             args, {});
-    const std::vector<std::string> sub{"--report", report,
-                                       "--expect", std::to_string(count + warmup_),
-                                       "--warmup", std::to_string(warmup_)};
-    const std::vector<std::string> pub{"--count", std::to_string(10 * (count + warmup_))};
-    std::vector<std::unique_ptr<Process>> procs;
-    if (multicore) {
-      procs.push_back(std::make_unique<Process>(
-          join(join({bin(name), "both"}, common, sub), pub, {}), log(name + "_both")));
-    } else {
-      procs.push_back(
-          std::make_unique<Process>(join({bin(name), "sub"}, common, sub), log(name + "_sub")));
-      std::this_thread::sleep_for(300ms);
-      procs.push_back(
-          std::make_unique<Process>(join({bin(name), "pub"}, common, pub), log(name + "_pub")));
-    }
-    return await_report(report, limit(r, count));
-  }
-
-  // The remote constellation: the sink on host 2, the source on host 1 (remote_hosts.hpp). Each
-  // run checks that the cues crossed the veth into host 2, so not by shared memory.
-  std::optional<Latency> framework_remote(const Row& r, const oscar::bench::RemoteHosts& hosts) {
-    const auto report = remote_file("oscar", r);
-    const auto sink = fmt::format(
-        "{{name: sink, network: {}, mode: single_step, kernels: [{{type: bench_sink, name: sink, "
-        "inputs: {{in: src/out}}, params: {{type: {}, report: '{}', expect: {}, warmup: {}}}}}]}}",
-        hosts.network(2), r.type, report, count_ + warmup_, warmup_);
-    const auto source = fmt::format(
-        "{{name: src, network: {}, mode: {{continuous: {}us}}, kernels: [{{type: bench_source, "
-        "name: src, params: {{type: {}}}}}]}}",
-        hosts.network(1), r.period_us, r.type);
-    const auto sink_file = dir_ + "/remote_sink.yaml", source_file = dir_ + "/remote_src.yaml";
-    std::ofstream(sink_file) << sink << "\n";
-    std::ofstream(source_file) << source << "\n";
-    return across(r, hosts, report,
-                  join(hosts.on(2), {bin("oscar-run"), sink_file, "--domain", dom()}, {}),
-                  join(hosts.on(1), {bin("oscar-run"), source_file, "--domain", dom()}, {}));
-  }
-
-  std::optional<Latency> raw_remote(const Row& r, const oscar::bench::RemoteHosts& hosts) {
-    const auto report = remote_file("raw", r);
-    const std::vector<std::string> common{"--type", r.type,        "--domain",
-                                          dom(),    "--period-us", std::to_string(r.period_us)};
-    const std::vector<std::string> sub{"sub",
-                                       "--report",
-                                       report,
-                                       "--expect",
-                                       std::to_string(count_ + warmup_),
-                                       "--warmup",
-                                       std::to_string(warmup_),
-                                       "--network",
-                                       hosts.network(2)};
-    const std::vector<std::string> pub{"pub", "--count", std::to_string(10 * (count_ + warmup_)),
-                                       "--network", hosts.network(1)};
-    return across(r, hosts, report,
-                  join(hosts.on(2), {bin("oscar-bench-raw")}, join(sub, common, {})),
-                  join(hosts.on(1), {bin("oscar-bench-raw")}, join(pub, common, {})));
-  }
-
- private:
-  std::optional<Latency> across(const Row& r, const oscar::bench::RemoteHosts& hosts,
-                                const std::string& report, const std::vector<std::string>& sink,
-                                const std::vector<std::string>& source) {
-    const auto before = hosts.received(2);
-    std::vector<std::unique_ptr<Process>> procs;
-    procs.push_back(std::make_unique<Process>(sink, log("remote_sink")));
-    std::this_thread::sleep_for(300ms);
-    procs.push_back(std::make_unique<Process>(source, log("remote_src")));
-    auto latency = await_report(report, limit(r));
-    procs.clear();
-    const auto after = hosts.received(2);
-    const auto cues = static_cast<std::uint64_t>(count_ + warmup_);
-    if (latency &&
-        (after.packets - before.packets < cues || after.bytes - before.bytes < cues * r.bytes)) {
-      std::cerr << fmt::format(
-          "bench cueflow: {} remote: only {} packets, {} bytes came into host 2 for {} cues: not "
-          "over UDP\n",
-          r.type, after.packets - before.packets, after.bytes - before.bytes, cues);
-      return std::nullopt;
-    }
-    return latency;
-  }
-  std::string remote_file(const char* who, const Row& r) {
-    auto f = fmt::format("{}/{}_{}_remote.json", dir_, who, r.type);
-    std::filesystem::remove(f);
-    return f;
-  }
-  static std::vector<std::string> join(std::vector<std::string> a,
-                                       const std::vector<std::string>& b,
-                                       const std::vector<std::string>& c) {
-    a.insert(a.end(), b.begin(), b.end());
-    a.insert(a.end(), c.begin(), c.end());
-    return a;
-  }
-  std::string dom() const { return std::to_string(domain_); }
-  std::string file(const char* who, const Row& r, bool multicore) {
-    auto f = fmt::format("{}/{}_{}_{}.json", dir_, who, r.type, multicore ? "multicore" : "local");
-    std::filesystem::remove(f);
-    return f;
-  }
-  std::string log(const std::string& who) const { return fmt::format("{}/{}.log", dir_, who); }
-  std::chrono::seconds limit(const Row& r, int count = 0) const {
-    return std::chrono::seconds(30 +
-                                ((count ? count : count_) + warmup_) * r.period_us / 1'000'000 * 3);
-  }
-  int count_, warmup_, domain_;
-  std::string dir_;
-};
 
 // The cue protections a keystore's governance may give cue topics (docs/security.md).
 const char* const kProtections[] = {"none", "sign", "encrypt"};
@@ -249,84 +71,6 @@ nlohmann::json system_row(const std::string& system, const Row& r, const std::st
   return {{"system", system},     {"type", r.type},  {"bytes", r.bytes}, {"constellation", c},
           {"p50_us", l.p50},      {"p90_us", l.p90}, {"p99_us", l.p99},  {"max_us", l.max},
           {"samples", l.samples}, {"runs", runs}};
-}
-
-// Issue 21 item 5: per row, the highest rate at which a trial of `seconds` (after a second of
-// warm-up) loses no cue, OSCAR beside raw Fast DDS (listener, synchronous, shared memory), and
-// the CPU % of that trial's processes (user + system over the trial's wall time, start-up
-// included; 100 = one core). Multicore and local only.
-int run_throughput(const std::vector<std::string>& types,
-                   const std::vector<std::string>& constellations, double seconds, int domain,
-                   const std::string& dir, bool json) {
-  const auto trial = [&](const Row& r, bool multicore, bool raw) {
-    return [&, r, multicore, raw](double rate) -> std::optional<oscar::bench::Trial> {
-      Row at = r;
-      at.period_us = std::max(1, static_cast<int>(std::lround(1e6 / rate)));
-      const int n = static_cast<int>(rate * seconds), warm = static_cast<int>(rate);
-      Bench b(n, warm, domain, dir);
-      rusage before{}, after{};
-      getrusage(RUSAGE_CHILDREN, &before);
-      const auto start = std::chrono::steady_clock::now();
-      const auto l =
-          raw ? b.program("oscar-bench-raw", oscar::bench::raw_config_args("listener,sync,shm"), at,
-                          multicore)
-              : b.framework(at, multicore);
-      const double wall =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      getrusage(RUSAGE_CHILDREN, &after);
-      const auto cpu_s = [](const rusage& u) {
-        return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-               static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec) / 1e6;
-      };
-      const bool lossless = l && l->gaps == 0 && l->samples >= n;
-      std::cerr << fmt::format("bench cueflow: throughput {} {} {} at {:.0f} Hz: {}\n", r.type,
-                               multicore ? "multicore" : "local", raw ? "raw" : "oscar", rate,
-                               !l         ? "no report"
-                               : lossless ? "no loss"
-                                          : fmt::format("{} lost", l->gaps));
-      if (!lossless) return std::nullopt;
-      return oscar::bench::Trial{(cpu_s(after) - cpu_s(before)) / wall * 100, l->rate_hz()};
-    };
-  };
-  nlohmann::json rows = nlohmann::json::array();
-  if (!json) {
-    std::cout << fmt::format(
-        "highest rate asked for that lost no cue over {:g} s, the rate the cues came at, and the "
-        "CPU of that trial\n{:<13} {:<10} {:>9} {:>9} {:>6} {:>9} {:>9} {:>6}\n",
-        seconds, "type", "constell.", "oscar Hz", "came Hz", "CPU %", "raw Hz", "came Hz", "CPU %");
-  }
-  for (const auto& r : kRows) {
-    if (std::find(types.begin(), types.end(), r.type) == types.end()) continue;
-    for (const auto& c : constellations) {
-      if (c == "remote") continue;
-      const bool multicore = c == "multicore";
-      const double start = 1e6 / r.period_us, cap = start * 128;
-      const auto ours =
-          oscar::bench::highest_lossless_rate(start, cap, 3, trial(r, multicore, false));
-      const auto raw =
-          oscar::bench::highest_lossless_rate(start, cap, 3, trial(r, multicore, true));
-      for (const auto& [system, t] : {std::pair{"oscar", ours}, std::pair{"fastdds", raw}}) {
-        rows.push_back({{"system", system},
-                        {"type", r.type},
-                        {"bytes", r.bytes},
-                        {"constellation", c},
-                        {"max_lossless_hz", t.rate_hz},
-                        {"achieved_hz", t.at.achieved_hz},
-                        {"cpu_pct", t.at.cpu_pct},
-                        {"seconds", seconds},
-                        {"capped", t.rate_hz >= cap}});
-      }
-      if (!json) {
-        std::cout << fmt::format(
-                         "{:<13} {:<10} {:>9.0f} {:>9.0f} {:>6.1f} {:>9.0f} {:>9.0f} {:>6.1f}\n",
-                         r.type, c, ours.rate_hz, ours.at.achieved_hz, ours.at.cpu_pct, raw.rate_hz,
-                         raw.at.achieved_hz, raw.at.cpu_pct)
-                  << std::flush;
-      }
-    }
-  }
-  if (json) std::cout << nlohmann::json{{"throughput", rows}}.dump() << "\n";
-  return 0;
 }
 
 }  // namespace
@@ -379,8 +123,8 @@ int main(int argc, char** argv) {
   const auto dir = std::filesystem::temp_directory_path() / fmt::format("oscar_bench_{}", getpid());
   std::filesystem::create_directories(dir);
   if (throughput_s > 0) {
-    const int code =
-        run_throughput(types, constellations, throughput_s, domain, dir.string(), json);
+    const int code = oscar::bench::run_throughput(types, constellations, throughput_s, domain,
+                                                  dir.string(), json);
     std::filesystem::remove_all(dir);
     return code;
   }
