@@ -29,6 +29,7 @@
 #include <oscar/dds_participant.hpp>
 #include <oscar/time.hpp>
 
+#include "peers/fastdds_cue_qos.hpp"
 #include "peers/peer_common.hpp"
 
 namespace fdds = eprosima::fastdds::dds;
@@ -56,22 +57,9 @@ T prototype() {
 }
 
 fdds::DataWriterQos writer_qos(const Config& c) {
-  fdds::DataWriterQos q = fdds::DATAWRITER_QOS_DEFAULT;
-  q.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
-  q.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
-  q.history().depth = 16;
-  q.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
+  auto q = oscar::bench::with_cue_qos(fdds::DATAWRITER_QOS_DEFAULT);
   q.publish_mode().kind =
       c.publish == "async" ? fdds::ASYNCHRONOUS_PUBLISH_MODE : fdds::SYNCHRONOUS_PUBLISH_MODE;
-  return q;
-}
-
-fdds::DataReaderQos reader_qos() {
-  fdds::DataReaderQos q = fdds::DATAREADER_QOS_DEFAULT;
-  q.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
-  q.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
-  q.history().depth = 16;  // as bench_sink's input
-  q.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
   return q;
 }
 
@@ -128,7 +116,8 @@ int run(const PeerOptions& o, const Config& c) {
   if (o.mode != "pub") {
     const bool listener = c.delivery == "listener";
     reader = participant.subscriber().create_datareader(
-        &topic, reader_qos(), listener ? &taker : nullptr,
+        &topic, oscar::bench::with_cue_qos(fdds::DATAREADER_QOS_DEFAULT),
+        listener ? &taker : nullptr,
         listener ? fdds::StatusMask::data_available() : fdds::StatusMask::none());
     if (!listener) waiter = std::thread([&] { wait_and_take(*reader, taker, log); });
   }
