@@ -176,12 +176,7 @@ std::vector<Point> Scheduler::parked_in(const Polygon& area) const {
     if (node->broken || node->working.points().empty()) continue;
     const auto& last = node->working.points().back();
     const Point p(last.x, last.y);
-    if (!boost::geometry::covered_by(p, area)) continue;
-    if (std::any_of(world_.static_obstacles.begin(), world_.static_obstacles.end(),
-                    [&](const Polygon& o) { return boost::geometry::covered_by(p, o); })) {
-      continue;
-    }
-    places.push_back(p);
+    if (boost::geometry::covered_by(p, area)) places.push_back(p);
   }
   return places;
 }

@@ -251,10 +251,10 @@ class Scheduler {
                        const std::map<std::string, std::vector<std::string>>& depends,
                        std::map<std::string, double> placed, const std::optional<Point>& at,
                        TransactionId tx, ScheduleResult& result);
-  // Where robots stand after their last job, if inside `area` and outside static obstacles:
-  // places a job there may be done that the samples of Anhang A.1 need not offer. In a crowded
-  // area robots parked at earlier jobs block the samples, and the robot standing in the area
-  // could do the job where it stands.
+  // Where robots stand after their last job, if inside `area`: places a job there may be done
+  // that the samples of Anhang A.1 need not offer. In a crowded area robots parked at earlier
+  // jobs block the samples, and the robot standing in the area could do the job where it stands.
+  // (Whether a node may stand there is checked as for any location, in qualifying_slots.)
   std::vector<Point> parked_in(const Polygon& area) const;
   bool try_schedule(const JobSpec& spec, TransactionId tx, const std::optional<Point>& at,
                     std::string& reason, Job& scheduled);
