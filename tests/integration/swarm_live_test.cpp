@@ -220,6 +220,7 @@ TEST_F(LiveSwarm, ASilentRobotTimesOutAndTheJobIsPlacedElsewhere) {
 }
 
 TEST_F(LiveSwarm, BadJobSpecificationsAreRefusedWithTheReason) {
+  all_in_planning();  // its last job is a good one, planned and proposed like any other
   auto too_short = job("short", 5, 5, 3, 4, 2);  // a 1 s window for 2 s of work
   const auto a = client_->outcome(client_->schedule(too_short));
   EXPECT_EQ(a.outcome(), SWARM_REFUSED);
