@@ -250,7 +250,8 @@ SystemUnderTest::SystemUnderTest(const std::string& system_file, BootOptions opt
     return is_port_of_domain(name, domain_);
   }).sweep();
   register_standard_cue_types();
-  participant_ = std::make_unique<DdsParticipant>(domain_, "oscar-test");
+  // The network profile of the system's local host: its interfaces, peers or discovery servers.
+  participant_ = tool_participant("oscar-test", file_, "", domain_);
   registry_ = std::make_unique<RegistryClient>(*participant_, "test");
   config_ = std::make_unique<ConfigClient>(*participant_, "boot");
 
