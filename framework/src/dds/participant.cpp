@@ -106,8 +106,8 @@ dds::DomainParticipantQos participant_qos(const std::string& name, const Network
   if (net.shared_memory) user.push_back(internal::unique_shared_memory_locator());
   internal::configure_discovery(builtin, net, domain);  // static peers or discovery servers
   // Leave quickly: a vanished participant must not linger for 20 s. Announced every second, not
-  // more: every announcement goes to every participant, so a hundred of them announcing every
-  // 200 ms kept both cores of the test machine busy with discovery alone (docs/network.md).
+  // every 200 ms: each announcement goes to every participant, and booting a hundred modules on
+  // two cores, UDP sends were most of their CPU time (perf; docs/network.md).
   builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(3, 0);
   builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(1, 0);
   return qos;
