@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <functional>
 #include <future>
+#include <map>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -102,11 +103,21 @@ void check_ssh_hosts(const oscar::SystemSpec& system, const std::string& file, b
   }
 }
 
+// The modules that do not run, the first few by name: a system of a hundred modules would
+// otherwise print lines of a hundred names.
 std::string summary(const oscar::SystemState& s) {
+  constexpr std::size_t kNamed = 8;
   std::vector<std::string> parts;
+  std::size_t others = 0;
   for (const auto& m : s.modules()) {
-    if (m.status() != "running") parts.push_back(m.name() + " " + m.status());
+    if (m.status() == "running") continue;
+    if (parts.size() < kNamed) {
+      parts.push_back(m.name() + " " + m.status());
+    } else {
+      ++others;
+    }
   }
+  if (others > 0) parts.push_back(fmt::format("and {} more", others));
   return parts.empty() ? std::string() : " [" + fmt::format("{}", fmt::join(parts, ", ")) + "]";
 }
 
@@ -171,6 +182,23 @@ bool wait_until(const std::function<bool()>& done, Clock::duration timeout, Stop
     log.flush();
   }
   return true;
+}
+
+// The discovery servers of a system whose network says `discovery: server`, by process name,
+// each with its command line; they run on the local host (where boot runs).
+std::map<std::string, std::vector<std::string>> discovery_servers(const oscar::SystemSpec& system,
+                                                                  const std::string& file,
+                                                                  const std::string& domain) {
+  const auto& local = system.local_host();
+  const auto network = oscar::NetworkConfig::for_host(system.root, local.name);
+  std::map<std::string, std::vector<std::string>> servers;
+  if (network.discovery != oscar::Discovery::kServer) return servers;
+  for (std::size_t i = 0; i < network.discovery_servers.size(); ++i) {
+    servers["discovery-server-" + std::to_string(i)] = oscar::on_host(
+        local, {oscar::sibling_program("oscar-discovery-server"), "--system", file, "--host",
+                local.name, "--domain", domain, "--index", std::to_string(i)});
+  }
+  return servers;
 }
 
 std::chrono::milliseconds seconds(double s) {
@@ -294,9 +322,12 @@ int main(int argc, char** argv) {
         participant, oscar::topics::log(),
         [&](const oscar::LogRecord& r, const auto&) { log.add(r); });
 
-    // Registry first (it waits for the monitors), then one monitor per host.
+    // The discovery servers first (every other participant is their client; stopped last),
+    // then the registry (it waits for the monitors), then one monitor per host.
     oscar::Supervisor children(log_dir);
     const auto dom = std::to_string(system.domain);
+    const auto servers = discovery_servers(system, file, dom);
+    for (const auto& [name, command] : servers) children.start(name, 1, command);
     children.start("registry", 1,
                    {oscar::sibling_program("oscar-registry"), "--system", file, "--host",
                     local.name, "--domain", dom});
@@ -320,12 +351,19 @@ int main(int argc, char** argv) {
     };
     bool registry_gone = false;
     bool registry_ended_orderly = false;  // exit code 0, asked by someone other than boot
+    bool shutting_down = false;
     const auto registry_exited = [&] {
       for (const auto& x : children.reap()) {
         // Code 0 is an orderly end (oscar shutdown, SIGTERM), also when its 'stopped' state
         // has not reached boot yet.
         if (x.exit_code != 0) {
           log.note("boot", fmt::format("{} {}", x.module, x.describe()), oscar::LOG_ERROR);
+        }
+        // A discovery server that died is started again: its clients find it at its address and
+        // tell it again what they have (meanwhile the other one, if any, serves them).
+        if (const auto it = servers.find(x.module); it != servers.end() && !shutting_down) {
+          log.note("boot", fmt::format("restarting {}", x.module), oscar::LOG_WARN);
+          children.start(x.module, x.incarnation + 1, it->second);
         }
         if (x.module == "registry") {
           registry_gone = true;
@@ -360,6 +398,7 @@ int main(int argc, char** argv) {
                  stop, log);
     }
     const int stops_before = stop.count();
+    shutting_down = true;
     // The registry may exit before its 'stopped' state reaches boot; boot asked it for nothing,
     // so an orderly exit was asked from elsewhere.
     if (state_is("stopped") || (registry_gone && registry_ended_orderly && stop.count() == 0)) {

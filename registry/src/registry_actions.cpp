@@ -2,6 +2,7 @@
 // configuration commands, the orderly shutdown and the published system state.
 #include <algorithm>
 #include <future>
+#include <map>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -17,6 +18,11 @@
 namespace oscar {
 namespace {
 constexpr std::chrono::milliseconds kFirstBeatGrace{3000};
+// At boot, modules of one host start at most this many at a time. A starting process loads its
+// plugins and discovers every other participant; a hundred of them at once on two cores starved
+// the running ones' heartbeats past their lease (300 ms), and each failure suspended the system
+// and made it busier still (tests/integration/scale_test.cpp).
+constexpr int kStartingPerHost = 8;
 }  // namespace
 
 void Registry::launch(Tracked& m, unsigned incarnation) {
@@ -39,10 +45,16 @@ void Registry::launch(Tracked& m, unsigned incarnation) {
 // backoff has passed (once the failed process is gone and its host's monitor answers).
 void Registry::tick() {
   const auto now = Clock::now();
+  std::map<std::string, int> starting;  // per host
+  for (const auto& m : modules_) {
+    if (m->status == "starting") ++starting[m->spec->spec.host];
+  }
   for (auto& m : modules_) {
     const auto& mon = monitors_[m->spec->spec.host];
     if (!mon.alive) continue;
     if (m->status == "waiting") {
+      if (starting[m->spec->spec.host] >= kStartingPerHost) continue;
+      ++starting[m->spec->spec.host];
       launch(*m, 1);
       publish();
     } else if (m->status == "restarting" && m->process_gone && now >= m->restart_at) {

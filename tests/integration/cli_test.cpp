@@ -12,12 +12,14 @@ namespace {
 using namespace std::chrono_literals;
 using testing::HasSubstr;
 
-const char* const kTools[] = {
-    "oscar-applet",  "oscar-applets",    "oscar-boot", "oscar-config", "oscar-coordinator",
-    "oscar-echo",    "oscar-graph",      "oscar-hz",   "oscar-info",   "oscar-log",
-    "oscar-monitor", "oscar-new-module", "oscar-ps",   "oscar-record", "oscar-registry",
-    "oscar-replay",  "oscar-restart",    "oscar-run",  "oscar-swarm",  "oscar-shutdown",
-    "oscar-topics",  "oscar-bridge"};
+const char* const kTools[] = {"oscar-applet",     "oscar-applets",     "oscar-boot",
+                              "oscar-config",     "oscar-coordinator", "oscar-discovery-server",
+                              "oscar-echo",       "oscar-graph",       "oscar-hz",
+                              "oscar-info",       "oscar-log",         "oscar-monitor",
+                              "oscar-new-module", "oscar-ps",          "oscar-record",
+                              "oscar-registry",   "oscar-replay",      "oscar-restart",
+                              "oscar-run",        "oscar-swarm",       "oscar-shutdown",
+                              "oscar-topics",     "oscar-bridge"};
 
 struct Run {
   int exit_code;

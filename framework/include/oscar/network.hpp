@@ -19,26 +19,52 @@ struct ParticipantSecurity {
   std::string identity;  ///< e.g. "registry", "monitor.h1", "module.camera", "operator"
 };
 
+/// Participant ids one domain has on one address: RTPS gives a domain 250 ports (spec 9.6.1.1)
+/// and each participant two of them, from offset 10, so ids 0-119 stay in their domain's range.
+inline constexpr int kParticipantIdsPerDomain = 120;
+
+/// How the participants of a system find each other (docs/network.md).
+enum class Discovery {
+  kStaticPeers,  ///< each announces itself to every participant id of every peer (Fast DDS SIMPLE)
+  kServer,       ///< each is a client of the discovery servers `oscar boot` starts
+};
+
 /// The transport profile of a DDS participant. The default confines it to the loopback
 /// interface: UDP on 127.0.0.1 with unicast discovery to localhost, plus shared memory; no
-/// multicast, no other interface. A system file may name other interfaces and peers.
+/// multicast, no other interface. A system file may name other interfaces and peers, or use
+/// discovery servers.
 struct NetworkConfig {
   std::vector<std::string> interfaces{"127.0.0.1"};  ///< IPv4 addresses UDP may use
   std::vector<std::string> peers{"127.0.0.1"};       ///< hosts discovery announces itself to
   bool shared_memory = true;
   std::uint32_t shm_segment_bytes = 8u << 20;  ///< must hold the largest cues in flight
-  int max_participants_per_host = 32;          ///< participant ids probed per peer
+  /// Participant ids taken and probed per address (at most kParticipantIdsPerDomain).
+  int max_participants_per_host = kParticipantIdsPerDomain;
+  Discovery discovery = Discovery::kStaticPeers;
+  /// kServer: the address of each discovery server, one or two (then either one suffices); the
+  /// i-th listens on discovery_server_port(domain, i).
+  std::vector<std::string> discovery_servers;
   /// DDS Security's builtin plugins with this identity; none: a plain participant.
   std::optional<ParticipantSecurity> security;
 
-  /// Reads a `network:` map (interfaces, peers, shared_memory, shm_segment_bytes).
-  /// @throws std::invalid_argument on unknown keys or non-IPv4 addresses.
+  /// Reads a `network:` map (interfaces, peers, shared_memory, shm_segment_bytes,
+  /// max_participants_per_host, discovery, discovery_servers) over `base`.
+  /// @throws std::invalid_argument on unknown keys, bad values or non-IPv4 addresses.
+  static NetworkConfig from_yaml(const YAML::Node& node, NetworkConfig base);
+  /// ... over the loopback default.
   static NetworkConfig from_yaml(const YAML::Node& node);
-  /// The profile of a process on `host` of a system file: the file's `network:` if given, else
-  /// the loopback default; a host with an `address:` (a test host in a network namespace) uses
-  /// that address and announces itself to the addresses of all the system's hosts.
+  /// The profile of a process on `host` of a system file: a host with an `address:` (a test host
+  /// in a network namespace) uses that address and announces itself to the addresses of all the
+  /// system's hosts, else the loopback default; the file's `network:` keys override that.
+  /// Discovery servers default to the address of the system's local host (where boot runs).
   static NetworkConfig for_host(const YAML::Node& system, const std::string& host);
 };
+
+/// The participant id discovery server `index` (0 or 1) of a domain takes on its address: the
+/// highest ones, which clients, taking the lowest free id, reach last.
+int discovery_server_participant_id(int index);
+/// The UDP port discovery server `index` of `domain` listens on (its id's discovery port).
+std::uint32_t discovery_server_port(int domain, int index);
 
 /// The domain id from $OSCAR_DOMAIN, else `fallback`.
 int domain_from_env(int fallback);

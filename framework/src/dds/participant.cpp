@@ -18,6 +18,7 @@
 #include <yaml-cpp/yaml.h>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/log/Log.hpp>
+#include "dds/discovery.hpp"
 #include "dds/guarded_type.hpp"
 #include "dds/participant_identity.hpp"
 #include "dds/udp_tuning.hpp"
@@ -119,26 +120,19 @@ dds::DomainParticipantQos participant_qos(const std::string& name, const Network
     user.push_back(l);
   }
   if (net.shared_memory) user.push_back(internal::unique_shared_memory_locator());
-  builtin.initialPeersList.clear();
-  for (const auto& peer : net.peers) {
-    for (int id = 0; id < net.max_participants_per_host; ++id) {
-      Locator_t l;
-      IPLocator::setIPv4(l, peer);
-      l.port = metatraffic_unicast_port(domain, id);
-      builtin.initialPeersList.push_back(l);
-    }
-  }
-  // Leave quickly and announce often: a vanished participant must not linger for 20 s.
+  internal::configure_discovery(builtin, net, domain);  // static peers or discovery servers
+  // Leave quickly: a vanished participant must not linger for 20 s. Announced every second, not
+  // every 200 ms: each announcement goes to every participant, and booting a hundred modules on
+  // two cores, UDP sends were most of their CPU time (perf; docs/network.md).
   builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(3, 0);
-  builtin.discovery_config.leaseDuration_announcementperiod =
-      eprosima::fastrtps::Duration_t(0, 200000000);
+  builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(1, 0);
   return qos;
 }
 
 }  // namespace
 
-NetworkConfig NetworkConfig::from_yaml(const YAML::Node& node) {
-  NetworkConfig net;
+NetworkConfig NetworkConfig::from_yaml(const YAML::Node& node, NetworkConfig base) {
+  NetworkConfig net = std::move(base);
   if (!node || node.IsNull()) return net;
   if (!node.IsMap()) throw std::invalid_argument("network: expected a map");
   const auto addresses = [](const YAML::Node& list, const char* key) {
@@ -155,41 +149,93 @@ NetworkConfig NetworkConfig::from_yaml(const YAML::Node& node) {
     }
     return out;
   };
+  bool servers_given = false;
   for (const auto& kv : node) {
     const auto key = kv.first.as<std::string>();
-    if (key == "interfaces")
+    if (key == "interfaces") {
       net.interfaces = addresses(kv.second, "interfaces");
-    else if (key == "peers")
+    } else if (key == "peers") {
       net.peers = addresses(kv.second, "peers");
-    else if (key == "shared_memory")
+    } else if (key == "shared_memory") {
       net.shared_memory = kv.second.as<bool>();
-    else if (key == "shm_segment_bytes")
+    } else if (key == "shm_segment_bytes") {
       net.shm_segment_bytes = kv.second.as<std::uint32_t>();
-    else if (key == "max_participants_per_host")
+    } else if (key == "max_participants_per_host") {
       net.max_participants_per_host = kv.second.as<int>();
-    else {
+      if (net.max_participants_per_host < 1 ||
+          net.max_participants_per_host > kParticipantIdsPerDomain) {
+        throw std::invalid_argument(
+            fmt::format("network.max_participants_per_host: {} is not in 1..{} (the ids a domain's "
+                        "ports leave room for)",
+                        net.max_participants_per_host, kParticipantIdsPerDomain));
+      }
+    } else if (key == "discovery") {
+      const auto kind = kv.second.as<std::string>();
+      if (kind == "static") {
+        net.discovery = Discovery::kStaticPeers;
+      } else if (kind == "server") {
+        net.discovery = Discovery::kServer;
+      } else {
+        throw std::invalid_argument(
+            fmt::format("network.discovery: '{}' is neither static nor server", kind));
+      }
+    } else if (key == "discovery_servers") {
+      net.discovery_servers = addresses(kv.second, "discovery_servers");
+      servers_given = true;
+      if (net.discovery_servers.size() > 2) {
+        throw std::invalid_argument(fmt::format(
+            "network.discovery_servers: {} addresses; one server, or two for redundancy",
+            net.discovery_servers.size()));
+      }
+    } else {
       throw std::invalid_argument(
           fmt::format("network: unknown key '{}' (allowed: interfaces, peers, shared_memory, "
-                      "shm_segment_bytes, max_participants_per_host)",
+                      "shm_segment_bytes, max_participants_per_host, discovery, "
+                      "discovery_servers)",
                       key));
     }
+  }
+  if (servers_given && net.discovery != Discovery::kServer) {
+    throw std::invalid_argument("network.discovery_servers: given without discovery: server");
+  }
+  if (net.discovery == Discovery::kServer && net.discovery_servers.empty()) {
+    net.discovery_servers = {net.interfaces.front()};
   }
   return net;
 }
 
+NetworkConfig NetworkConfig::from_yaml(const YAML::Node& node) {
+  return from_yaml(node, NetworkConfig{});
+}
+
 NetworkConfig NetworkConfig::for_host(const YAML::Node& system, const std::string& host) {
-  if (system["network"]) return from_yaml(system["network"]);
   NetworkConfig net;
   const auto hosts = system["hosts"];
-  if (!hosts || !hosts.IsMap() || host.empty() || !hosts[host] || !hosts[host]["address"]) {
-    return net;
-  }
-  net.interfaces = {hosts[host]["address"].as<std::string>()};
-  net.peers.clear();
-  for (const auto& kv : hosts) {
-    if (kv.second.IsMap() && kv.second["address"]) {
-      net.peers.push_back(kv.second["address"].as<std::string>());
+  if (hosts && hosts.IsMap()) {
+    if (!host.empty() && hosts[host] && hosts[host]["address"]) {
+      net.interfaces = {hosts[host]["address"].as<std::string>()};
+      net.peers.clear();
+      for (const auto& kv : hosts) {
+        if (kv.second.IsMap() && kv.second["address"]) {
+          net.peers.push_back(kv.second["address"].as<std::string>());
+        }
+      }
     }
+    // Boot starts the discovery servers on its own host: every host's processes reach them there.
+    for (const auto& kv : hosts) {
+      if (kv.second.IsMap() && kv.second["local"] && kv.second["address"]) {
+        net.discovery_servers = {kv.second["address"].as<std::string>()};
+        break;
+      }
+    }
+  }
+  if (net.discovery_servers.empty()) net.discovery_servers = {"127.0.0.1"};
+  // from_yaml keeps these only for discovery: server (where they are the default).
+  const auto default_servers = std::move(net.discovery_servers);
+  net.discovery_servers.clear();
+  net = from_yaml(system["network"], std::move(net));
+  if (net.discovery == Discovery::kServer && !system["network"]["discovery_servers"]) {
+    net.discovery_servers = default_servers;
   }
   return net;
 }
@@ -338,7 +384,8 @@ DdsParticipant::DdsParticipant(int domain, const std::string& name, const Networ
   // The lowest id no other process has claimed (see participant_identity.hpp) and whose port
   // nobody else (e.g. a plain Fast DDS program) has bound.
   const auto& address = network.interfaces.front();
-  for (int id = 0; id < network.max_participants_per_host && !participant_; ++id) {
+  const int ids = internal::participant_ids(network, domain);
+  for (int id = 0; id < ids && !participant_; ++id) {
     auto claim = std::make_unique<internal::ParticipantIdClaim>(domain, address, id);
     if (!*claim || !udp_port_free(address, metatraffic_unicast_port(domain, id))) continue;
     participant_ = factory->create_participant(domain, participant_qos(name, network, domain, id),
@@ -361,7 +408,7 @@ DdsParticipant::DdsParticipant(int domain, const std::string& name, const Networ
     throw std::runtime_error(fmt::format(
         "cannot create a DDS participant '{}' on domain {}: no free participant id among {} "
         "on {}",
-        name, domain, network.max_participants_per_host, network.interfaces.front()));
+        name, domain, ids, network.interfaces.front()));
   }
   publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
   subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);

@@ -29,6 +29,7 @@
 #include "oscar/module_spec.hpp"
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/registry/running_systems.hpp"
+#include "oscar/registry/system_spec.hpp"
 #include "oscar/security_files.hpp"
 #include "oscar/shared_memory.hpp"
 #include "oscar/testing/eventually.hpp"
@@ -252,10 +253,12 @@ SystemUnderTest::SystemUnderTest(const std::string& system_file, BootOptions opt
     return is_port_of_domain(name, domain_);
   }).sweep();
   register_standard_cue_types();
-  NetworkConfig network;
-  const auto keystore = options.keystore.empty()
-                            ? security_files::system_keystore(load_yaml_file(file_), file_)
-                            : fs::absolute(options.keystore).string();
+  // The network profile of the system's local host (its interfaces, peers or discovery servers)
+  // with boot's authority; a keystore given to this test wins over the file's.
+  const auto system = SystemSpec::load(file_);
+  auto network = system.network_for(system.local_host().name, security_files::kOperatorBoot);
+  const auto keystore =
+      options.keystore.empty() ? std::string{} : fs::absolute(options.keystore).string();
   if (!keystore.empty()) {
     network.security = ParticipantSecurity{keystore, security_files::kOperatorBoot};
   }
