@@ -128,14 +128,13 @@ std::unique_ptr<DdsParticipant> tool_participant(const std::string& name, std::s
   const std::string identity = authority == ToolAuthority::kActAsBoot
                                    ? security_files::kOperatorBoot
                                    : security_files::kOperator;
-  if (system_file.empty() && domain < 0) {
-    domain = domain_from_env(-1);
-    if (domain < 0) {
-      // The system booted on this machine, with its own network profile.
-      const auto running = default_system();
-      domain = running ? running->domain : 0;
-      if (running && std::filesystem::exists(running->file)) system_file = running->file;
-    }
+  if (system_file.empty()) {
+    // The system booted on this machine (on the domain named, if one was), with its own network
+    // profile: its hosts' addresses, or its discovery servers.
+    if (domain < 0) domain = domain_from_env(-1);
+    const auto running = domain < 0 ? default_system() : running_system(domain);
+    if (domain < 0) domain = running ? running->domain : 0;
+    if (running && std::filesystem::exists(running->file)) system_file = running->file;
   }
   NetworkConfig network;
   std::optional<SystemSpec> system;

@@ -62,8 +62,9 @@ enum class ToolAuthority { kLook, kActAsBoot };
 
 /// The participant of a command-line tool: with `system_file`, that system's domain and the
 /// network of its host `host` (default: its local host); `domain` >= 0 overrides the domain.
-/// Told neither, it takes $OSCAR_DOMAIN, else the system booted on this machine (its domain and
-/// file; see default_system()), else domain 0 on loopback. It authenticates with the
+/// Without a file it takes the domain given, else $OSCAR_DOMAIN, else that of the system booted
+/// on this machine (see default_system()), else domain 0; and the file of the system booted on
+/// that domain here, if any (its network: addresses, discovery servers), else loopback. It authenticates with the
 /// system's keystore ($OSCAR_KEYSTORE, the file's, or the one boot was given) as the identity
 /// `authority` names, if the system has one.
 /// @throws std::invalid_argument if several systems run and none was named.
