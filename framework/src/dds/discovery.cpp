@@ -27,6 +27,10 @@ std::uint32_t discovery_server_port(int domain, int index) {
 namespace internal {
 namespace {
 
+// How often clients ping their servers until they are matched, and servers go through what
+// they learned (Fast DDS's default: 450 ms).
+const eprosima::fastrtps::Duration_t kServerSyncPeriod(0, 50'000'000);
+
 Locator_t udp_locator(const std::string& address, std::uint32_t port) {
   Locator_t l;
   IPLocator::setIPv4(l, address);
@@ -78,6 +82,7 @@ void configure_discovery(eprosima::fastrtps::rtps::BuiltinAttributes& builtin,
     // participants it shares a topic with), but from the servers alone: nobody announces
     // itself to every participant id of every host any more.
     discovery.discoveryProtocol = DiscoveryProtocol::SUPER_CLIENT;
+    discovery.discoveryServer_client_syncperiod = kServerSyncPeriod;
     for (std::size_t i = 0; i < net.discovery_servers.size(); ++i) {
       discovery.m_DiscoveryServers.push_back(
           remote_server(net.discovery_servers[i], domain, static_cast<int>(i)));
@@ -123,6 +128,7 @@ dds::DomainParticipantQos discovery_server_qos(const NetworkConfig& net, int dom
   wire.participant_id = discovery_server_participant_id(index);
   auto& builtin = wire.builtin;
   builtin.discovery_config.discoveryProtocol = DiscoveryProtocol::SERVER;
+  builtin.discovery_config.discoveryServer_client_syncperiod = kServerSyncPeriod;
   builtin.avoid_builtin_multicast = true;
   builtin.metatrafficMulticastLocatorList.clear();
   builtin.metatrafficUnicastLocatorList.clear();
