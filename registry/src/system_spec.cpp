@@ -7,6 +7,7 @@
 #include <set>
 #include <stdexcept>
 
+#include <fastrtps/config.h>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -384,6 +385,14 @@ SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
   std::vector<std::string> names;
   for (const auto& m : s.modules) names.push_back(m.spec.name);
   const auto keystore = s.keystore();
+  if (!keystore.empty() && NetworkConfig::for_host(root, "").discovery == Discovery::kServer) {
+    // Authentication changes a participant's GUID prefix, so clients no longer find a server at
+    // the one they are told; Fast DDS 2.10 made discovery servers work with security.
+    fail(yaml_where(file, root["network"]["discovery"]),
+         fmt::format("network.discovery: server cannot run with DDS Security (keystore {}): "
+                     "Fast DDS {}.{} has no authenticated discovery server; use discovery: static",
+                     keystore, FASTRTPS_VERSION_MAJOR, FASTRTPS_VERSION_MINOR));
+  }
   for (auto& m : s.modules) {
     m.spec.system_modules = names;
     if (!keystore.empty()) {

@@ -123,6 +123,16 @@ TEST(SystemSpec, SecuritySectionRefusesUnknownKeysAndProtections) {
               HasSubstr("s.yaml:2: security: expected {keystore: DIR"));
 }
 
+TEST(SystemSpec, ADiscoveryServerWithAKeystoreIsRefusedNamingTheRule) {
+  EXPECT_THAT(error_of(std::string(kOneModule) +
+                       "security: { keystore: /etc/oscar/keys }\nnetwork: { discovery: server }\n"),
+              HasSubstr("s.yaml:3: network.discovery: server cannot run with DDS Security "
+                        "(keystore /etc/oscar/keys): Fast DDS 2.9 has no authenticated discovery "
+                        "server; use discovery: static"));
+  EXPECT_NO_THROW(parse(std::string(kOneModule) + "network: { discovery: server }\n"));
+  EXPECT_NO_THROW(parse(std::string(kOneModule) + "security: { keystore: /etc/oscar/keys }\n"));
+}
+
 TEST(SystemSpec, UnknownHostIsAnErrorListingTheHosts) {
   EXPECT_THAT(error_of(R"(
 hosts: { a: { local: true } }
