@@ -2,20 +2,28 @@
 // @foxglove/ws-protocol (the client Foxglove connects with), @foxglove/omgidl-parser and
 // @foxglove/omgidl-serialization (how Foxglove decodes `omgidl` + `cdr` channels).
 //
-//   node bridge_client.js --url ws://127.0.0.1:PORT --late oscar-run ARGS...
+//   node bridge_client.js --url ws://127.0.0.1:PORT --config-url ws://127.0.0.1:PORT2
+//        --late oscar-run ARGS...
 //
-// The system under test publishes oscar::Bool on oscar/cue/sig/out every 20 ms and oscar::GvImage
-// (640 x 480) on oscar/cue/cam/out every 50 ms; --late is the command of a module whose topic
-// oscar/cue/late/out appears only when this script starts it. Prints what it measured as JSON
-// and exits 1 if a check failed.
+// The system under test publishes oscar::Bool on oscar/cue/sig/out every 20 ms, oscar::GvImage
+// (640 x 480) on oscar/cue/cam/out every 50 ms and robot r7's oscar::RobotState every 100 ms;
+// --url is a bridge started without --allow-config, --config-url one started with it; --late is
+// the command of a module whose topic oscar/cue/late/out appears only when this script starts
+// it. The side channels are checked in bridge_views.js, the services in bridge_services.js.
+// Prints what it measured as JSON and exits 1 if a check failed.
 "use strict";
 const { spawn } = require("child_process");
 const WebSocket = require("ws");
 const { FoxgloveClient } = require("@foxglove/ws-protocol");
 const { parseIDL } = require("@foxglove/omgidl-parser");
 const { MessageReader } = require("@foxglove/omgidl-serialization");
+const { checkSideChannels } = require("./bridge_views");
+const { checkServices } = require("./bridge_services");
 
-const args = { url: process.argv[process.argv.indexOf("--url") + 1] };
+const args = {
+  url: process.argv[process.argv.indexOf("--url") + 1],
+  configUrl: process.argv[process.argv.indexOf("--config-url") + 1],
+};
 const lateCommand = process.argv.slice(process.argv.indexOf("--late") + 1);
 const SIG = "oscar/cue/sig/out", CAM = "oscar/cue/cam/out", LATE = "oscar/cue/late/out";
 const STATE = "oscar/system/state";
@@ -43,9 +51,9 @@ async function until(predicate, ms) {
 // One client: its channels by topic, decoders made from the advertised schema alone, and
 // every message it received by subscription.
 class Client {
-  constructor(name) {
+  constructor(name, url = args.url) {
     this.name = name;
-    this.ws = new WebSocket(args.url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]);
+    this.ws = new WebSocket(url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]);
     this.client = new FoxgloveClient({ ws: this.ws });
     this.channels = new Map();  // topic -> channel
     this.unadvertised = new Set();
@@ -53,6 +61,8 @@ class Client {
     this.received = new Map();  // subscription id -> [{ at, timestamp, msg, bytes }]
     this.statuses = [];
     this.errors = [];
+    this.services = new Map();  // name -> service
+    this.client.on("advertiseServices", (services) => { for (const s of services) this.services.set(s.name, s); });
     this.client.on("serverInfo", (info) => { this.serverInfo = info; });
     this.client.on("advertise", (channels) => {
       for (const c of channels) { this.channels.set(c.topic, c); this.unadvertised.delete(c.id); }
@@ -142,7 +152,7 @@ async function main() {
     const state = (a.received.get(stateSub)[0] || {}).msg || {};
     const modules = (state.modules || []).map((m) => `${m.name}:${m.status}`).sort().join(" ");
     check(state.system === "viewed" && state.state === "running" &&
-          modules === "camera:running sources:running",
+          modules === "camera:running robot:running sources:running",
           `the last system state arrives on subscribing and decodes: ${state.system} ${state.state}, ${modules}`);
     a.client.unsubscribe(stateSub);
   }
@@ -185,6 +195,9 @@ async function main() {
   figures.healthy_client_bools = { received: bools.length, lost, told };
   check(lost <= told && lost <= 0.05 * bools.length,
         `the Bool messages this client did not get were dropped and reported (${lost} missing, ${told} reported)`);
+
+  // 3b. Side channels in Foxglove's schemas, the system graph, converting only when subscribed.
+  await checkSideChannels(a, { check, until, sleep, figures, imageComplete });
 
   // 4. A topic that appears later is advertised, served, and unadvertised when it goes.
   const child = spawn(lateCommand[0], lateCommand.slice(1), { stdio: "ignore" });
@@ -237,6 +250,9 @@ async function main() {
   check(figures.stalled_images.told === figures.stalled_images.lost,
         `every image it missed was reported dropped (${figures.stalled_images.lost} missing, ${figures.stalled_images.told} reported)`);
   check(stalled.received.get(stalledSig).length > 0, "it still gets Bool messages after resuming");
+
+  // 6. Configuration from Foxglove: only with --allow-config; malformed calls refused.
+  await checkServices(a, args.configUrl, { check, until, sleep, Client, figures, rateHz });
   for (const c of [a, b, stalled]) check(c.errors.length === 0, `client ${c.name}: no errors ${c.errors.join("; ")}`);
   for (const c of [a, b, stalled]) c.close();
 }

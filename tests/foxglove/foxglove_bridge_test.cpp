@@ -1,6 +1,8 @@
 // oscar bridge foxglove against a booted system, checked by Foxglove's own client libraries
-// (bridge_client.js with @foxglove/ws-protocol and @foxglove/omgidl-serialization, run by
-// Node.js). Skipped where node or npm is missing.
+// (bridge_client.js with @foxglove/ws-protocol, @foxglove/omgidl-serialization and
+// @foxglove/schemas, run by Node.js): one bridge as started by default, one with
+// --allow-config; and the bridge's schemas for Foxglove's types held to the published ones
+// (schema_checks.js). Skipped where node or npm is missing.
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -11,7 +13,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include "booted_system.hpp"  // tests/integration
+#include "foxglove_messages.hpp"
+#include "json_schemas.hpp"
 
 namespace oscar {
 namespace {
@@ -71,6 +77,77 @@ int served_port(const Process& bridge) {
   return 0;
 }
 
+// The schemas the bridge advertises for Foxglove's types are its own, declaring only the fields
+// it sends. Each must follow Foxglove's published schema of that name: every field it declares
+// exists there at the same place with the same type, and it declares all the published one
+// requires; and what the encoders make conforms to both and sends nothing undeclared. A field
+// whose name or type drifts from Foxglove's fails here.
+TEST(FoxgloveBridge, ItsSchemasForFoxglovesTypesFollowThePublishedOnes) {
+  const auto node = on_path("node"), npm = on_path("npm");
+  if (node.empty() || npm.empty()) GTEST_SKIP() << "node/npm not found (see the test below)";
+  ASSERT_EQ(install_client_packages(npm), "");
+  using nlohmann::json;
+  CueHeader header;
+  header.stamps({1'700'000'000'123'456'789ull});
+  header.source("cam/out");
+  GvImage grey;
+  grey.header(header);
+  grey.dx(4);
+  grey.dy(2);
+  grey.image({0, 1, 2, 3, 252, 253, 254, 255});
+  CameraImage camera;
+  camera.header(header);
+  camera.camera_id("cam_a");
+  camera.encoding("mono8");
+  camera.width(1);
+  camera.height(3);
+  camera.data({7, 8, 9});
+  LandmarkPose pose;
+  pose.header(header);
+  pose.valid(true);
+  Pose3 p;
+  p.t({0.5, -1.0, 2.0});
+  p.q({1.0, 0.0, 0.0, 0.0});
+  pose.pose(p);
+  json messages = {{"foxglove.RawImage", json::array()},
+                   {"foxglove.PoseInFrame", json::array()},
+                   {"foxglove.SceneUpdate", json::array()}};
+  messages["foxglove.RawImage"].push_back(json::parse(*bridge::raw_image_json(grey)));
+  messages["foxglove.RawImage"].push_back(json::parse(*bridge::raw_image_json(camera)));
+  messages["foxglove.PoseInFrame"].push_back(json::parse(*bridge::pose_in_frame_json(pose)));
+  for (const auto& [job, broken] : {std::pair{"j1", false}, {"", false}, {"", true}}) {
+    RobotState robot;
+    robot.header(header);
+    robot.robot("r1");
+    robot.radius(0.3);
+    robot.x(1.0);
+    robot.y(-2.0);
+    robot.heading(0.5);
+    robot.speed(0.75);
+    RobotJob j;
+    j.id(job);
+    robot.job(j);
+    robot.broken(broken);
+    robot.fault(broken ? "motor" : "");
+    messages["foxglove.SceneUpdate"].push_back(json::parse(*bridge::scene_update_json(robot)));
+  }
+  json schemas = json::object();
+  for (const auto& entry : messages.items()) {
+    schemas[entry.key()] = json::parse(bridge::json_schema(entry.key()));
+  }
+  const auto schemas_file = test::temp_path("foxglove_schemas") + ".json";
+  const auto messages_file = test::temp_path("foxglove_messages") + ".json";
+  std::ofstream(schemas_file) << schemas.dump(2);
+  std::ofstream(messages_file) << messages.dump(2);
+
+  ::setenv("NODE_PATH", (fs::path(OSCAR_FOXGLOVE_NPM_DIR) / "node_modules").c_str(), 1);
+  Process check({node, std::string(OSCAR_FOXGLOVE_TEST_DIR) + "/schema_checks.js", "--schemas",
+                 schemas_file, "--messages", messages_file},
+                test::temp_path("schema_checks") + ".log");
+  EXPECT_EQ(check.wait(60s), 0) << check.output();
+  std::cout << check.output();
+}
+
 TEST(FoxgloveBridge, ServesABootedSystemToFoxglovesOwnClient) {
   const auto node = on_path("node"), npm = on_path("npm");
   if (node.empty() || npm.empty()) {
@@ -90,10 +167,14 @@ modules:
   - name: camera
     kernels: [ { type: bench_source, name: cam, params: { type: GvImage, dx: 640, dy: 480 } } ]
     mode: deactivated
+  - name: robot
+    kernels: [ { type: robot_sim, name: r7, params: { start_x: 3, start_y: 4, radius: 0.3 } } ]
+    mode: deactivated
 )");
   system.running();
-  for (const auto& [module, kernel, mode] :
-       {std::tuple{"sources", "sig", "continuous:20ms"}, {"camera", "cam", "continuous:50ms"}}) {
+  for (const auto& [module, kernel, mode] : {std::tuple{"sources", "sig", "continuous:20ms"},
+                                             {"camera", "cam", "continuous:50ms"},
+                                             {"robot", "r7", "continuous:100ms"}}) {
     const auto reply = system.configure(module, CMD_ACTIVATE, {kernel, mode});
     ASSERT_TRUE(reply.ok()) << kernel << ": " << reply.error();
   }
@@ -103,17 +184,25 @@ modules:
       test::temp_path("bridge") + ".log");
   const auto port = served_port(bridge);
   ASSERT_NE(port, 0) << bridge.output();
+  Process config_bridge(
+      {test::bin("oscar-bridge"), "foxglove", "-d", domain, "--port", "0", "--allow-config"},
+      test::temp_path("config_bridge") + ".log");
+  const auto config_port = served_port(config_bridge);
+  ASSERT_NE(config_port, 0) << config_bridge.output();
 
   ::setenv("NODE_PATH", (fs::path(OSCAR_FOXGLOVE_NPM_DIR) / "node_modules").c_str(), 1);
   // After --late: the command of a module the client starts later (its topic appears then).
   Process client({node, std::string(OSCAR_FOXGLOVE_TEST_DIR) + "/bridge_client.js", "--url",
-                  "ws://127.0.0.1:" + std::to_string(port), "--late", test::bin("oscar-run"),
+                  "ws://127.0.0.1:" + std::to_string(port), "--config-url",
+                  "ws://127.0.0.1:" + std::to_string(config_port), "--late", test::bin("oscar-run"),
                   "--name", "late", "--domain", domain, "-k", "bench_source:late", "-p",
                   "late.type=Bool", "-m", "continuous:50ms"},
                  test::temp_path("bridge_client") + ".log");
-  const auto rc = client.wait(180s);
+  const auto rc = client.wait(240s);
   std::cout << client.output();
-  EXPECT_EQ(rc, 0) << client.output() << "\nbridge:\n" << bridge.output();
+  EXPECT_EQ(rc, 0) << client.output() << "\nbridge:\n"
+                   << bridge.output() << "\nbridge with --allow-config:\n"
+                   << config_bridge.output();
   for (const auto pid : test::processes_mentioning("bench_source:late")) ::kill(pid, SIGKILL);
 
   // The bridge read the topics only while subscribed, and said whom it dropped what for.
@@ -122,8 +211,87 @@ modules:
   EXPECT_THAT(log, ::testing::ContainsRegex("reads too slowly: dropped the oldest [0-9]+ of "
                                             "oscar/cue/cam/out"));
   EXPECT_THAT(log, HasSubstr("oscar/cue/late/out is gone"));
+  // The image side channel converted only while the client subscribed to it: once.
+  const std::regex converting("bridge: converting oscar/cue/cam/out for foxglove/cam/out");
+  EXPECT_EQ(std::distance(std::sregex_iterator(log.begin(), log.end(), converting),
+                          std::sregex_iterator()),
+            1)
+      << log;
+  EXPECT_THAT(log, ::testing::ContainsRegex(
+                       "stopped converting oscar/cue/cam/out for foxglove/cam/out after [1-9]"));
+  // Malformed calls did not stop the bridge that takes them; the valid one was carried out.
+  const auto config_log = config_bridge.output();
+  EXPECT_THAT(config_log, HasSubstr("oscar/config robot set-cycle r7 50ms: accepted"));
   bridge.stop();
+  config_bridge.stop();
   EXPECT_THAT(bridge.output(), HasSubstr("oscar bridge: stopped"));
+  EXPECT_THAT(config_bridge.output(), HasSubstr("oscar bridge: stopped"));
+}
+
+// In a secured system (docs/security.md) the bridge with --allow-config joins as `operator_boot`,
+// whose permissions let it write configuration commands: Foxglove's client changes a module's
+// cycle through it. A keystore holding only the look-only `operator` serves a bridge without the
+// flag, and refuses one with it, naming the identity it lacks.
+TEST(FoxgloveBridge, InASecuredSystemConfiguresOnlyAsTheIdentityOperatorBoot) {
+  const auto node = on_path("node"), npm = on_path("npm");
+  if (node.empty() || npm.empty()) GTEST_SKIP() << "node/npm not found (see the test above)";
+  ASSERT_EQ(install_client_packages(npm), "");
+  const std::string yaml = R"(
+system: secured_view
+lease: 1s
+modules:
+  - name: sources
+    kernels: [ { type: bench_source, name: sig, params: { type: Bool } } ]
+    mode: { continuous: 100ms }
+)";
+  const fs::path keystore = test::temp_path("foxglove_keystore");
+  fs::remove_all(keystore);
+  test::make_keystore("foxglove", yaml, keystore);
+  ASSERT_FALSE(HasFatalFailure());
+  const auto domain = std::to_string(test::test_domain());
+  {
+    testing::BootOptions options;
+    options.keystore = keystore.string();
+    BootedSystem system("foxglove_secured", yaml, options);
+    system.running();
+    Process bridge(
+        {test::bin("oscar-bridge"), "foxglove", "-d", domain, "--port", "0", "--allow-config"},
+        test::temp_path("secured_bridge") + ".log");
+    const auto port = served_port(bridge);
+    ASSERT_NE(port, 0) << bridge.output();
+    ::setenv("NODE_PATH", (fs::path(OSCAR_FOXGLOVE_NPM_DIR) / "node_modules").c_str(), 1);
+    Process call({node, std::string(OSCAR_FOXGLOVE_TEST_DIR) + "/config_call.js", "--url",
+                  "ws://127.0.0.1:" + std::to_string(port), "--request",
+                  R"({"module": "sources", "command": "set-cycle", "args": ["sig", "50ms"]})"},
+                 test::temp_path("secured_call") + ".log");
+    EXPECT_EQ(call.wait(30s), 0) << call.output() << "\nbridge:\n" << bridge.output();
+    EXPECT_THAT(call.output(), HasSubstr(R"("cycle_ms":50.0)"));
+    system.wait_for([](const SystemState& s) {
+      const auto* m = test::entry(s, "sources");
+      const auto* k = m ? test::kernel_state(*m, "sig") : nullptr;
+      return k && k->cycle_ns() == 50'000'000;
+    });
+    bridge.stop();
+  }
+  const fs::path look = test::temp_path("foxglove_look_keystore");
+  fs::remove_all(look);
+  fs::create_directories(look / "identities");
+  fs::copy(keystore / "identities" / "operator", look / "identities" / "operator",
+           fs::copy_options::recursive);
+  fs::copy(keystore / "public", look / "public", fs::copy_options::recursive);
+  ::setenv("OSCAR_KEYSTORE", look.c_str(), 1);
+  Process acting(
+      {test::bin("oscar-bridge"), "foxglove", "-d", domain, "--port", "0", "--allow-config"},
+      test::temp_path("acting_bridge") + ".log");
+  Process looking({test::bin("oscar-bridge"), "foxglove", "-d", domain, "--port", "0"},
+                  test::temp_path("looking_bridge") + ".log");
+  ::unsetenv("OSCAR_KEYSTORE");
+  EXPECT_EQ(acting.wait(20s), 1) << acting.output();
+  EXPECT_THAT(acting.output(), HasSubstr("identity 'operator_boot' has no"));
+  EXPECT_NE(served_port(looking), 0) << looking.output();
+  looking.stop();
+  fs::remove_all(look);
+  fs::remove_all(keystore);
 }
 
 }  // namespace

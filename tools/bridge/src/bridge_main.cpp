@@ -20,7 +20,8 @@ int main(int argc, char** argv) {
   auto* foxglove = app.add_subcommand(
       "foxglove",
       "a Foxglove WebSocket server (protocol v1): every topic as a channel with its OMG IDL "
-      "schema and raw CDR messages");
+      "schema and raw CDR messages; images, poses, robot states and the system graph also in "
+      "Foxglove's schemas (JSON)");
   oscar::SystemOptions tool;
   tool.add_to(*foxglove);
   oscar::bridge::BridgeOptions options;
@@ -38,16 +39,26 @@ int main(int argc, char** argv) {
                    "per client: MiB of messages queued before the oldest are dropped")
       ->capture_default_str()
       ->check(CLI::Range(1, 1 << 20));
+  foxglove->add_flag(
+      "--allow-config", options.allow_config,
+      "offer the service oscar/config: Foxglove users may then configure modules with the "
+      "coordinator's authority (with a keystore, as the identity operator_boot)");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   options.queue.bytes = queue_mib << 20;
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {
     oscar::bridge::check_listen_address(options.address);
-    auto participant = tool.participant("oscar-bridge");
+    // Only with --allow-config does the bridge act: otherwise it takes the identity that may
+    // only look (docs/security.md).
+    auto participant =
+        tool.participant("oscar-bridge", options.allow_config ? oscar::ToolAuthority::kActAsBoot
+                                                              : oscar::ToolAuthority::kLook);
     oscar::bridge::FoxgloveBridge bridge(*participant, options);
-    fmt::print(stderr, "oscar bridge: serving domain {} to Foxglove at ws://{}:{}\n",
-               participant->domain(), options.address, bridge.port());
+    fmt::print(
+        stderr, "oscar bridge: serving domain {} to Foxglove at ws://{}:{}{}\n",
+        participant->domain(), options.address, bridge.port(),
+        options.allow_config ? " (service oscar/config: clients may configure modules)" : "");
     bridge.run(g_stop);
     fmt::print(stderr, "oscar bridge: stopped\n");
     return 0;

@@ -11,14 +11,25 @@
 #include <boost/asio/steady_timer.hpp>
 
 #include "channel_directory.hpp"
+#include "config_service.hpp"
 #include "oscar/idl_texts.hpp"
+#include "oscar/topics.hpp"
 #include "raw_tap.hpp"
 #include "session.hpp"
+#include "side_channels.hpp"
+#include "system_graph.hpp"
 
 namespace oscar::bridge {
 namespace net = boost::asio;
 using tcp = net::ip::tcp;
 using Clock = std::chrono::steady_clock;
+using Payload = std::shared_ptr<const std::vector<std::uint8_t>>;
+
+namespace {
+constexpr std::uint32_t kConfigServiceId = 1;
+// The authority configuration commands from Foxglove carry (as `oscar config --as coordinator`).
+constexpr const char* kConfigSender = "coordinator";
+}  // namespace
 
 void check_listen_address(const std::string& address) {
   boost::system::error_code ec;
@@ -29,17 +40,33 @@ void check_listen_address(const std::string& address) {
   }
 }
 
-// Everything below runs on the one thread that runs io (Fast DDS threads only post to it).
+// Everything below runs on the one thread that runs io (Fast DDS threads and the configuration
+// worker only post to it).
 struct FoxgloveBridge::Impl final : SessionHost {
+  // What the bridge knows of a channel it advertised, live or not.
+  struct Known {
+    std::string topic;
+    std::string source;       // the DDS topic read for it (its own topic unless a side channel)
+    std::string source_type;  // that topic's IDL type
+    std::string schema_name;
+    bool side = false;
+  };
+
   BridgeOptions options;
   DdsParticipant& participant;
   std::string started_ns = std::to_string(inspect::now_ns());  // the session id
   net::io_context io{1};
   tcp::acceptor acceptor{io};
-  ChannelDirectory directory{idl_texts()};
+  ChannelDirectory directory{idl_texts(), side_channel_for};
   std::set<std::shared_ptr<Session>> sessions;
-  std::map<std::uint32_t, int> wanted;          // channel -> subscribers; read while > 0
-  std::map<std::uint32_t, std::string> topics;  // every channel id ever made -> its topic
+  std::map<std::uint32_t, int> wanted;   // channel -> subscribers
+  std::map<std::string, int> readers;    // DDS topic -> channels wanting it; read while > 0
+  std::map<std::uint32_t, Known> known;  // every channel id ever made
+  std::map<std::uint32_t, SideChannelActivity> activity;  // live side channels
+  std::set<std::string> reported_malformed;
+  Payload last_system_state;  // while oscar/system/state is read
+  Clock::time_point last_graph_sent{};
+  std::unique_ptr<ConfigWorker> config;  // with allow_config
   // Last: deleted first, so no Fast DDS thread posts to `io` once it is gone.
   inspect::RawTap tap{
       participant,
@@ -49,7 +76,17 @@ struct FoxgloveBridge::Impl final : SessionHost {
                   [this, topic, payload, receive_ns] { on_sample(topic, payload, receive_ns); });
       }};
 
-  Impl(DdsParticipant& p, BridgeOptions o) : options(std::move(o)), participant(p) { listen(); }
+  Impl(DdsParticipant& p, BridgeOptions o) : options(std::move(o)), participant(p) {
+    listen();
+    if (!options.allow_config) return;
+    config = std::make_unique<ConfigWorker>(participant, kConfigSender);
+    if (!net::ip::make_address(options.address).is_loopback()) {
+      fmt::print(stderr,
+                 "oscar bridge: warning: --allow-config on {}: anyone who reaches port {} there "
+                 "may configure this system's modules\n",
+                 options.address, acceptor.local_endpoint().port());
+    }
+  }
 
   void listen() {
     check_listen_address(options.address);
@@ -79,65 +116,68 @@ struct FoxgloveBridge::Impl final : SessionHost {
     });
   }
 
-  void on_sample(const std::string& topic,
-                 const std::shared_ptr<const std::vector<std::uint8_t>>& payload,
-                 std::uint64_t receive_ns) {
-    const auto channel = directory.id_of(topic);
-    if (!channel || wanted[*channel] == 0) return;  // unsubscribed meanwhile
-    const ClientQueue::Message message{*channel, payload, receive_ns};
+  void deliver(std::uint32_t channel, Payload payload, std::uint64_t receive_ns) {
+    const ClientQueue::Message message{channel, std::move(payload), receive_ns};
     for (const auto& s : sessions) s->deliver(message);
   }
 
-  void discover() {
-    const auto change = directory.update(participant.discovered_writers());
-    for (const auto& topic : change.unknown) {
-      fmt::print(stderr, "oscar bridge: {} is not served: its type has no IDL text here\n", topic);
+  void on_sample(const std::string& topic, const Payload& payload, std::uint64_t receive_ns) {
+    if (const auto raw = directory.id_of(topic); raw && wanted[*raw] > 0) {
+      deliver(*raw, payload, receive_ns);
     }
-    for (const auto channel : change.removed) {
-      if (wanted[channel] > 0) tap.unsubscribe(topic_of_removed(channel));
-      wanted.erase(channel);
-      for (const auto& s : sessions) s->forget_channel(channel);
+    const auto side = directory.side_of(topic);
+    if (!side) return;
+    const auto& k = known[*side];
+    if (k.schema_name == kSystemGraphSchema) {
+      last_system_state = payload;
+      return send_graph(*side, receive_ns);
     }
-    for (const auto& c : change.added) {
-      fmt::print(stderr, "oscar bridge: channel {} {} ({})\n", c.id, c.topic, c.schema_name);
-      topics[c.id] = c.topic;
-    }
-    if (!change.removed.empty()) {
-      for (const auto channel : change.removed) {
-        fmt::print(stderr, "oscar bridge: channel {} {} is gone\n", channel, topics[channel]);
+    if (wanted[*side] == 0) return;  // the raw channel alone is read: nothing to convert
+    auto& a = activity[*side];
+    try {
+      if (auto message = convert_sample(k.source_type, *payload)) {
+        ++a.converted;
+        deliver(*side,
+                std::make_shared<const std::vector<std::uint8_t>>(message->begin(), message->end()),
+                receive_ns);
+      } else {
+        ++a.skipped;
       }
-      const auto text = unadvertise_json(change.removed);
-      for (const auto& s : sessions) s->send_text(text);
-    }
-    if (!change.added.empty()) {
-      const auto text = advertise_json(change.added);
-      for (const auto& s : sessions) s->send_text(text);
-    }
-  }
-  std::string topic_of_removed(std::uint32_t channel) { return topics[channel]; }
-
-  void report_drops() {
-    for (const auto& s : sessions) {
-      const auto drops = s->new_drops();
-      if (drops.empty()) continue;
-      std::string what;
-      for (const auto& [channel, n] : drops) {
-        what += fmt::format("{}{} of {}", what.empty() ? "" : ", ", n, topics[channel]);
+    } catch (const std::runtime_error& e) {
+      ++a.skipped;
+      if (reported_malformed.insert(topic).second) {
+        fmt::print(stderr, "oscar bridge: {} not converted for {}: {}\n", topic, k.topic, e.what());
       }
-      fmt::print(stderr, "oscar bridge: client {} reads too slowly: dropped the oldest {}\n",
-                 s->peer(), what);
-      s->set_status(
-          StatusLevel::kWarning,
-          fmt::format("the bridge dropped the oldest {} (this client read too slowly)", what));
     }
   }
 
-  // SessionHost
-  std::vector<ChannelInfo> channels() const override { return directory.channels(); }
-  const ChannelInfo* channel(std::uint32_t id) const override { return directory.find(id); }
-  void want(std::uint32_t channel) override {
-    if (wanted[channel]++ > 0) return;
-    const auto& topic = topics[channel];
+  // The system graph from the last system state, to its subscribers.
+  void send_graph(std::uint32_t channel, std::uint64_t receive_ns) {
+    if (wanted[channel] == 0 || !last_system_state) return;
+    try {
+      const auto state = system_state_from_cdr(*last_system_state);
+      ++activity[channel].converted;
+      const auto text = system_graph_json(state, participant.discovered_writers(), side_activity());
+      last_graph_sent = Clock::now();
+      deliver(channel, std::make_shared<const std::vector<std::uint8_t>>(text.begin(), text.end()),
+              receive_ns);
+    } catch (const std::runtime_error& e) {
+      ++activity[channel].skipped;
+      fmt::print(stderr, "oscar bridge: no system graph: {}\n", e.what());
+    }
+  }
+
+  std::vector<SideChannelActivity> side_activity() {
+    std::vector<SideChannelActivity> out;
+    for (auto [channel, a] : activity) {
+      a.subscribers = wanted[channel];
+      out.push_back(a);
+    }
+    return out;
+  }
+
+  void read(const std::string& topic) {
+    if (readers[topic]++ > 0) return;
     try {
       if (tap.subscribe(topic).empty()) {
         fmt::print(stderr, "oscar bridge: {} has no writer any more\n", topic);
@@ -146,13 +186,146 @@ struct FoxgloveBridge::Impl final : SessionHost {
       fmt::print(stderr, "oscar bridge: cannot read {}: {}\n", topic, e.what());
     }
   }
+  void release(const std::string& topic) {
+    const auto it = readers.find(topic);
+    if (it == readers.end() || it->second == 0) return;
+    if (--it->second > 0) return;
+    tap.unsubscribe(topic);
+    if (topic == topics::system_state().name) last_system_state.reset();
+  }
+
+  void discover() {
+    const auto change = directory.update(participant.discovered_writers());
+    for (const auto& topic : change.unknown) {
+      fmt::print(stderr, "oscar bridge: {} is not served: its type has no IDL text here\n", topic);
+    }
+    for (const auto channel : change.removed) {
+      if (wanted[channel] > 0) release(known[channel].source);
+      wanted.erase(channel);
+      activity.erase(channel);
+      for (const auto& s : sessions) s->forget_channel(channel);
+      fmt::print(stderr, "oscar bridge: channel {} {} is gone\n", channel, known[channel].topic);
+    }
+    for (const auto& c : change.added) {
+      const bool side = !c.source.empty();
+      const auto source = side ? c.source : c.topic;
+      const auto* raw = side ? directory.find(*directory.id_of(c.source)) : &c;
+      known[c.id] = {c.topic, source, raw->schema_name, c.schema_name, side};
+      if (side) activity[c.id] = {.topic = c.topic, .source = c.source};
+      fmt::print(stderr, "oscar bridge: channel {} {} ({}{})\n", c.id, c.topic, c.schema_name,
+                 side ? ", from " + c.source : "");
+    }
+    if (!change.removed.empty()) {
+      const auto text = unadvertise_json(change.removed);
+      for (const auto& s : sessions) s->send_text(text);
+    }
+    if (!change.added.empty()) {
+      const auto text = advertise_json(change.added);
+      for (const auto& s : sessions) s->send_text(text);
+    }
+  }
+
+  void report() {
+    for (const auto& s : sessions) {
+      const auto drops = s->new_drops();
+      if (drops.empty()) continue;
+      std::string what;
+      for (const auto& [channel, n] : drops) {
+        what += fmt::format("{}{} of {}", what.empty() ? "" : ", ", n, known[channel].topic);
+      }
+      fmt::print(stderr, "oscar bridge: client {} reads too slowly: dropped the oldest {}\n",
+                 s->peer(), what);
+      s->set_status(
+          StatusLevel::kWarning,
+          fmt::format("the bridge dropped the oldest {} (this client read too slowly)", what));
+    }
+    // The graph's rates and counters move even when the system state does not.
+    if (Clock::now() - last_graph_sent < options.report_period) return;
+    for (const auto& [channel, k] : known) {
+      if (k.schema_name == kSystemGraphSchema && wanted[channel] > 0) {
+        send_graph(channel, inspect::now_ns());
+      }
+    }
+  }
+
+  void on_config_done(const std::weak_ptr<Session>& caller, const ServiceCall& call,
+                      const std::string& command, const ConfigWorker::Outcome& outcome) {
+    const auto session = caller.lock();
+    fmt::print(stderr, "oscar bridge: client {}: oscar/config {}: {}\n",
+               session ? session->peer() : "(gone)", command,
+               outcome.ok ? "accepted" : outcome.text);
+    if (!session) return;
+    if (outcome.ok) {
+      session->answer_call(call, outcome.text);
+    } else {
+      session->fail_call(call, command + ": " + outcome.text);
+    }
+  }
+
+  // SessionHost
+  std::vector<ChannelInfo> channels() const override { return directory.channels(); }
+  const ChannelInfo* channel(std::uint32_t id) const override { return directory.find(id); }
+  void want(std::uint32_t channel) override {
+    if (wanted[channel]++ > 0) return;
+    const auto& k = known[channel];
+    read(k.source);
+    if (k.side) {
+      fmt::print(stderr, "oscar bridge: converting {} for {} (subscribed)\n", k.source, k.topic);
+    }
+    if (k.schema_name == kSystemGraphSchema) send_graph(channel, inspect::now_ns());
+  }
   void unwant(std::uint32_t channel) override {
     const auto it = wanted.find(channel);
     if (it == wanted.end() || it->second == 0) return;
-    if (--it->second == 0) tap.unsubscribe(topics[channel]);
+    if (--it->second > 0) return;
+    const auto& k = known[channel];
+    release(k.source);
+    if (k.side) {
+      fmt::print(stderr, "oscar bridge: stopped converting {} for {} after {} messages\n", k.source,
+                 k.topic, activity[channel].converted);
+    }
   }
   void closed(const std::shared_ptr<Session>& session) override { sessions.erase(session); }
   const std::string& session_id() const override { return started_ns; }
+  std::vector<ServiceInfo> services() const override {
+    if (!config) return {};
+    return {config_service_info(kConfigServiceId)};
+  }
+  void call_service(const std::shared_ptr<Session>& caller, ServiceCall call) override {
+    if (!config) {
+      return caller->fail_call(
+          call,
+          "this bridge offers no services: it was started without --allow-config, so "
+          "Foxglove may not configure modules");
+    }
+    if (call.service != kConfigServiceId) {
+      return caller->fail_call(call, fmt::format("no service {} is advertised (oscar/config is {})",
+                                                 call.service, kConfigServiceId));
+    }
+    if (call.encoding != "json") {
+      return caller->fail_call(
+          call,
+          fmt::format("encoding '{}' is not offered: oscar/config takes json", call.encoding));
+    }
+    ConfigRequest request;
+    try {
+      request = parse_config_request(call.payload);
+    } catch (const std::invalid_argument& e) {
+      return caller->fail_call(call, e.what());
+    }
+    const auto command = request.text();
+    fmt::print(stderr, "oscar bridge: client {} calls oscar/config {}\n", caller->peer(), command);
+    std::weak_ptr<Session> weak = caller;
+    const bool queued =
+        config->submit(std::move(request), [this, weak, call, command](ConfigWorker::Outcome o) {
+          net::post(io, [this, weak, call, command, o = std::move(o)] {
+            on_config_done(weak, call, command, o);
+          });
+        });
+    if (!queued) {
+      caller->fail_call(call, command + ": refused: too many configuration commands are waiting");
+    }
+  }
 };
 
 FoxgloveBridge::FoxgloveBridge(DdsParticipant& participant, BridgeOptions options)
@@ -186,7 +359,7 @@ void FoxgloveBridge::run(const std::atomic<bool>& stop) {
         last_discovery = now;
       }
       if (now - last_report >= d.options.report_period) {
-        d.report_drops();
+        d.report();
         last_report = now;
       }
     }

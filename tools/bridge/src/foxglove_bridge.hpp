@@ -2,7 +2,9 @@
 // FoxgloveBridge: serves the running system to Foxglove over the Foxglove WebSocket protocol v1
 // (docs/foxglove.md). Every topic with a live writer and a known IDL is a channel (CDR
 // messages, OMG IDL schema); a topic is read only while some client subscribes to it, and its
-// raw CDR goes to each subscriber as it came, through a bounded per-client queue.
+// raw CDR goes to each subscriber as it came, through a bounded per-client queue. Images, poses,
+// robot states and the system state have side channels in Foxglove's schemas (JSON), converted
+// only while subscribed; with `allow_config`, the service oscar/config configures modules.
 
 #include <atomic>
 #include <chrono>
@@ -21,6 +23,9 @@ struct BridgeOptions {
   QueueLimits queue;                  ///< per client
   std::chrono::milliseconds discovery_period{200};
   std::chrono::milliseconds report_period{1000};  ///< how often drops are reported
+  /// Offer the service oscar/config (configuration commands with the coordinator's authority;
+  /// the participant must be allowed to write them, see ToolAuthority::kActAsBoot).
+  bool allow_config = false;
 };
 
 /// @throws std::invalid_argument if `address` is no IP address (checked before anything joins

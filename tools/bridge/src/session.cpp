@@ -96,8 +96,10 @@ void Session::on_accept(beast::error_code ec) {
   open_ = true;
   request_.reset();
   fmt::print(stderr, "oscar bridge: client {} connected\n", peer_);
-  send_text(server_info_json("oscar bridge", host_.session_id()));
+  const auto services = host_.services();
+  send_text(server_info_json("oscar bridge", host_.session_id(), !services.empty()));
   send_text(advertise_json(host_.channels()));
+  if (!services.empty()) send_text(advertise_services_json(services));
   read();
 }
 
@@ -112,7 +114,7 @@ void Session::on_read(beast::error_code ec, std::size_t) {
   if (ws_.got_text()) {
     handle(beast::buffers_to_string(buffer_.data()));
   } else {
-    set_status(StatusLevel::kError, "this server takes no binary messages (no clientPublish)");
+    handle_binary(beast::buffers_to_string(buffer_.data()));
   }
   buffer_.consume(buffer_.size());
   read();
@@ -132,6 +134,36 @@ void Session::handle(const std::string& text) {
   } catch (const std::invalid_argument& e) {
     set_status(StatusLevel::kError, e.what());
   }
+}
+
+void Session::handle_binary(const std::string& bytes) {
+  if (!bytes.empty() && static_cast<std::uint8_t>(bytes[0]) != kServiceCallRequestOpcode) {
+    return set_status(StatusLevel::kError,
+                      "this server takes no binary messages but service calls (no clientPublish)");
+  }
+  try {
+    auto call =
+        parse_service_call({reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()});
+    host_.call_service(shared_from_this(), std::move(call));
+  } catch (const std::invalid_argument& e) {
+    set_status(StatusLevel::kError, e.what());
+  }
+}
+
+void Session::answer_call(const ServiceCall& call, const std::string& response) {
+  queue_call_reply({service_call_response(call.service, call.call, "json", response), true, true});
+}
+
+void Session::fail_call(const ServiceCall& call, const std::string& why) {
+  queue_call_reply({service_call_failure_json(call.service, call.call, why), false, true});
+  set_status(StatusLevel::kError, fmt::format("service call {}: {}", call.call, why));
+}
+
+void Session::queue_call_reply(Frame frame) {
+  if (pending_call_replies_ >= kMaxPendingCallReplies) return;
+  ++pending_call_replies_;
+  controls_.push_back(std::move(frame));
+  write_next();
 }
 
 void Session::subscribe(std::uint32_t subscription, std::uint32_t channel) {
@@ -169,7 +201,7 @@ void Session::unsubscribe(std::uint32_t subscription) {
 }
 
 void Session::send_text(std::string text) {
-  texts_.push_back(std::move(text));
+  controls_.push_back({std::move(text), false, false});
   write_next();
 }
 
@@ -207,12 +239,19 @@ void Session::write_next() {
   auto done = [self = shared_from_this()](beast::error_code ec, std::size_t) {
     self->on_write(ec);
   };
-  if (!texts_.empty() || !statuses_.empty()) {
-    auto& from = texts_.empty() ? statuses_ : texts_;
-    writing_text_ = std::move(from.front());
-    from.pop_front();
+  if (!controls_.empty() || !statuses_.empty()) {
+    bool binary = false;
+    if (!controls_.empty()) {
+      writing_text_ = std::move(controls_.front().bytes);
+      binary = controls_.front().binary;
+      if (controls_.front().call_reply) --pending_call_replies_;
+      controls_.pop_front();
+    } else {
+      writing_text_ = std::move(statuses_.front());
+      statuses_.pop_front();
+    }
     writing_ = true;
-    ws_.text(true);
+    ws_.binary(binary);
     ws_.async_write(net::buffer(writing_text_), std::move(done));
     return;
   }

@@ -1,8 +1,9 @@
 #pragma once
 // Session: one Foxglove client of the bridge, on the bridge's I/O thread. It completes the
 // WebSocket handshake (subprotocol foxglove.websocket.v1), keeps the client's subscriptions,
-// and writes one frame at a time: control messages (advertise, status) first, then messages
-// from its ClientQueue, so a client that reads slowly only loses its own oldest messages.
+// hands its service calls to the bridge, and writes one frame at a time: control messages
+// (advertise, service call replies, status) first, then messages from its ClientQueue, so a
+// client that reads slowly only loses its own oldest messages.
 
 #include <array>
 #include <cstdint>
@@ -39,6 +40,11 @@ class SessionHost {
   /// The session's connection ended (after it released its subscriptions).
   virtual void closed(const std::shared_ptr<Session>& session) = 0;
   virtual const std::string& session_id() const = 0;
+  /// The services offered (none unless the bridge was started with --allow-config).
+  virtual std::vector<ServiceInfo> services() const = 0;
+  /// A client called a service: the bridge answers through caller->answer_call() or
+  /// caller->fail_call(), later, on its I/O thread.
+  virtual void call_service(const std::shared_ptr<Session>& caller, ServiceCall call) = 0;
 };
 
 class Session : public std::enable_shared_from_this<Session> {
@@ -48,6 +54,13 @@ class Session : public std::enable_shared_from_this<Session> {
   void start();
   /// Sends a JSON text message (never dropped).
   void send_text(std::string text);
+  /// Answers a service call (a Service Call Response, JSON encoded).
+  void answer_call(const ServiceCall& call, const std::string& response);
+  /// Tells the client its service call failed: serviceCallFailure, and an error status for
+  /// viewers that show no call failures.
+  void fail_call(const ServiceCall& call, const std::string& why);
+  /// Answers waiting at most (of a client that calls but does not read, the newest are lost).
+  static constexpr std::size_t kMaxPendingCallReplies = 64;
   /// Queues a message of `channel` if this client subscribes to it.
   void deliver(const ClientQueue::Message& message);
   /// `channel` is no more: its subscription ends without a word (it was unadvertised).
@@ -67,6 +80,7 @@ class Session : public std::enable_shared_from_this<Session> {
   void read();
   void on_read(boost::beast::error_code ec, std::size_t bytes);
   void handle(const std::string& text);
+  void handle_binary(const std::string& bytes);
   void subscribe(std::uint32_t subscription, std::uint32_t channel);
   void unsubscribe(std::uint32_t subscription);
   void write_next();
@@ -80,7 +94,15 @@ class Session : public std::enable_shared_from_this<Session> {
   std::optional<boost::beast::http::request<boost::beast::http::string_body>> request_;
   std::shared_ptr<boost::beast::http::response<boost::beast::http::string_body>> rejection_;
   ClientQueue queue_;
-  std::deque<std::string> texts_;
+  struct Frame {
+    std::string bytes;
+    bool binary = false;
+    bool call_reply = false;
+  };
+  void queue_call_reply(Frame frame);
+
+  std::deque<Frame> controls_;  // advertise, call replies, ...
+  std::size_t pending_call_replies_ = 0;
   std::deque<std::string> statuses_;                        // not sent yet
   std::map<std::uint32_t, std::uint32_t> channel_of_;       // subscription -> channel
   std::map<std::uint32_t, std::uint32_t> subscription_of_;  // channel -> subscription

@@ -54,5 +54,39 @@ TEST(ChannelDirectory, FollowsTopicsThatGoAndComeBack) {
   EXPECT_NE(change.added[0].id, id) << "another type: another channel";
 }
 
+// A side channel for images only, as side_channel_for() makes them.
+std::optional<ChannelInfo> image_side(const std::string& topic, const std::string& type) {
+  if (type != "oscar::GvImage") return std::nullopt;
+  return ChannelInfo{.id = 0,
+                     .topic = "foxglove/" + topic,
+                     .schema_name = "foxglove.RawImage",
+                     .schema = "{}",
+                     .encoding = "json",
+                     .schema_encoding = "jsonschema",
+                     .source = topic};
+}
+
+TEST(ChannelDirectory, ASideChannelComesAndGoesWithItsSource) {
+  ChannelDirectory d(kIdl, image_side);
+  auto change = d.update({{"oscar/cue/cam/out", writer("oscar::GvImage")},
+                          {"oscar/cue/sig/out", writer("oscar::Bool")}});
+  ASSERT_EQ(change.added.size(), 3u);
+  const auto cam = *d.id_of("oscar/cue/cam/out");
+  const auto side = d.side_of("oscar/cue/cam/out");
+  ASSERT_TRUE(side);
+  EXPECT_NE(*side, cam);
+  EXPECT_EQ(d.find(*side)->topic, "foxglove/oscar/cue/cam/out");
+  EXPECT_EQ(d.find(*side)->encoding, "json");
+  EXPECT_FALSE(d.side_of("oscar/cue/sig/out"));
+  change = d.update({{"oscar/cue/sig/out", writer("oscar::Bool")}});
+  EXPECT_EQ(change.removed, (std::vector<std::uint32_t>{cam, *side}));
+  EXPECT_FALSE(d.side_of("oscar/cue/cam/out"));
+  EXPECT_EQ(d.find(*side), nullptr);
+  change = d.update({{"oscar/cue/cam/out", writer("oscar::GvImage")},
+                     {"oscar/cue/sig/out", writer("oscar::Bool")}});
+  ASSERT_EQ(change.added.size(), 2u);
+  EXPECT_EQ(d.side_of("oscar/cue/cam/out"), side) << "back with its source, under its old id";
+}
+
 }  // namespace
 }  // namespace oscar::bridge

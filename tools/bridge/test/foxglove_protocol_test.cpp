@@ -76,5 +76,67 @@ TEST(FoxgloveProtocol, RejectsMalformedClientMessagesSayingWhy) {
                   "unsubscribe: 'subscriptionIds' must hold numbers");
 }
 
+TEST(FoxgloveProtocol, OffersServicesOnlyWhenAskedTo) {
+  const auto without = json::parse(server_info_json("oscar bridge", "1"));
+  EXPECT_EQ(without["capabilities"], json::array());
+  const auto with = json::parse(server_info_json("oscar bridge", "1", true));
+  EXPECT_EQ(with["capabilities"], json::array({"services"}));
+  EXPECT_EQ(with["supportedEncodings"], json::array({"json"}));
+  const auto a = json::parse(advertise_services_json({{.id = 1,
+                                                       .name = "oscar/config",
+                                                       .type = "oscar.Config",
+                                                       .request_schema_name = "Req",
+                                                       .request_schema = "{}",
+                                                       .response_schema_name = "Res",
+                                                       .response_schema = "{}"}}));
+  EXPECT_EQ(a["op"], "advertiseServices");
+  const auto& s = a["services"][0];
+  EXPECT_EQ(s["id"], 1);
+  EXPECT_EQ(s["name"], "oscar/config");
+  EXPECT_EQ(s["request"]["encoding"], "json");
+  EXPECT_EQ(s["request"]["schemaEncoding"], "jsonschema");
+  EXPECT_EQ(s["request"]["schemaName"], "Req");
+  EXPECT_EQ(s["responseSchema"], "{}");
+  EXPECT_EQ(json::parse(service_call_failure_json(1, 9, "no")),
+            json::parse(R"({"op":"serviceCallFailure","serviceId":1,"callId":9,"message":"no"})"));
+}
+
+std::vector<std::uint8_t> frame_of(const std::string& s) { return {s.begin(), s.end()}; }
+
+TEST(FoxgloveProtocol, ReadsAServiceCallAndWritesItsResponseInTheSameLayout) {
+  // A response frame has the request's layout with opcode 3: reuse it to build a request.
+  auto bytes = frame_of(service_call_response(0x01020304, 7, "json", R"({"a":1})"));
+  EXPECT_EQ(bytes[0], 3);
+  EXPECT_EQ(bytes[1], 4);
+  EXPECT_EQ(bytes[9], 4);  // the encoding's length
+  bytes[0] = 2;
+  const auto call = parse_service_call(bytes);
+  EXPECT_EQ(call.service, 0x01020304u);
+  EXPECT_EQ(call.call, 7u);
+  EXPECT_EQ(call.encoding, "json");
+  EXPECT_EQ(call.payload, R"({"a":1})");
+}
+
+void expect_call_rejected(std::vector<std::uint8_t> frame, const std::string& message) {
+  try {
+    parse_service_call(frame);
+    ADD_FAILURE() << "accepted " << frame.size() << " bytes";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(e.what(), message);
+  }
+}
+
+TEST(FoxgloveProtocol, RejectsMalformedServiceCallsSayingWhy) {
+  expect_call_rejected({}, "an empty binary message");
+  expect_call_rejected({1, 0, 0, 0, 0},
+                       "binary opcode 1 is not offered by this server (only 2, a service call "
+                       "request)");
+  expect_call_rejected({2, 1, 0, 0},
+                       "service call request: 4 bytes, shorter than its 13-byte header");
+  expect_call_rejected({2, 1, 0, 0, 0, 1, 0, 0, 0, 0xff, 0xff, 0xff, 0xff, 'j'},
+                       "service call request: its encoding's length (4294967295) runs past the "
+                       "frame");
+}
+
 }  // namespace
 }  // namespace oscar::bridge

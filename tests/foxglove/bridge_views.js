@@ -1,0 +1,134 @@
+// The Foxglove bridge's side channels, checked with Foxglove's own client and published schemas
+// (@foxglove/schemas): images as foxglove.RawImage, robot states as foxglove.SceneUpdate, the
+// system graph as JSON — each decoded the way Foxglove decodes a `json` channel, from the
+// advertised JSON schema alone (JSON.parse, then every field the schema marks
+// contentEncoding "base64" to bytes). The bridge's schemas for Foxglove's types are its own;
+// they and the messages must follow the published ones (schema_checks.js). Called by
+// bridge_client.js with its helpers.
+"use strict";
+const published = require("@foxglove/schemas/jsonschema");
+const { mismatch, undeclared, publishedDrift } = require("./schema_checks");
+
+const CAM = "oscar/cue/cam/out", CAM_SIDE = "foxglove/cam/out";
+const ROBOT_SIDE = "foxglove/r7/state", GRAPH = "foxglove/system/graph";
+
+// A `json` channel's message as Foxglove reads it, using only its schema.
+function decodeJson(schema, value) {
+  if (schema.contentEncoding === "base64" && typeof value === "string") {
+    return new Uint8Array(Buffer.from(value, "base64"));
+  }
+  if (schema.type === "object" && value && typeof value === "object" && schema.properties) {
+    for (const [k, sub] of Object.entries(schema.properties)) if (k in value) value[k] = decodeJson(sub, value[k]);
+  }
+  if (schema.type === "array" && Array.isArray(value) && schema.items) return value.map((v) => decodeJson(schema.items, v));
+  return value;
+}
+
+// Subscribes `client` to a json channel; its messages arrive checked and decoded.
+function subscribeJson(client, topic) {
+  const c = client.channels.get(topic);
+  const schema = JSON.parse(c.schema);
+  // A message in one of Foxglove's types also sends nothing its schema leaves out, and conforms
+  // to the published schema.
+  const theirs = c.schemaName.startsWith("foxglove.") ? published[c.schemaName.slice("foxglove.".length)] : undefined;
+  client.readers.set(c.id, {
+    readMessage: (bytes) => {
+      const raw = JSON.parse(Buffer.from(bytes).toString("utf8"));
+      let bad = mismatch(schema, raw);
+      if (!bad && theirs) {
+        const extra = undeclared(schema, raw);
+        bad = extra ? `${extra} is not declared` : mismatch(theirs, raw) && `published: ${mismatch(theirs, raw)}`;
+      }
+      return bad ? { error: `does not conform to ${c.schemaName}: ${bad}` } : decodeJson(schema, raw);
+    },
+  });
+  const id = client.client.subscribe(c.id);
+  const list = [];
+  list.channel = c.id;
+  client.received.set(id, list);
+  return id;
+}
+
+function sideCounter(graph, topic) {
+  const s = ((graph && graph.side_channels) || []).find((x) => x.topic === topic);
+  return s ? s.converted : undefined;
+}
+
+async function checkSideChannels(a, { check, until, sleep, figures, imageComplete }) {
+  await until(() => a.channels.has(CAM_SIDE) && a.channels.has(ROBOT_SIDE) && a.channels.has(GRAPH), 10000);
+  for (const [topic, name] of [[CAM_SIDE, "RawImage"], [ROBOT_SIDE, "SceneUpdate"]]) {
+    const c = a.channels.get(topic);
+    if (!check(c, `${topic} is advertised beside its source`)) return;
+    const drift = publishedDrift(JSON.parse(c.schema), published[name]);
+    check(c.encoding === "json" && c.schemaEncoding === "jsonschema" && c.schemaName === `foxglove.${name}` &&
+          drift.length === 0,
+          `${topic}: json, a jsonschema foxglove.${name} that follows the published one (${c.encoding}, ${c.schemaEncoding}, ${c.schemaName}) ${drift.join("; ")}`);
+  }
+  const g = a.channels.get(GRAPH);
+  if (!check(g && g.encoding === "json" && g.schemaEncoding === "jsonschema" && g.schemaName === "oscar.SystemGraph",
+             `${GRAPH} is advertised: json, jsonschema oscar.SystemGraph`)) return;
+
+  // The graph: every booted module with its state, kernels and wiring.
+  const graphSub = subscribeJson(a, GRAPH);
+  const graphs = a.received.get(graphSub);
+  await until(() => graphs.length > 0, 5000);
+  const graph = (graphs[graphs.length - 1] || {}).msg || {};
+  check(!graph.error, `the graph conforms to its schema ${graph.error || ""}`);
+  const modules = (graph.modules || []).map((m) => `${m.name}:${m.status}`).sort().join(" ");
+  check(graph.system === "viewed" && graph.state === "running" &&
+        modules === "camera:running robot:running sources:running",
+        `the graph lists the booted modules with their states: ${graph.system} ${graph.state}, ${modules}`);
+  const sig = (graph.modules || []).flatMap((m) => m.kernels).find((k) => k.name === "sig") || {};
+  check(sig.type === "bench_source" && sig.mode === "continuous" && sig.cycle_ms === 20,
+        `kernel sig: ${sig.type} ${sig.mode} ${sig.cycle_ms} ms`);
+  const camChannel = (graph.channels || []).find((c) => c.source === "cam/out") || {};
+  check(camChannel.type === "oscar::GvImage" && camChannel.producer === "cam",
+        `channel cam/out: ${camChannel.type} from ${camChannel.producer}`);
+
+  // Reading the image topic raw converts nothing (the client read it raw for 3 s already).
+  const camSub = a.subscribe(CAM);
+  await sleep(1500);
+  const lastGraph = () => (graphs[graphs.length - 1] || {}).msg;
+  const idle = sideCounter(lastGraph(), CAM_SIDE);
+  check(idle === 0 && a.received.get(camSub).length > 0,
+        `while nobody subscribes to ${CAM_SIDE}, no image is converted (${idle}), though ${CAM} is read raw (${a.received.get(camSub).length} images)`);
+
+  // Subscribed, images arrive as foxglove.RawImage, decoded with the schema alone.
+  const sideSub = subscribeJson(a, CAM_SIDE);
+  await sleep(2000);
+  a.client.unsubscribe(sideSub);
+  const images = a.received.get(sideSub);
+  const decodedRight = (m) => m.msg && !m.msg.error && m.msg.width === 640 && m.msg.height === 480 &&
+    m.msg.encoding === "mono8" && m.msg.step === 640 && m.msg.frame_id === "cam" &&
+    m.msg.data instanceof Uint8Array && imageComplete({ msg: { dx: 640, dy: 480, image: m.msg.data } });
+  check(images.length >= 20, `${images.length} RawImages in 2 s (20 Hz source)`);
+  check(images.every(decodedRight),
+        `every RawImage decodes with only its schema: 640 x 480 mono8, step 640, frame cam, all ${640 * 480} pixels intact` +
+        (images.find((m) => !decodedRight(m)) ? ` (first bad: ${JSON.stringify(images.find((m) => !decodedRight(m)).msg).slice(0, 200)})` : ""));
+  const nowS = Date.now() / 1000;
+  check(images.every((m) => Math.abs(m.msg.timestamp.sec + m.msg.timestamp.nsec / 1e9 - nowS) < 60),
+        "their timestamps are the cues' stamps (recent)");
+  await sleep(1500);  // in flight, then a graph after the unsubscription
+  const stopped = sideCounter(lastGraph(), CAM_SIDE);
+  await sleep(2000);
+  const later = sideCounter(lastGraph(), CAM_SIDE);
+  figures.side_images = { received: images.length, converted: stopped };
+  check(stopped >= images.length && later === stopped && a.received.get(camSub).length > 0,
+        `once unsubscribed, conversion stops: ${stopped} converted for the ${images.length} received, ${later} two seconds later, the raw topic still read`);
+  a.client.unsubscribe(camSub);
+
+  // A robot state as a SceneUpdate: the robot as an entity where it stands.
+  const sceneSub = subscribeJson(a, ROBOT_SIDE);
+  await until(() => a.received.get(sceneSub).length >= 3, 5000);
+  a.client.unsubscribe(sceneSub);
+  const scene = (a.received.get(sceneSub)[0] || {}).msg || {};
+  const e = ((scene.entities || [])[0]) || {};
+  const disc = (e.cylinders || [])[0] || { pose: { position: {} }, size: {} };
+  check(!scene.error && e.id === "r7" && e.frame_id === "world" &&
+        Math.abs(disc.pose.position.x - 3) < 1e-6 && Math.abs(disc.pose.position.y - 4) < 1e-6 &&
+        Math.abs(disc.size.x - 0.6) < 1e-9,
+        `r7's state is a SceneUpdate: entity ${e.id} in ${e.frame_id}, a disc at (${disc.pose.position.x}, ${disc.pose.position.y}) of diameter ${disc.size.x} ${scene.error || ""}`);
+  a.client.unsubscribe(graphSub);
+}
+
+module.exports = { checkSideChannels, subscribeJson };
