@@ -33,7 +33,8 @@ if(OSCAR_WITH_FRAMEWORK)
   find_program(OSCAR_FASTDDSGEN fastddsgen REQUIRED)
   find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc imgcodecs videoio)
   find_package(apriltag REQUIRED)
-  # The keystore tool (oscar security) makes keys, certificates and S/MIME signatures with it.
+  # The keystore tool (oscar security) makes keys, certificates and S/MIME signatures with it;
+  # modules read their trusted identities' certificates with it (dds/writer_identity.cpp).
   find_package(OpenSSL 3 REQUIRED COMPONENTS Crypto)
   find_package(PkgConfig REQUIRED)
   pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)

@@ -9,6 +9,7 @@
 #include "command_bounds.hpp"
 #include "dds/module_dds.hpp"
 #include "module_slot.hpp"
+#include "oscar/security_files.hpp"
 #include "oscar/time.hpp"
 
 namespace oscar {
@@ -26,13 +27,31 @@ constexpr const char* kCoordinatorModule = "coordinator";
 // Kernels' command ports are the coordinator's (and boot's) too: the registry restores
 // configuration, it does not command actuators. The sender's name counts only from a process
 // that hosts no module of the system (boot, the registry, an operator's tool): a kernel cannot
-// borrow the coordinator's name, because the command comes from its module's process. (On the
-// wire, DDS Security's permissions make this hold against any participant, see docs/security.)
+// borrow the coordinator's name, because the command comes from its module's process. In a
+// secured system the name counts for nothing: the identity the writer authenticated as decides
+// (DDS Security's permissions say who may write the topic at all, see docs/security.md).
+constexpr const char* kRule =
+    "only the coordinator configures modules (the registry may suspend, resume and re-apply; "
+    "boot applies the initial configuration)";
+
+std::optional<std::string> refusal_by_identity(const ConfigCommand& c, const std::string& identity,
+                                               const std::string& kind, const std::string& module) {
+  if (identity == security_files::module_identity(kCoordinatorModule) ||
+      identity == security_files::kBoot || identity == security_files::kOperatorBoot) {
+    return std::nullopt;
+  }
+  if (identity == security_files::kRegistry && c.kind() != CMD_TRIGGER && c.kind() != CMD_COMMAND) {
+    return std::nullopt;
+  }
+  return fmt::format(
+      "refused: the writer authenticated as {} may not {} module '{}' (whatever "
+      "sender it names, here '{}'): {}",
+      identity.empty() ? "an identity with no such right" : "'" + identity + "'", kind, module,
+      c.sender(), kRule);
+}
+
 std::optional<std::string> refusal(const ConfigCommand& c, const CommandOrigin& origin,
                                    const std::string& kind, const std::string& module) {
-  constexpr const char* kRule =
-      "only the coordinator configures modules (the registry may suspend, resume and re-apply; "
-      "boot applies the initial configuration)";
   const bool from_coordinator =
       origin.modules.size() == 1 && origin.modules.front() == kCoordinatorModule;
   if (!origin.modules.empty() && !from_coordinator) {
@@ -41,6 +60,7 @@ std::optional<std::string> refusal(const ConfigCommand& c, const CommandOrigin& 
         "'{}', and {}",
         c.sender(), kind, module, fmt::join(origin.modules, "', '"), kRule);
   }
+  if (origin.identity) return refusal_by_identity(c, *origin.identity, kind, module);
   const std::string& sender = from_coordinator ? kCoordinatorModule : c.sender();
   if (sender == kCoordinatorModule || sender == "boot") return std::nullopt;
   if (sender == "registry" && c.kind() != CMD_TRIGGER && c.kind() != CMD_COMMAND) {

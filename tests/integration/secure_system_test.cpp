@@ -206,6 +206,23 @@ TEST_F(SecureSystem, TheOperatorLooksButOnlyOperatorBootConfigures) {
   system_->wait_for([](const SystemState& s) { return mode_of(s, "cam") == "continuous"; });
 }
 
+TEST_F(SecureSystem, TheIdentityAWriterAuthenticatedAsDecidesNotTheSenderItNames) {
+  // The registry's identity may suspend, not trigger: naming the coordinator does not help.
+  DdsParticipant registry(system_->domain(), "registry-2", as(keystore_, "registry"));
+  ConfigClient claims_coordinator(registry, "coordinator");
+  const auto refused = claims_coordinator.send("cam", CMD_TRIGGER, {"cam"}, 10s);
+  EXPECT_FALSE(refused.ok());
+  EXPECT_THAT(refused.error(),
+              HasSubstr("refused: the writer authenticated as 'registry' may not trigger module "
+                        "'cam' (whatever sender it names, here 'coordinator')"));
+  // Boot's authority holds under any name.
+  DdsParticipant operator_boot(system_->domain(), "operator-2", as(keystore_, "operator_boot"));
+  ConfigClient nameless(operator_boot, "someone");
+  const auto reply = nameless.send("cam", CMD_ACTIVATE, {"*", "continuous:100ms"}, 10s);
+  ASSERT_TRUE(reply.ok()) << reply.error();
+  system_->wait_for([](const SystemState& s) { return mode_of(s, "cam") == "continuous"; });
+}
+
 TEST_F(SecureSystem, OnlyTheRegistryMayWriteLaunchRequests) {
   for (const auto* identity : {"boot", "operator_boot", "module.rogue", "monitor.localhost"}) {
     DdsParticipant p(system_->domain(), "forger", as(keystore_, identity));

@@ -33,6 +33,10 @@ class SequenceStore;
 struct CommandOrigin {
   /// Empty for a process that hosts no module of the system: boot, the registry, a tool.
   std::vector<std::string> modules;
+  /// In a secured system, the identity the writer authenticated as ("registry", "boot",
+  /// "operator_boot", "module.coordinator"; "" for any other): it, not the command's claimed
+  /// sender, decides. Unset without DDS Security.
+  std::optional<std::string> identity{};
 };
 
 class Module {

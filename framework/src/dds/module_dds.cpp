@@ -5,6 +5,7 @@
 #include "dds/log_sink.hpp"
 #include "oscar/malformed_samples.hpp"
 #include "oscar/raw_cdr_type.hpp"
+#include "oscar/security_files.hpp"
 #include "oscar/topic_io.hpp"
 
 #include <unistd.h>
@@ -176,6 +177,13 @@ Module::Dds::Dds(Module& module, int domain)
   // Samples dropped as malformed are reported where the module's other lines go: its console
   // and oscar/log. The logger outlives this (shared), and its DDS sink is detached below.
   set_malformed_sample_log(module.log_);
+  if (const auto& security = module.spec_.network.security) {
+    trusted_writers_.emplace(
+        security->keystore,
+        std::vector<std::string>{security_files::module_identity("coordinator"),
+                                 security_files::kRegistry, security_files::kBoot,
+                                 security_files::kOperatorBoot});
+  }
 }
 
 Module::Dds::~Dds() {
@@ -417,6 +425,9 @@ void Module::Dds::start_config() {
 // embedded modules).
 CommandOrigin Module::Dds::origin_of(const eprosima::fastdds::dds::SampleInfo& info) {
   CommandOrigin origin;
+  if (trusted_writers_) {
+    origin.identity = trusted_writers_->of(info.sample_identity.writer_guid().guidPrefix);
+  }
   const auto& system = module_.spec_.system_modules;
   for (auto& m : participant_.modules_in_process_of(info.sample_identity.writer_guid())) {
     if (std::find(system.begin(), system.end(), m) != system.end() &&

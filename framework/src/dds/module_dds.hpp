@@ -21,6 +21,7 @@
 #include "command_rate_limit.hpp"
 #include "dds/module_wishes.hpp"
 #include "dds/pull.hpp"
+#include "dds/writer_identity.hpp"
 #include "module_slot.hpp"
 #include "oscar/dds_participant.hpp"
 #include "oscar/module.hpp"
@@ -98,8 +99,11 @@ class Module::Dds {
     ConfigCommand command;
     CommandOrigin origin;
   };
-  // The modules of the running system living in the process that wrote a command.
+  // The modules of the running system living in the process that wrote a command, and in a
+  // secured system the identity it authenticated as.
   CommandOrigin origin_of(const eprosima::fastdds::dds::SampleInfo& info);
+  // Secured systems: the identities whose commands count, by their certificates.
+  std::optional<internal::WriterIdentities> trusted_writers_;
   // Called on a DDS thread for each command: queues it unless its writer is over its rate or
   // the queue is full.
   void enqueue(const ConfigCommand& c, const eprosima::fastdds::dds::SampleInfo& info);
