@@ -138,13 +138,19 @@ constexpr std::chrono::milliseconds kDiscoveryWindow{400};
 // one's shutdown would stop the other.
 void check_domain_free(oscar::DdsParticipant& participant, oscar::RegistryClient& registry) {
   std::this_thread::sleep_for(kDiscoveryWindow);
-  std::set<std::string> members;
-  for (const auto& name : participant.discovered_participants()) {
-    if (oscar::is_system_member(name)) members.insert(name);
-  }
-  if (members.empty()) return;
-  // The other registry's state names the system; it may come a moment after its participant.
-  const auto state = registry.wait_for([](const auto&) { return true; }, kDiscoveryWindow);
+  const auto members_seen = [&] {
+    std::set<std::string> members;
+    for (const auto& name : participant.discovered_participants()) {
+      if (oscar::is_system_member(name)) members.insert(name);
+    }
+    return members;
+  };
+  if (members_seen().empty()) return;
+  // Refused. The other registry's state names the system: it may come a while after the first
+  // participant seen (a loaded machine), and the refusal is worth the wait.
+  const auto state =
+      registry.wait_for([](const auto&) { return true; }, std::chrono::milliseconds(3000));
+  const auto members = members_seen();
   throw std::runtime_error(fmt::format(
       "domain {} is in use by {}: {}; stop it (oscar shutdown -d {}) or boot on another domain "
       "(--domain N)",
