@@ -1,6 +1,8 @@
 // Registry, monitors and boot with real processes on loopback (issue 3, tests a-e and g).
 #include <signal.h>
 
+#include <algorithm>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -136,7 +138,15 @@ kernels: [ { type: test_collect, name: watch, inputs: { in: src/out } } ]
   s = sys.wait_for([](const SystemState& st) {
     return entry(st, "src")->incarnation() == 2 && st.state() == "running";
   });
-  std::this_thread::sleep_for(500ms);
+  // The watcher, not part of the system, takes its time to discover the new writer (seconds
+  // under a sanitizer on a loaded machine): wait for cues of the new incarnation.
+  const auto cues_after_kill = [&] {
+    const auto seen = collected.seen();
+    return std::count_if(seen.begin(), seen.end(), [&](const auto& cue) {
+      return cue->header().stamps().front() > static_cast<unsigned long long>(killed_at);
+    });
+  };
+  for (int i = 0; i < 100 && cues_after_kill() <= 20; ++i) std::this_thread::sleep_for(100ms);
   watcher->stop();
   const auto cues = collected.seen();
   ASSERT_GT(cues.size(), 20u);
