@@ -205,6 +205,25 @@ modules:
                    << config_bridge.output();
   for (const auto pid : test::processes_mentioning("bench_source:late")) ::kill(pid, SIGKILL);
 
+  // A bridge that sends each client at most 5 images per second of a channel: the 20 Hz camera
+  // arrives at about 5 Hz, the 50 Hz Bool untouched, and the client is told why.
+  Process throttled(
+      {test::bin("oscar-bridge"), "foxglove", "-d", domain, "--port", "0", "--image-rate", "5"},
+      test::temp_path("throttled_bridge") + ".log");
+  const auto throttled_port = served_port(throttled);
+  ASSERT_NE(throttled_port, 0) << throttled.output();
+  Process rate_client({node, std::string(OSCAR_FOXGLOVE_TEST_DIR) + "/image_rate.js", "--url",
+                       "ws://127.0.0.1:" + std::to_string(throttled_port), "--image",
+                       "oscar/cue/cam/out", "--bool", "oscar/cue/sig/out"},
+                      test::temp_path("image_rate_client") + ".log");
+  ASSERT_EQ(rate_client.wait(60s), 0) << rate_client.output();
+  const auto rates = nlohmann::json::parse(rate_client.output());
+  EXPECT_GE(rates["images_per_s"].get<double>(), 3.5) << rates;
+  EXPECT_LE(rates["images_per_s"].get<double>(), 6.0) << rates;
+  EXPECT_GE(rates["bools_per_s"].get<double>(), 25.0) << rates;
+  EXPECT_TRUE(rates["told"].get<bool>()) << rates;
+  throttled.stop();
+
   // The bridge read the topics only while subscribed, and said whom it dropped what for.
   const auto log = bridge.output();
   EXPECT_THAT(log, HasSubstr("subscribes to oscar/cue/sig/out"));

@@ -39,6 +39,11 @@ int main(int argc, char** argv) {
                    "per client: MiB of messages queued before the oldest are dropped")
       ->capture_default_str()
       ->check(CLI::Range(1, 1 << 20));
+  foxglove
+      ->add_option("--image-rate", options.image_rate,
+                   "per client and image channel: images per second at most (0: every image)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   foxglove->add_flag(
       "--allow-config", options.allow_config,
       "offer the service oscar/config: Foxglove users may then configure modules with the "

@@ -109,7 +109,8 @@ struct FoxgloveBridge::Impl final : SessionHost {
       // for the client's delayed ACK (a GvImage to 4 clients took a frame period, 33 ms, p50).
       boost::system::error_code ignored;
       s.set_option(tcp::no_delay(true), ignored);
-      auto session = std::make_shared<Session>(std::move(s), *this, options.queue);
+      auto session =
+          std::make_shared<Session>(std::move(s), *this, options.queue, options.image_rate);
       sessions.insert(session);
       session->start();
       accept();

@@ -21,6 +21,7 @@ struct BridgeOptions {
   std::string address = "127.0.0.1";  ///< where to listen: loopback unless told otherwise
   std::uint16_t port = 8765;          ///< 0: any free port (see FoxgloveBridge::port())
   QueueLimits queue;                  ///< per client
+  double image_rate = 0;              ///< images per second and channel to a client (0: all)
   std::chrono::milliseconds discovery_period{200};
   std::chrono::milliseconds report_period{1000};  ///< how often drops are reported
   /// Offer the service oscar/config (configuration commands with the coordinator's authority;

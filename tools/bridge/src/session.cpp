@@ -38,8 +38,9 @@ bool offers(std::string_view offer, std::string_view wanted) {
 }
 }  // namespace
 
-Session::Session(net::ip::tcp::socket socket, SessionHost& host, QueueLimits limits)
-    : ws_(std::move(socket)), host_(host), queue_(limits) {
+Session::Session(net::ip::tcp::socket socket, SessionHost& host, QueueLimits limits,
+                 double images_per_second)
+    : ws_(std::move(socket)), host_(host), queue_(limits), images_(images_per_second) {
   peer_ = describe(beast::get_lowest_layer(ws_).socket());
 }
 
@@ -197,6 +198,7 @@ void Session::unsubscribe(std::uint32_t subscription) {
   channel_of_.erase(it);
   subscription_of_.erase(channel);
   queue_.forget(channel);
+  images_.forget(channel);
   host_.unwant(channel);
 }
 
@@ -213,6 +215,19 @@ void Session::set_status(StatusLevel level, std::string message) {
 
 void Session::deliver(const ClientQueue::Message& message) {
   if (!subscription_of_.contains(message.channel)) return;
+  if (images_.limits()) {
+    const auto* c = host_.channel(message.channel);
+    if (c && is_image_schema(c->schema_name) &&
+        !images_.admit(message.channel, message.receive_ns)) {
+      if (images_.held_back().at(message.channel) == 1) {
+        set_status(StatusLevel::kInfo,
+                   fmt::format("{}: images come faster than this bridge's image rate for a "
+                               "client (--image-rate); the others are held back",
+                               c->topic));
+      }
+      return;
+    }
+  }
   queue_.push(message);
   write_next();
 }
@@ -223,6 +238,7 @@ void Session::forget_channel(std::uint32_t channel) {
   channel_of_.erase(it->second);
   subscription_of_.erase(it);
   queue_.forget(channel);
+  images_.forget(channel);
 }
 
 std::map<std::uint32_t, std::uint64_t> Session::new_drops() {

@@ -23,6 +23,7 @@
 
 #include "client_queue.hpp"
 #include "foxglove_protocol.hpp"
+#include "image_throttle.hpp"
 
 namespace oscar::bridge {
 
@@ -49,7 +50,9 @@ class SessionHost {
 
 class Session : public std::enable_shared_from_this<Session> {
  public:
-  Session(boost::asio::ip::tcp::socket socket, SessionHost& host, QueueLimits limits);
+  /// `images_per_second` (> 0) limits each image channel's rate to this client (ImageThrottle).
+  Session(boost::asio::ip::tcp::socket socket, SessionHost& host, QueueLimits limits,
+          double images_per_second = 0);
   /// Reads the HTTP upgrade request and accepts the WebSocket.
   void start();
   /// Sends a JSON text message (never dropped).
@@ -61,7 +64,8 @@ class Session : public std::enable_shared_from_this<Session> {
   void fail_call(const ServiceCall& call, const std::string& why);
   /// Answers waiting at most (of a client that calls but does not read, the newest are lost).
   static constexpr std::size_t kMaxPendingCallReplies = 64;
-  /// Queues a message of `channel` if this client subscribes to it.
+  /// Queues a message of `channel` if this client subscribes to it (and, for an image, if it
+  /// is due at this client's image rate).
   void deliver(const ClientQueue::Message& message);
   /// `channel` is no more: its subscription ends without a word (it was unadvertised).
   void forget_channel(std::uint32_t channel);
@@ -94,6 +98,7 @@ class Session : public std::enable_shared_from_this<Session> {
   std::optional<boost::beast::http::request<boost::beast::http::string_body>> request_;
   std::shared_ptr<boost::beast::http::response<boost::beast::http::string_body>> rejection_;
   ClientQueue queue_;
+  ImageThrottle images_;
   struct Frame {
     std::string bytes;
     bool binary = false;
