@@ -162,8 +162,8 @@ std::string make_keystore(const std::string& file) {
   return keystore;
 }
 
-// One boot: the time boot reports to `running`, then one module's restart, then Ctrl-C. The
-// module restarted is the last sink, on the last host.
+// One boot: the time boot reports to `running`, then one module's restart (the last sink),
+// then Ctrl-C.
 void run_once(const Options& o, const Hosts& hosts, const std::string& file,
               const std::string& keystore, int run, Figures& f) {
   const auto restarted = fmt::format("m{}", o.modules % 2 == 0 ? o.modules - 1 : o.modules - 2);
