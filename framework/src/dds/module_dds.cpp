@@ -183,6 +183,12 @@ Module::Dds::Dds(Module& module, int domain)
         std::vector<std::string>{security_files::module_identity("coordinator"),
                                  security_files::kRegistry, security_files::kBoot,
                                  security_files::kOperatorBoot});
+    for (const auto& identity : trusted_writers_->missing()) {
+      module.log_->warn(
+          "keystore {} holds no certificate of identity '{}': its configuration "
+          "commands will be refused (oscar security init adds it)",
+          security->keystore, identity);
+    }
   }
 }
 

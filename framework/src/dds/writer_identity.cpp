@@ -45,7 +45,7 @@ WriterIdentities::WriterIdentities(const std::filesystem::path& keystore,
     try {
       known_.emplace_back(subject_bits_of_certificate(pem), identity);
     } catch (const std::runtime_error&) {
-      // Not in this keystore: its writers stay unknown, and commands from them are refused.
+      missing_.push_back(identity);  // its writers stay unknown: their commands are refused
     }
   }
 }

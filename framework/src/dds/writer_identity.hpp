@@ -35,9 +35,12 @@ class WriterIdentities {
 
   /// The identity whose certificate gave `writer_prefix` its bits, or "" for none of them.
   std::string of(const eprosima::fastrtps::rtps::GuidPrefix_t& writer_prefix) const;
+  /// The identities whose certificates were not found.
+  const std::vector<std::string>& missing() const { return missing_; }
 
  private:
   std::vector<std::pair<SubjectBits, std::string>> known_;
+  std::vector<std::string> missing_;
 };
 
 }  // namespace oscar::internal
