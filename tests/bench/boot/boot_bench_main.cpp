@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 #include <oscar/command_line.hpp>
 
+#include "bench_system.hpp"  // tests/common
 #include "oscar/process_util.hpp"
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/registry/system_spec.hpp"
@@ -29,6 +30,7 @@
 
 namespace {
 using namespace std::chrono_literals;
+using oscar::test::module_of;
 using oscar::test::percentile;
 
 struct Options {
@@ -120,24 +122,17 @@ std::string system_yaml(const Options& o, const Hosts& hosts) {
   return yaml;
 }
 
-const oscar::ModuleEntry* find(const oscar::SystemState& s, const std::string& name) {
-  for (const auto& m : s.modules()) {
-    if (m.name() == name) return &m;
-  }
-  return nullptr;
-}
-
 // kill -9 of `module` until the registry reports the system running with its next incarnation.
 double restart_ms(oscar::RegistryClient& registry, const std::string& module) {
   const auto before =
       registry.wait_for([](const oscar::SystemState& s) { return s.state() == "running"; }, 30s);
-  if (!before || !find(*before, module)) throw std::runtime_error("the system is not running");
-  const auto incarnation = find(*before, module)->incarnation();
+  if (!before || !module_of(*before, module)) throw std::runtime_error("the system is not running");
+  const auto incarnation = module_of(*before, module)->incarnation();
   const auto t0 = oscar::wall_now();
-  kill(static_cast<pid_t>(find(*before, module)->pid()), SIGKILL);
+  kill(static_cast<pid_t>(module_of(*before, module)->pid()), SIGKILL);
   const auto back = registry.wait_for(
       [&](const oscar::SystemState& s) {
-        const auto* m = find(s, module);
+        const auto* m = module_of(s, module);
         return s.state() == "running" && m && m->incarnation() > incarnation;
       },
       60s);
@@ -148,19 +143,6 @@ double restart_ms(oscar::RegistryClient& registry, const std::string& module) {
 struct Figures {
   std::vector<double> boot_ms, restart_ms;
 };
-
-// A keystore for the system in `file`, made by `oscar security init` in a folder of its own.
-std::string make_keystore(const std::string& file) {
-  const auto keystore = oscar::test::temp_path("bench_boot_keys");
-  std::filesystem::remove_all(keystore);
-  oscar::test::Process init(
-      {oscar::sibling_program("oscar-security"), "init", file, "--keystore", keystore},
-      keystore + ".log");
-  if (init.wait(60s) != 0) {
-    throw std::runtime_error("oscar security init failed:\n" + init.output());
-  }
-  return keystore;
-}
 
 // One boot: the time boot reports to `running`, then one module's restart (the last sink),
 // then Ctrl-C.
@@ -249,7 +231,7 @@ int main(int argc, char** argv) {
     const Hosts hosts(o);
     const auto file = oscar::test::temp_path("bench_boot") + ".yaml";
     std::ofstream(file) << system_yaml(o, hosts);
-    const auto keystore = o.security ? make_keystore(file) : "";
+    const auto keystore = o.security ? oscar::test::make_bench_keystore(file, "bench_boot") : "";
     Figures f;
     for (int run = 0; run < o.runs; ++run) run_once(o, hosts, file, keystore, run, f);
     if (!keystore.empty()) std::filesystem::remove_all(keystore);

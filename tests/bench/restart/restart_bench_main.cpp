@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 #include <oscar/command_line.hpp>
 
+#include "bench_system.hpp"  // tests/common
 #include "oscar/process_util.hpp"
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/time.hpp"
@@ -26,14 +27,8 @@
 namespace {
 using namespace std::chrono_literals;
 
+using oscar::test::module_of;
 using oscar::test::percentile;
-
-const oscar::ModuleEntry* find(const oscar::SystemState& s, const std::string& name) {
-  for (const auto& m : s.modules()) {
-    if (m.name() == name) return &m;
-  }
-  return nullptr;
-}
 
 struct Failures {
   std::vector<double> detect_ms, resume_ms;
@@ -49,14 +44,15 @@ Failures fail_modules(oscar::RegistryClient& registry, const std::vector<std::st
     const auto before =
         registry.wait_for([&](const oscar::SystemState& s) { return s.state() == "running"; }, 30s);
     if (!before) throw std::runtime_error("the system is not running");
-    const auto incarnation = find(*before, name)->incarnation();
+    const auto incarnation = module_of(*before, name)->incarnation();
     const auto t0 = oscar::wall_now();
-    kill(static_cast<pid_t>(find(*before, name)->pid()), sig);
+    kill(static_cast<pid_t>(module_of(*before, name)->pid()), sig);
     const auto detected = registry.wait_for(
-        [&](const oscar::SystemState& s) { return find(s, name)->status() != "running"; }, 30s);
+        [&](const oscar::SystemState& s) { return module_of(s, name)->status() != "running"; },
+        30s);
     const auto back = registry.wait_for(
         [&](const oscar::SystemState& s) {
-          return s.state() == "running" && find(s, name)->incarnation() > incarnation;
+          return s.state() == "running" && module_of(s, name)->incarnation() > incarnation;
         },
         30s);
     if (!detected || !back) throw std::runtime_error(name + " did not come back within 30 s");
@@ -67,18 +63,6 @@ Failures fail_modules(oscar::RegistryClient& registry, const std::vector<std::st
                  f.detect_ms.back(), f.resume_ms.back());
   }
   return f;
-}
-
-// A keystore for the system in `file`, made by `oscar security init` in a folder of its own.
-std::string make_keystore(const std::string& file, const std::string& name) {
-  const auto keystore = oscar::test::temp_path(name + "_keys");
-  std::filesystem::remove_all(keystore);
-  oscar::test::Process init(
-      {oscar::sibling_program("oscar-security"), "init", file, "--keystore", keystore},
-      oscar::test::temp_path(name + "_keys") + ".log");
-  if (init.wait(60s) != 0)
-    throw std::runtime_error("oscar security init failed:\n" + init.output());
-  return keystore;
 }
 
 // boot's arguments for the system in `file` on `domain`, with `keystore` unless it is empty.
@@ -120,7 +104,7 @@ double boot_time_ms(int modules, bool netns, int domain, bool secured) {
   }
   const auto file = oscar::test::temp_path("bench_boot20") + ".yaml";
   std::ofstream(file) << yaml;
-  const auto keystore = secured ? make_keystore(file, "bench_boot20") : "";
+  const auto keystore = secured ? oscar::test::make_bench_keystore(file, "bench_boot20") : "";
   std::vector<std::string> argv;
   if (netns) argv = hosts->on(1);
   const auto boot_argv =
@@ -159,7 +143,7 @@ void time_failures(Run& run, int kills, int hangs, int domain, bool secured) {
   const auto name = std::string(secured ? "bench_restart_secured" : "bench_restart");
   const auto file = oscar::test::temp_path(name) + ".yaml";
   std::ofstream(file) << kRestartSystem;
-  const auto keystore = secured ? make_keystore(file, name) : "";
+  const auto keystore = secured ? oscar::test::make_bench_keystore(file, name) : "";
   oscar::test::Process boot(
       boot_command(file, domain, oscar::test::temp_path(name + "_logs"), keystore),
       oscar::test::temp_path(name) + ".log");
