@@ -6,6 +6,7 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <mutex>
 #include <set>
 #include <string>
@@ -50,6 +51,10 @@ TEST(Topics, TheWriterAndReaderOfEveryCatalogueTopicMatch) {
   expect_both_sides_match(p, topics::sched_command());
   expect_both_sides_match(p, topics::sched_command_reply());
   expect_both_sides_match(p, topics::sched_wishes());
+  expect_both_sides_match(p, topics::swarm_request());
+  expect_both_sides_match(p, topics::swarm_reply());
+  expect_both_sides_match(p, topics::swarm_status());
+  expect_both_sides_match(p, topics::swarm_plan());
   expect_both_sides_match(p, topics::pull_request("k/out"));
   expect_both_sides_match(p, topics::pull_reply("k/out"));
 }
@@ -75,10 +80,14 @@ TEST(Topics, EveryCatalogueTopicHasANameOfItsOwn) {
                                     topics::sched_command().name,
                                     topics::sched_command_reply().name,
                                     topics::sched_wishes().name,
+                                    topics::swarm_request().name,
+                                    topics::swarm_reply().name,
+                                    topics::swarm_status().name,
+                                    topics::swarm_plan().name,
                                     topics::pull_request("k/out").name,
                                     topics::pull_reply("k/out").name,
                                     topics::cue("k/out")};
-  EXPECT_EQ(names.size(), 23u);
+  EXPECT_EQ(names.size(), 27u);
 }
 
 // A module's first log lines are written before boot's reader has discovered it (its process
@@ -107,6 +116,39 @@ TEST(Topics, ALogReaderThatMatchesLateGetsTheLinesWrittenBefore) {
       5s));
   std::lock_guard lock(mutex);
   EXPECT_EQ(got, (std::vector<std::string>{"line 0", "line 1", "line 2"}));
+}
+
+// A requester's reader matches the replier's writer before that writer has matched the reader
+// (each side learns of the other on its own): a reply written in between must still arrive.
+template <class T, class PubSubType>
+void expect_a_late_reader_gets_the_reply(DdsParticipant& p, const TopicSpec<T, PubSubType>& spec) {
+  TopicWriter<T, PubSubType> writer(p, spec);
+  T reply;
+  reply.id(42);
+  writer.write(reply);
+  std::atomic<unsigned long long> got{0};
+  TopicReader<T, PubSubType> reader(p, spec, [&](const T& r, const auto&) { got = r.id(); });
+  EXPECT_TRUE(eventually([&] { return got == 42; }, 5s))
+      << spec.name << ": a reply written before the requester's reader matched was lost";
+}
+
+TEST(Topics, AReplyWrittenBeforeTheRequesterMatchedReachesIt) {
+  DdsParticipant p(150 + getpid() % 50, "test:topics");
+  expect_a_late_reader_gets_the_reply(p, topics::config_reply("m"));
+  expect_a_late_reader_gets_the_reply(p, topics::registry_reply());
+}
+
+TEST(Topics, ASwarmReplyWrittenBeforeTheRequesterMatchedReachesIt) {
+  DdsParticipant p(150 + getpid() % 50, "test:topics");
+  TopicWriter<SwarmReply, SwarmReplyPubSubType> writer(p, topics::swarm_reply());
+  SwarmReply reply;
+  reply.request(42);
+  writer.write(reply);
+  std::atomic<unsigned long long> got{0};
+  TopicReader<SwarmReply, SwarmReplyPubSubType> reader(
+      p, topics::swarm_reply(), [&](const SwarmReply& r, const auto&) { got = r.request(); });
+  EXPECT_TRUE(eventually([&] { return got == 42; }, 5s))
+      << "a swarm reply written before `oscar swarm`'s reader matched was lost";
 }
 
 TEST(Topics, CueTopicsAreNamedAfterTheirOutput) {

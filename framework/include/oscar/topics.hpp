@@ -97,9 +97,9 @@ TopicSpec<SchedNotice, SchedNoticePubSubType> sched_notice();
 TopicSpec<SchedCommand, SchedCommandPubSubType> sched_command();
 TopicSpec<SchedCommandReply, SchedCommandReplyPubSubType> sched_command_reply();
 
-/// The live swarm (docs/swarm.md): jobs submitted to the coordinator and its replies (reliable,
-/// volatile, keep all), the swarm's status (keep last 1; `oscar swarm status`) and its committed
-/// plan (keep last 1; `oscar swarm snapshot`).
+/// The live swarm (docs/swarm.md): jobs submitted to the coordinator (reliable, volatile, keep
+/// all), its replies (transient-local, the last 64), its status (keep last 1; `oscar swarm
+/// status`) and its committed plan (keep last 1; `oscar swarm snapshot`).
 TopicSpec<SwarmRequest, SwarmRequestPubSubType> swarm_request();
 TopicSpec<SwarmReply, SwarmReplyPubSubType> swarm_reply();
 TopicSpec<SwarmStatus, SwarmStatusPubSubType> swarm_status();

@@ -122,7 +122,10 @@ TopicSpec<SwarmRequest, SwarmRequestPubSubType> swarm_request() {
 }
 
 TopicSpec<SwarmReply, SwarmReplyPubSubType> swarm_reply() {
-  return {"oscar/swarm/reply", qos::command_writer(), qos::command_reader()};
+  // Transient-local: a reader matches the coordinator's writer before that writer has matched
+  // the reader, so a reply written in between would be lost to a volatile reader, and the
+  // requester would wait for it in vain. Kept replies reach a late reader; it takes its own.
+  return {"oscar/swarm/reply", qos::state_writer(64), qos::state_reader(64)};
 }
 
 TopicSpec<SwarmStatus, SwarmStatusPubSubType> swarm_status() {
