@@ -1,6 +1,7 @@
 #include "oscar/registry/run_command.hpp"
 
 #include <fcntl.h>
+#include <linux/close_range.h>
 #include <poll.h>
 #include <pthread.h>
 #include <signal.h>
@@ -63,6 +64,7 @@ CommandResult run_command(const std::vector<std::string>& argv, std::chrono::mil
     dup2(in[0], 0);
     dup2(out[1], 1);
     dup2(out[1], 2);
+    close_range(3, ~0U, CLOSE_RANGE_CLOEXEC);  // the caller's sockets and files stay with it
     execvp(cargs[0], cargs.data());
     constexpr char kFailed[] = ": cannot be started\n";
     (void)!::write(2, cargs[0], std::strlen(cargs[0]));

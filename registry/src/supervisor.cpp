@@ -1,6 +1,7 @@
 #include "oscar/registry/supervisor.hpp"
 
 #include <fcntl.h>
+#include <linux/close_range.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -40,7 +41,8 @@ std::string ProcessExit::describe() const {
   return fmt::format("exited with code {}", exit_code);
 }
 
-Supervisor::Supervisor(std::string log_dir) : log_dir_(std::move(log_dir)) {
+Supervisor::Supervisor(std::string log_dir, int death_signal)
+    : log_dir_(std::move(log_dir)), death_signal_(death_signal) {
   std::error_code ec;
   std::filesystem::create_directories(log_dir_, ec);
   if (ec) {
@@ -90,9 +92,10 @@ pid_t Supervisor::start(const std::string& module, unsigned incarnation,
   for (auto& e : envs) cenv.push_back(e.data());
   cenv.push_back(nullptr);
   const pid_t parent = getpid();
+  const int death_signal = death_signal_;
   const pid_t pid = fork();
   if (pid == 0) {
-    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    prctl(PR_SET_PDEATHSIG, death_signal);
     if (getppid() != parent) _exit(127);  // the supervisor died before prctl
     setpgid(0, 0);
     sigset_t none;
@@ -102,6 +105,10 @@ pid_t Supervisor::start(const std::string& module, unsigned incarnation,
     dup2(fd, 2);
     const int devnull = ::open("/dev/null", O_RDONLY);
     if (devnull >= 0) dup2(devnull, 0);
+    // Nothing else of the supervisor's goes along: its DDS sockets, and the lock files of its
+    // shared-memory segments, which would make it look alive to every sweeper for as long as
+    // the child lives (the report pipe is close-on-exec already).
+    close_range(3, ~0U, CLOSE_RANGE_CLOEXEC);
     execvpe(cargs[0], cargs.data(), cenv.data());
     const int err = errno;
     (void)!::write(report[1], &err, sizeof err);

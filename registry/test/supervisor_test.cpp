@@ -1,11 +1,15 @@
 #include "oscar/registry/supervisor.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <thread>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -43,6 +47,22 @@ TEST(Supervisor, ReportsTheExitCodeAndTheLastOutput) {
   std::stringstream text;
   text << log.rdbuf();
   EXPECT_THAT(text.str(), HasSubstr("=== m incarnation 1 started"));
+}
+
+// A module must not hold its monitor's sockets and shared-memory lock files (nor a monitor
+// boot's): a killed monitor would look alive to every sweeper while its modules live.
+TEST(Supervisor, AChildInheritsNoFileOfTheSupervisor) {
+  const auto held = dir("held") + ".txt";
+  const int fd = ::open(held.c_str(), O_WRONLY | O_CREAT, 0644);  // inheritable, as DDS's are
+  ASSERT_GE(fd, 3);
+  Supervisor s(dir("inherit"));
+  s.start("m", 1,
+          {"sh", "-c", fmt::format("test -e /proc/$$/fd/{} && echo inherited || echo none", fd)});
+  const auto exits = reap_within(s, std::chrono::seconds(5));
+  ::close(fd);
+  std::filesystem::remove(held);
+  ASSERT_EQ(exits.size(), 1u);
+  EXPECT_THAT(exits[0].last_output, ::testing::EndsWith("\nnone"));
 }
 
 TEST(Supervisor, ReportsASignal) {

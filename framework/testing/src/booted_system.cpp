@@ -1,6 +1,7 @@
 #include "oscar/testing/booted_system.hpp"
 
 #include <fcntl.h>
+#include <linux/close_range.h>
 #include <signal.h>
 #include <sys/file.h>
 #include <sys/prctl.h>
@@ -290,6 +291,8 @@ SystemUnderTest::SystemUnderTest(const std::string& system_file, BootOptions opt
     sigset_t none;
     sigemptyset(&none);
     sigprocmask(SIG_SETMASK, &none, nullptr);
+    // The test's own DDS sockets and shared-memory locks stay with the test.
+    close_range(3, ~0U, CLOSE_RANGE_CLOEXEC);
     execv(args[0], args.data());
     _exit(127);
   }

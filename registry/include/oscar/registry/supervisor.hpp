@@ -6,6 +6,7 @@
 #include <sys/types.h>
 
 #include <chrono>
+#include <csignal>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,13 +28,16 @@ struct ProcessExit {
 class Supervisor {
  public:
   /// Module output goes to `<log_dir>/<module>.log` (appended, one header line per start).
-  explicit Supervisor(std::string log_dir);
+  /// Children get `death_signal` when the supervisor's process dies (PR_SET_PDEATHSIG): SIGKILL
+  /// for a monitor's modules (they die with their host), SIGTERM for boot's registry and
+  /// monitors, so that a killed boot still stops the system in order.
+  explicit Supervisor(std::string log_dir, int death_signal = SIGKILL);
   ~Supervisor();  ///< stops whatever still runs
   Supervisor(const Supervisor&) = delete;
   Supervisor& operator=(const Supervisor&) = delete;
 
   /// Starts `argv` (argv[0] looked up on PATH unless it has a '/') with extra "NAME=value"
-  /// environment entries. Children die with the supervisor (PR_SET_PDEATHSIG).
+  /// environment entries. Children die with the supervisor (see the constructor).
   /// @throws std::runtime_error "cannot start <module>: <program>: <reason>" if exec fails.
   pid_t start(const std::string& module, unsigned incarnation, const std::vector<std::string>& argv,
               const std::vector<std::string>& env = {});
@@ -56,6 +60,7 @@ class Supervisor {
   ProcessExit finished(const Child& child, int status) const;
 
   std::string log_dir_;
+  int death_signal_;
   std::vector<Child> children_;  // in start order
 };
 
