@@ -73,6 +73,28 @@ TEST_F(SharedMemoryDir, RemovesOnlyWhatDeadProcessesLeft) {
   EXPECT_TRUE(fs::exists(dir_ / "other")) << "not Fast DDS's";
 }
 
+// What the last process of a system removes as it exits: everything of the dead at once, and the
+// participant id claims of its own domain that killed processes left (a living one's stays).
+TEST_F(SharedMemoryDir, AtExitEverythingOfTheDeadAndTheDomainsAbandonedClaimsGo) {
+  for (const auto* name : {"fastrtps_0123456789abcdef", "fastrtps_port7411", "fastrtps_live"}) {
+    touch(name);
+    touch(std::string(name) + "_el");
+  }
+  touch("sem.fastrtps_port7411_mutex");
+  hold("fastrtps_live_el");
+  const auto claims = internal::claim_prefix(7);
+  touch(claims + "127.0.0.1_0");  // left by a killed process
+  touch(claims + "127.0.0.1_1");
+  hold(claims + "127.0.0.1_1");                      // its process lives
+  touch(internal::claim_prefix(8) + "127.0.0.1_0");  // another system's
+  EXPECT_EQ(remove_files_of_dead_processes(7, dir_), 3u);
+  std::set<std::string> left;
+  for (const auto& e : fs::directory_iterator(dir_)) left.insert(e.path().filename().string());
+  EXPECT_EQ(left,
+            (std::set<std::string>{"fastrtps_live", "fastrtps_live_el", claims + "127.0.0.1_1",
+                                   internal::claim_prefix(8) + "127.0.0.1_0"}));
+}
+
 // Fast DDS leaves a port's semaphore behind when the port goes, and a sender that opens the port
 // of a dead participant creates the port anew, with no owner: both would pile up for good.
 TEST_F(SharedMemoryDir, RemovesPortsNobodyOwnsAndLocksOfPortsThatAreGone) {

@@ -35,6 +35,7 @@
 #include "oscar/registry/supervisor.hpp"
 #include "oscar/registry/system_spec.hpp"
 #include "oscar/security_files.hpp"
+#include "oscar/shared_memory.hpp"
 #include "oscar/time.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
@@ -282,6 +283,9 @@ int main(int argc, char** argv) {
          .keystore = keystore,
          .boot_pid = getpid(),
          .started = static_cast<long long>(std::time(nullptr))});
+    // Boot outlives its participant only by a moment: the port semaphores Fast DDS leaves when it
+    // ends are removed by the next boot, with whatever else ended processes left.
+    oscar::remove_files_of_dead_processes(system.domain);
     oscar::DdsParticipant participant(system.domain, "oscar-boot",
                                       system.network_for(local.name, oscar::security_files::kBoot));
     std::mutex last_line_mutex;  // DDS may call back from its UDP and shared-memory threads
@@ -330,7 +334,10 @@ int main(int argc, char** argv) {
 
     // The discovery servers first (every other participant is their client; stopped last),
     // then the registry (it waits for the monitors), then one monitor per host.
-    oscar::Supervisor children(log_dir);
+    // Killed itself (SIGKILL, an OOM kill), boot leaves the system as it would on Ctrl-C: its
+    // children get SIGTERM, so the registry and every monitor stop their modules in order (a
+    // monitor over ssh sees its connection end), and nothing runs on without boot.
+    oscar::Supervisor children(log_dir, SIGTERM);
     const auto dom = std::to_string(system.domain);
     const auto servers = discovery_servers(system, file, dom);
     for (const auto& [name, command] : servers) children.start(name, 1, command);

@@ -27,6 +27,7 @@
 #include "oscar/registry/supervisor.hpp"
 #include "oscar/registry/system_spec.hpp"
 #include "oscar/security_files.hpp"
+#include "oscar/shared_memory.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
 
@@ -89,10 +90,12 @@ int main(int argc, char** argv) {
   const auto pattern = "%H:%M:%S.%e %^%-5l%$ [monitor " + host + "] %v";
   spdlog::set_pattern(pattern);
 
+  int code = 0;
   try {
     auto system = oscar::SystemSpec::load(file);
     system.host(host);  // throws for an unknown host
     if (domain >= 0) system.override_domain(domain);
+    domain = system.domain;
     if (log_dir.empty()) {
       log_dir = fmt::format("/tmp/oscar/{}-{}/{}", system.name, system.domain, host);
     }
@@ -123,6 +126,21 @@ int main(int argc, char** argv) {
           std::lock_guard lock(mutex);
           if (seen.insert(q.id()).second) requests.push_back(q);
         });
+
+    const auto report_exit = [&](const oscar::ProcessExit& x) {
+      auto ev = event(host, x.module, x.incarnation, oscar::PROC_EXITED, x.pid);
+      ev.exit_code(x.exit_code);
+      ev.signal(x.signal);
+      ev.detail(x.last_output);
+      events.write(ev);
+    };
+    const auto stop_modules = [&] {
+      for (const auto& x : supervisor.stop_all(std::chrono::milliseconds(5000))) {
+        spdlog::log(x.exit_code == 0 ? spdlog::level::info : spdlog::level::warn, "{} (pid {}) {}",
+                    x.module, x.pid, x.describe());
+        report_exit(x);
+      }
+    };
 
     oscar::MonitorBeat beat;
     beat.host(host);
@@ -197,29 +215,24 @@ int main(int argc, char** argv) {
         spdlog::log(
             x.signal == SIGTERM || x.exit_code == 0 ? spdlog::level::info : spdlog::level::warn,
             "{} (pid {}) {}", x.module, x.pid, x.describe());
-        auto ev = event(host, x.module, x.incarnation, oscar::PROC_EXITED, x.pid);
-        ev.exit_code(x.exit_code);
-        ev.signal(x.signal);
-        ev.detail(x.last_output);
-        events.write(ev);
+        report_exit(x);
         janitor.after_death(x.module);
       }
       janitor.tick();
     }
     beater.request_stop();
     beater.join();
-    for (const auto& x : supervisor.stop_all(std::chrono::milliseconds(5000))) {
-      spdlog::log(x.exit_code == 0 ? spdlog::level::info : spdlog::level::warn, "{} (pid {}) {}",
-                  x.module, x.pid, x.describe());
-      auto ev = event(host, x.module, x.incarnation, oscar::PROC_EXITED, x.pid);
-      ev.exit_code(x.exit_code);
-      ev.signal(x.signal);
-      events.write(ev);
-    }
-    spdlog::info("stopped");
-    return 0;
+    stop_modules();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "oscar-monitor: %s\n", e.what());
-    return 2;
+    code = 2;
   }
+  // Its participant is gone now: what it, its modules and the rest of the system left goes too.
+  if (domain >= 0) {
+    if (const auto n = oscar::remove_files_of_dead_processes(domain); n > 0) {
+      spdlog::info("removed {} shared-memory files of processes that ended", n);
+    }
+  }
+  if (code == 0) spdlog::info("stopped");
+  return code;
 }

@@ -10,6 +10,7 @@
 #include "oscar/process_util.hpp"
 #include "oscar/registry/registry.hpp"
 #include "oscar/security_files.hpp"
+#include "oscar/shared_memory.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"oscar-registry: boots a system through its monitors and restarts failed modules"};
@@ -26,17 +27,22 @@ int main(int argc, char** argv) {
     auto system = oscar::SystemSpec::load(file);
     if (domain >= 0) system.override_domain(domain);
     if (host.empty()) host = system.local_host().name;
-    oscar::DdsParticipant participant(system.domain, "oscar-registry",
-                                      system.network_for(host, oscar::security_files::kRegistry));
-    oscar::Registry registry(system, participant);
-    std::thread signal_waiter([&] {
-      int sig = 0;
-      sigwait(&signals, &sig);
-      registry.stop();
-    });
-    registry.run();
-    pthread_kill(signal_waiter.native_handle(), SIGTERM);
-    signal_waiter.join();
+    {
+      oscar::DdsParticipant participant(system.domain, "oscar-registry",
+                                        system.network_for(host, oscar::security_files::kRegistry));
+      oscar::Registry registry(system, participant);
+      std::thread signal_waiter([&] {
+        int sig = 0;
+        sigwait(&signals, &sig);
+        registry.stop();
+      });
+      registry.run();
+      pthread_kill(signal_waiter.native_handle(), SIGTERM);
+      signal_waiter.join();
+    }
+    // Its participant is gone: what it and the system's ended processes left goes too (the
+    // monitors do the same; whoever exits last leaves nothing behind).
+    oscar::remove_files_of_dead_processes(system.domain);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "oscar-registry: %s\n", e.what());

@@ -1,7 +1,8 @@
 // oscar boot's life cycle with real processes on loopback: a busy domain is refused, `oscar
-// shutdown` and Ctrl-C (during boot too) end boot, a second Ctrl-C aborts, an operator's restart
-// is no failure, a command's transition shows in the system state at once, and the tools find
-// the system booted on this machine without flags.
+// shutdown` and Ctrl-C (during boot too) end boot, a second Ctrl-C aborts, a killed boot still
+// stops the system in order, an operator's restart is no failure, a command's transition shows
+// in the system state at once, and the tools find the system booted on this machine without
+// flags.
 #include <signal.h>
 #include <stdlib.h>
 
@@ -15,6 +16,7 @@
 
 #include "booted_system.hpp"
 #include "oscar/registry/running_systems.hpp"
+#include "oscar/testing/eventually.hpp"
 #include "oscar/time.hpp"
 
 namespace oscar {
@@ -195,6 +197,30 @@ TEST(Boot, ASecondCtrlCAbortsAShutdownThatHangs) {
   for (int i = 0; i < 100 && test::alive(src); ++i) std::this_thread::sleep_for(20ms);
   EXPECT_FALSE(test::alive(src)) << "the module outlived the abort";
   EXPECT_TRUE(test::processes_mentioning(sys.file()).empty()) << "a process of the system is left";
+}
+
+// `oscar boot` killed with SIGKILL (or by the OOM killer) cannot stop anything itself: its
+// children get SIGTERM from the kernel (PR_SET_PDEATHSIG), so the registry and the monitor stop
+// the modules in reverse boot order, cleanly; nothing of the system runs on, and nothing is
+// left in /dev/shm.
+TEST(BootDies, AKilledBootStopsTheModulesInOrderAndLeavesNoProcess) {
+  BootedSystem sys("boot_killed", two_sources("boot_killed"));
+  const auto s = sys.running();
+  const long src = entry(s, "src")->pid(), sink = entry(s, "sink")->pid();
+  ASSERT_EQ(kill(sys.boot_pid(), SIGKILL), 0);
+  EXPECT_TRUE(eventually([&] { return test::processes_mentioning(sys.file()).empty(); }, 30s))
+      << "processes of the system outlived boot";
+  EXPECT_FALSE(test::alive(src));
+  EXPECT_FALSE(test::alive(sink));
+  // The last of them removed what the others left in /dev/shm, boot's too.
+  EXPECT_EQ(sys.leftover_shared_memory(), std::vector<std::string>{});
+  std::ifstream in(sys.log_dir() + "/monitor-localhost.log");  // the monitor's output
+  const std::string log((std::istreambuf_iterator<char>(in)), {});
+  const auto sink_stopped = log.find(fmt::format("sink (pid {}) exited with code 0", sink));
+  const auto src_stopped = log.find(fmt::format("src (pid {}) exited with code 0", src));
+  ASSERT_NE(sink_stopped, std::string::npos) << "the sink was not stopped cleanly:\n" << log;
+  ASSERT_NE(src_stopped, std::string::npos) << "the source was not stopped cleanly:\n" << log;
+  EXPECT_LT(sink_stopped, src_stopped) << "not in reverse boot order:\n" << log;
 }
 
 TEST(Registry, AnOperatorRestartIsNoFailureAndCountsNothingAgainstTheLimit) {

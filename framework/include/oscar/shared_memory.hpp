@@ -40,6 +40,16 @@ class DeadSharedMemorySweeper {
   std::map<std::string, Clock::time_point> dead_since_;  ///< lock file name -> first seen dead
 };
 
+/// What the processes of a system leave in `dir` once they are gone, removed at once: the
+/// segments and ports of dead processes, the port semaphores Fast DDS leaves even at a clean exit,
+/// and the participant id claims of `domain` that killed processes left. The registry and every
+/// monitor call it as they exit, after their own participant is gone, so whichever exits last
+/// leaves nothing behind, also when boot itself was killed. (Segments and ports do not name
+/// their domain: those of another system's dead process go too, a little before its monitor
+/// would remove them.) Returns how many files it removed.
+std::size_t remove_files_of_dead_processes(int domain,
+                                           const std::filesystem::path& dir = "/dev/shm");
+
 /// Releases the process-shared mutexes in Fast DDS's port segments (files in `dir` whose names
 /// start with `prefix`) that a killed thread held.
 ///

@@ -8,6 +8,8 @@
 #include <string>
 #include <system_error>
 
+#include "../participant_identity.hpp"
+
 namespace oscar {
 namespace {
 
@@ -83,6 +85,20 @@ std::size_t DeadSharedMemorySweeper::sweep(Clock::time_point now) {
     }
   }
   dead_since_ = std::move(still_dead);  // a name reused by a living owner is forgotten
+  return removed;
+}
+
+std::size_t remove_files_of_dead_processes(int domain, const std::filesystem::path& dir) {
+  auto removed = DeadSharedMemorySweeper(std::chrono::seconds(0), dir).sweep();
+  const auto claims = internal::claim_prefix(domain);
+  std::error_code ec, ignore;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const auto name = entry.path().filename().string();
+    if (name.starts_with(claims) && abandoned(entry.path()) &&
+        std::filesystem::remove(entry.path(), ignore)) {
+      ++removed;
+    }
+  }
   return removed;
 }
 
