@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -28,6 +29,7 @@
 #include "oscar/registry/system_spec.hpp"
 #include "oscar/security_files.hpp"
 #include "oscar/shared_memory.hpp"
+#include "oscar/time.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
 
@@ -54,6 +56,39 @@ bool connection_lost() {
   pollfd out{1, 0, 0};
   return poll(&out, 1, 0) == 1 && (out.revents & (POLLHUP | POLLERR)) != 0;
 }
+
+// When a monitor has been without a registry for longer than the system's headless_limit.
+// Armed only once a registry has been seen: at boot the monitor may start first. The registry is
+// "seen" while its launch writer is matched; Fast DDS drops a participant that went silent
+// after its discovery lease (3 s), so the limit counts from then. A registry that boot restarts
+// is matched again long before (its new writer is matched before the old one is dropped).
+class HeadlessWatch {
+ public:
+  explicit HeadlessWatch(std::optional<std::chrono::milliseconds> limit) : limit_(limit) {}
+  /// True once, when the registry has been missing for the limit.
+  bool over(bool registry_seen, Clock::time_point now) {
+    if (registry_seen) {
+      armed_ = true;
+      alone_ = false;
+      return false;
+    }
+    if (!armed_ || !limit_) return false;
+    if (!alone_) {
+      alone_ = true;
+      alone_since_ = now;
+      spdlog::warn("the registry is gone (no participant of it for the discovery lease)");
+    }
+    if (now - alone_since_ < *limit_) return false;
+    armed_ = false;  // until a registry is seen again
+    return true;
+  }
+
+ private:
+  std::optional<std::chrono::milliseconds> limit_;
+  bool armed_ = false;
+  bool alone_ = false;
+  Clock::time_point alone_since_{};
+};
 
 }  // namespace
 
@@ -141,6 +176,7 @@ int main(int argc, char** argv) {
         report_exit(x);
       }
     };
+    HeadlessWatch headless(system.headless_limit);
 
     oscar::MonitorBeat beat;
     beat.host(host);
@@ -165,6 +201,16 @@ int main(int argc, char** argv) {
       if (over_ssh && connection_lost()) {
         spdlog::warn("the ssh connection to boot is gone: stopping this host's modules");
         break;
+      }
+      if (headless.over(launches.matched() > 0, Clock::now())) {
+        // A network split, or a registry gone for good: nobody would restart, stop or
+        // reconfigure these modules, and after the split heals the registry restarts them.
+        spdlog::warn(
+            "no registry for {} (headless_limit): stopping this host's modules in order; they "
+            "start again when the registry asks",
+            oscar::format_duration(*system.headless_limit));
+        stop_modules();
+        stopping.clear();
       }
       std::deque<oscar::LaunchRequest> batch;  // handled without holding the lock
       {

@@ -305,8 +305,8 @@ SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
   s.root = root;
   if (!root.IsMap()) fail(file, "a system file is a map with system, hosts and modules");
   check_yaml_keys(root, file, "system file",
-                  {"system", "domain", "hosts", "modules", "network", "lease", "plugins",
-                   "services", "coordinator", "security"});
+                  {"system", "domain", "hosts", "modules", "network", "lease", "headless_limit",
+                   "plugins", "services", "coordinator", "security"});
   const auto plugins = ModuleSpec::plugins_of(root, file);
   s.name = root["system"] ? root["system"].as<std::string>() : "system";
   if (root["domain"]) {
@@ -314,6 +314,11 @@ SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
     if (s.domain < 0 || s.domain > 232) fail(yaml_where(file, root["domain"]), "domain: 0..232");
   }
   if (root["lease"]) s.lease = millis(root["lease"], file, "lease");
+  if (const auto limit = root["headless_limit"]) {
+    const bool none = limit.IsScalar() && limit.Scalar() == "none";
+    s.headless_limit =
+        none ? std::nullopt : std::optional(millis(limit, file, "headless_limit (or none)"));
+  }
   if (root["security"]) s.security = parse_security(root["security"], file);
   if (const auto hosts = root["hosts"]) {
     if (!hosts.IsMap() || hosts.size() == 0) fail(yaml_where(file, hosts), "hosts: a map");

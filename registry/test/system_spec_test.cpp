@@ -98,6 +98,17 @@ TEST(SystemSpec, UnknownKeysAreErrorsWithTheirLine) {
 
 constexpr const char* kOneModule = "modules: [ { name: m, kernels: [ {type: relay} ] } ]\n";
 
+TEST(SystemSpec, HeadlessLimitIsADurationOrNone) {
+  EXPECT_EQ(parse(kOneModule).headless_limit, std::chrono::milliseconds(2000)) << "the default";
+  EXPECT_EQ(parse(std::string("headless_limit: 5s\n") + kOneModule).headless_limit,
+            std::chrono::milliseconds(5000));
+  EXPECT_EQ(parse(std::string("headless_limit: none\n") + kOneModule).headless_limit, std::nullopt);
+  EXPECT_THAT(error_of(std::string("headless_limit: 0s\n") + kOneModule),
+              HasSubstr("headless_limit (or none): must be positive"));
+  EXPECT_THAT(error_of(std::string("headless_limit: forever\n") + kOneModule),
+              HasSubstr("headless_limit (or none)"));
+}
+
 TEST(SystemSpec, SecuritySectionIsOptionalAndReadsKeystoreAndCueProtection) {
   EXPECT_FALSE(parse(kOneModule).security);
   const auto s =

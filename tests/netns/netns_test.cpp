@@ -1,8 +1,10 @@
 // Three test hosts in network namespaces (issue 3, test f): modules spread across them, cues
 // crossing hosts over UDP between the test addresses; a killed monitor is a lost host whose
-// modules are failed; a monitor started again brings them back. Root only; skipped otherwise.
+// modules are failed; a monitor started again brings them back; a host cut off stops its modules
+// and rejoins when healed. Root only; skipped otherwise.
 #include <signal.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -98,6 +100,22 @@ modules:
     return s;
   }
 
+  // The pids of processes of this system whose command line has all of `words`.
+  std::vector<long> processes_with(const std::vector<std::string>& words) const {
+    std::vector<long> pids;
+    for (const auto& e : std::filesystem::directory_iterator("/proc")) {
+      std::ifstream in(e.path() / "cmdline");
+      const std::string cmd((std::istreambuf_iterator<char>(in)), {});
+      if (cmd.find(file_) == std::string::npos) continue;
+      if (std::all_of(words.begin(), words.end(), [&](const std::string& w) {
+            return cmd.find(w + '\0') != std::string::npos;
+          })) {
+        pids.push_back(std::stol(e.path().filename()));
+      }
+    }
+    return pids;
+  }
+
   std::unique_ptr<test::TestHosts> hosts_;
   std::string file_, log_dir_;
   std::unique_ptr<test::Process> boot_;
@@ -141,6 +159,62 @@ TEST_F(ThreeHosts, CuesCrossHostsALostHostFailsItsModulesAndComesBack) {
     return st["state"] == "running" && st["hosts_lost"].empty() &&
            module(st, "relay")["incarnation"] == 2 && module(st, "relay")["status"] == "running";
   });
+  const auto published = module(s, "relay")["kernels"][0]["published"].get<std::uint64_t>();
+  until([&](const json& st) {
+    return module(st, "relay")["kernels"][0]["published"].get<std::uint64_t>() > published + 10;
+  });
+}
+
+}  // namespace
+}  // namespace oscar
+
+namespace oscar {
+namespace {
+
+// A cable pulled: h2 is cut off. The registry on h1 reports h2 lost and its relay failed; on h2
+// the monitor, alone, stops the relay after the registry's discovery lease and headless_limit
+// instead of letting it run headless. Healed, h2 rejoins and the relay starts again there, once,
+// with the configuration the coordinator had given it (stub on).
+TEST_F(ThreeHosts, ACutHostStopsItsModulesAndRejoinsWithTheirConfigurationWhenHealed) {
+  until([&](const json& st) { return st["state"] == "running"; });
+  auto argv = hosts_->on(1);
+  argv.insert(argv.end(), {test::bin("oscar-config"), "relay", "stub", "relay", "on", "--as",
+                           "coordinator", "--system", file_, "--domain", domain()});
+  test::Process stub(argv, test::temp_path("netns_stub.log"));
+  ASSERT_EQ(stub.wait(30s), 0) << stub.output();
+  auto s = until([&](const json& st) { return module(st, "relay")["kernels"][0]["stub"] == true; });
+  const auto relays = processes_with({"--module", "relay"});
+  ASSERT_EQ(relays.size(), 1u);
+
+  hosts_->cut(2);
+  s = until([&](const json& st) {
+    return !st["hosts_lost"].empty() && st["hosts_lost"][0] == "h2" &&
+           module(st, "relay")["last_failure"].get<std::string>().find("host 'h2' lost") !=
+               std::string::npos &&
+           st["state"] == "suspended";
+  });
+  // Alone, h2's monitor stops the relay: 3 s of discovery lease, then headless_limit (2 s).
+  const auto until_stopped = std::chrono::steady_clock::now() + 40s;
+  while (std::filesystem::exists("/proc/" + std::to_string(relays[0])) &&
+         std::chrono::steady_clock::now() < until_stopped) {
+    std::this_thread::sleep_for(100ms);
+  }
+  EXPECT_FALSE(std::filesystem::exists("/proc/" + std::to_string(relays[0])))
+      << "the relay ran on headless on the far side of the split";
+  std::ifstream monitor_log(log_dir_ + "/monitor-h2.log");  // boot keeps its output there
+  const std::string h2_log((std::istreambuf_iterator<char>(monitor_log)), {});
+  EXPECT_THAT(h2_log, ::testing::HasSubstr("(headless_limit): stopping this host's modules"));
+
+  hosts_->heal(2);
+  s = until(
+      [&](const json& st) {
+        return st["state"] == "running" && st["hosts_lost"].empty() &&
+               module(st, "relay")["incarnation"] == 2 &&
+               module(st, "relay")["status"] == "running";
+      },
+      60s);
+  EXPECT_EQ(module(s, "relay")["kernels"][0]["stub"], true) << "the configuration was lost";
+  EXPECT_EQ(processes_with({"--module", "relay"}).size(), 1u) << "two relays after healing";
   const auto published = module(s, "relay")["kernels"][0]["published"].get<std::uint64_t>();
   until([&](const json& st) {
     return module(st, "relay")["kernels"][0]["published"].get<std::uint64_t>() > published + 10;

@@ -53,6 +53,10 @@ class TestHosts {
 
   std::string netns(int i) const { return fmt::format("{}_h{}", tag_, i); }
   std::string address(int i) const { return fmt::format("10.77.{}.{}", subnet_, i); }
+  /// Cuts host i off the others (its port on the bridge goes down), as a pulled cable would.
+  void cut(int i) const { run("ip -n {} link set {}b{} down", bridge_ns(), tag_, i); }
+  /// Connects host i again.
+  void heal(int i) const { run("ip -n {} link set {}b{} up", bridge_ns(), tag_, i); }
   /// argv prefix that runs a program on host i.
   std::vector<std::string> on(int i) const {
     return {"/usr/bin/env", "ip", "netns", "exec", netns(i)};

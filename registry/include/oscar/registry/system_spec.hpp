@@ -153,6 +153,9 @@ struct SystemSpec {
   std::string name;
   int domain = 0;
   std::chrono::milliseconds lease{300};
+  /// How long a host's monitor lets its modules run without a registry (a network split, or a
+  /// registry gone for good) before it stops them in order; nullopt: no limit (`none`).
+  std::optional<std::chrono::milliseconds> headless_limit = std::chrono::milliseconds{2000};
   std::vector<HostSpec> hosts;        ///< without a `hosts:` key, one local host "localhost"
   std::vector<SystemModule> modules;  ///< with the coordinator's module, if there is one
   std::vector<ServiceSpec> services;
