@@ -1,7 +1,8 @@
 // Three test hosts in network namespaces (issue 3, test f): modules spread across them, cues
 // crossing hosts over UDP between the test addresses; a killed monitor is a lost host whose
 // modules are failed; a monitor started again brings them back; a host cut off stops its modules
-// and rejoins when healed. Root only; skipped otherwise.
+// and rejoins when healed; a killed boot leaves no process on any host. Root only; skipped
+// otherwise.
 #include <signal.h>
 
 #include <algorithm>
@@ -219,6 +220,27 @@ TEST_F(ThreeHosts, ACutHostStopsItsModulesAndRejoinsWithTheirConfigurationWhenHe
   until([&](const json& st) {
     return module(st, "relay")["kernels"][0]["published"].get<std::uint64_t>() > published + 10;
   });
+}
+
+// Boot killed with SIGKILL on h1: every host's monitor stops its modules in order (SIGTERM from
+// the kernel as boot dies), and no process of the system is left on any host.
+TEST_F(ThreeHosts, AKilledBootLeavesNoProcessOnAnyHost) {
+  until([&](const json& st) { return st["state"] == "running"; });
+  const auto modules = processes_with({"--module"});
+  ASSERT_EQ(modules.size(), 3u);
+  ASSERT_EQ(kill(boot_->pid(), SIGKILL), 0);
+  const auto limit = std::chrono::steady_clock::now() + 30s;
+  while (!processes_with({}).empty() && std::chrono::steady_clock::now() < limit) {
+    std::this_thread::sleep_for(100ms);
+  }
+  EXPECT_EQ(processes_with({}), std::vector<long>{}) << "processes of the system outlived boot";
+  for (const auto* host : {"h2", "h3"}) {
+    std::ifstream in(log_dir_ + "/monitor-" + host + ".log");
+    const std::string log((std::istreambuf_iterator<char>(in)), {});
+    EXPECT_THAT(log, ::testing::HasSubstr("exited with code 0")) << host << ":\n" << log;
+    EXPECT_THAT(log, ::testing::HasSubstr("stopped")) << host << ":\n" << log;
+  }
+  boot_.reset();  // already dead
 }
 
 }  // namespace
