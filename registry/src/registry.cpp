@@ -20,8 +20,13 @@ constexpr std::size_t kMaxRequestNameChars = 256;
 
 }  // namespace
 
-Registry::Registry(const SystemSpec& system, DdsParticipant& participant)
-    : system_(system), participant_(participant), config_(participant, "registry") {
+Registry::Registry(const SystemSpec& system, DdsParticipant& participant, bool recovering)
+    : system_(system),
+      participant_(participant),
+      config_(participant, "registry"),
+      state_(recovering ? "recovering" : "booting"),
+      recovering_(recovering),
+      recovery_since_(Clock::now()) {
   for (const auto& m : system_.modules) {
     auto t = std::make_unique<Tracked>();
     t->spec = &m;
@@ -46,8 +51,10 @@ void Registry::stop() {
 }
 
 void Registry::run() {
-  spdlog::info("registry: system '{}' with {} modules on {} hosts, domain {}", system_.name,
-               modules_.size(), system_.hosts.size(), system_.domain);
+  spdlog::info("registry: system '{}' with {} modules on {} hosts, domain {}{}", system_.name,
+               modules_.size(), system_.hosts.size(), system_.domain,
+               recovering_ ? "; recovering after a crash: adopting what the monitors run" : "");
+  if (recovering_) message_ = "a registry before this one died: adopting what the monitors run";
   publish();
   std::unique_lock lock(mutex_);
   while (true) {
@@ -127,8 +134,61 @@ void Registry::on_monitor_lost(const std::string& host, long pid) {
   publish();
 }
 
+// A monitor's report of its module processes. While recovering, the modules it runs are
+// adopted; a host's other modules are started only after its report (may_start_on), so none
+// runs twice.
+void Registry::on_monitor_report(const MonitorReport& r) {
+  const bool first = reported_[r.host()] != r.monitor_pid();
+  reported_[r.host()] = r.monitor_pid();
+  if (!recovering_) return;
+  if (first) {
+    spdlog::info("registry: monitor of host '{}' (pid {}) runs {} module processes", r.host(),
+                 r.monitor_pid(), r.children().size());
+  }
+  for (const auto& child : r.children()) {
+    auto* m = find(child.module_name());
+    if (!m || m->spec->spec.host != r.host() || m->status != "waiting") continue;
+    adopt(*m, child, r.monitor_pid());
+  }
+}
+
+void Registry::adopt(Tracked& m, const MonitorChild& child, long monitor_pid) {
+  const auto& name = m.spec->spec.name;
+  m.incarnation = child.incarnation();
+  m.pid = child.pid();
+  m.launched_by = monitor_pid;
+  m.status = "starting";  // until its state comes: then it runs (started())
+  m.process_gone = false;
+  m.has_state = false;
+  m.held = false;
+  ++adopted_;
+  spdlog::info("registry: adopting '{}' on '{}' (incarnation {}, pid {})", name, m.spec->spec.host,
+               m.incarnation, m.pid);
+  if (const auto it = early_.find(name); it != early_.end()) {
+    const auto state = it->second;
+    early_.erase(it);
+    if (state.incarnation() == m.incarnation) on_module_state(state);
+  }
+  publish();
+}
+
+bool Registry::may_start_on(const std::string& host) const {
+  if (!recovering_) return true;
+  // One lease as well: the replay of the monitor's process events (the incarnations its modules
+  // had) comes on a writer of its own, matched in its own time.
+  const auto reported = reported_.find(host);
+  const auto monitor = monitors_.find(host);
+  return reported != reported_.end() && monitor != monitors_.end() &&
+         reported->second == monitor->second.pid && Clock::now() - recovery_since_ >= system_.lease;
+}
+
 void Registry::on_process_event(const ProcessEvent& e) {
   auto* m = find(e.module_name());
+  if (m && recovering_ && m->status == "waiting") {
+    // A replay of what happened before the crash: the next start counts on from it.
+    m->incarnation = std::max(m->incarnation, static_cast<unsigned>(e.incarnation()));
+    return;
+  }
   if (!m || e.incarnation() != m->incarnation) return;  // an earlier incarnation's news
   if (e.kind() == PROC_STARTED) {
     m->pid = e.pid();
@@ -191,6 +251,12 @@ void Registry::on_module_lost(const std::string& module, unsigned incarnation) {
 
 void Registry::on_module_state(const ModuleState& s) {
   auto* m = find(s.module_name());
+  if (m && recovering_ && m->status == "waiting") {
+    // A running module's state, replayed before its monitor's report: kept for the adoption.
+    auto& early = early_[s.module_name()];
+    if (s.incarnation() >= early.incarnation()) early = s;
+    return;
+  }
   if (!m || s.incarnation() != m->incarnation) return;
   const auto now = Clock::now();
   std::uint64_t published = 0;
@@ -220,6 +286,7 @@ void Registry::on_module_state(const ModuleState& s) {
 void Registry::started(Tracked& m, const ModuleState& now) {
   m.status = "running";
   m.running_since = Clock::now();
+  m.suspended = now.suspended();  // an adopted module may have been suspended before the crash
   spdlog::info("registry: module '{}' running (incarnation {}, pid {})", m.spec->spec.name,
                m.incarnation, now.pid());
   for (auto& other : modules_) {

@@ -53,9 +53,13 @@ void Registry::tick() {
     const auto& mon = monitors_[m->spec->spec.host];
     if (!mon.alive) continue;
     if (m->status == "waiting") {
-      if (starting[m->spec->spec.host] >= kStartingPerHost) continue;
+      if (starting[m->spec->spec.host] >= kStartingPerHost || !may_start_on(m->spec->spec.host)) {
+        continue;
+      }
       ++starting[m->spec->spec.host];
-      launch(*m, 1);
+      if (state_ == "recovering") ++started_in_recovery_;
+      // 1 at boot; when recovering, one more than the last incarnation its monitor reported.
+      launch(*m, m->incarnation + 1);
       publish();
     } else if (m->status == "restarting" && m->process_gone && now >= m->restart_at) {
       if (m->incarnation > 0 && !m->restart_requested) {
@@ -84,12 +88,18 @@ void Registry::tick() {
       spdlog::info("registry: module '{}' sends its heartbeat again", m->spec->spec.name);
     }
   }
-  if (state_ == "booting") {
+  if (recovering_ && std::none_of(modules_.begin(), modules_.end(),
+                                  [](const auto& m) { return m->status == "waiting"; })) {
+    recovering_ = false;  // every module was adopted or started
+  }
+  if (state_ == "booting" || state_ == "recovering") {
     std::vector<std::string> missing;
     for (const auto& m : modules_) {
       if (m->status != "running" && m->status != "standby") missing.push_back(m->spec->spec.name);
     }
-    if (missing.empty()) {
+    if (missing.empty() && state_ == "recovering") {
+      recovered();
+    } else if (missing.empty()) {
       set_system("running", "all modules announced");
     } else if (message_ != "waiting for: " + fmt::format("{}", fmt::join(missing, ", "))) {
       message_ = fmt::format("waiting for: {}", fmt::join(missing, ", "));
@@ -97,6 +107,19 @@ void Registry::tick() {
     }
   }
   if (now - last_publish_ > std::chrono::seconds(1)) publish();
+}
+
+// Every module runs again after a crash of the registry: those the registry before suspended
+// (it died during a restart) are resumed.
+void Registry::recovered() {
+  std::vector<Tracked*> targets;
+  for (auto& m : modules_) {
+    if (m->status == "running" && m->suspended) targets.push_back(m.get());
+  }
+  const auto ok = configure_all(targets, CMD_RESUME);
+  for (std::size_t i = 0; i < targets.size(); ++i) targets[i]->suspended = !ok[i];
+  set_system("running", fmt::format("registry recovered: {} modules adopted, {} started", adopted_,
+                                    started_in_recovery_));
 }
 
 // What the coordinator had made of the module (modes, stub, parameters, wiring), from its last

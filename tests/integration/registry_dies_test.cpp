@@ -1,0 +1,125 @@
+// The registry dies while the system runs (issue 19): boot starts it again with --recover and
+// the new one adopts the running modules instead of starting them twice.
+#include <signal.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <thread>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "booted_system.hpp"
+
+namespace oscar {
+namespace {
+using namespace std::chrono_literals;
+using test::BootedSystem;
+using test::entry;
+using ::testing::HasSubstr;
+
+constexpr const char* kThreeModules = R"(
+system: regdies
+lease: 1s
+modules:
+  - name: src
+    kernels: [ { type: bench_source, name: src, params: { type: Bool } } ]
+    mode: { continuous: 20ms }
+    restart: { policy: auto, max: 3, backoff: 50ms }
+  - name: relay
+    kernels: [ { type: relay, name: relay, params: { type: Bool }, inputs: { in: src/out } } ]
+    mode: single_step
+    restart: { policy: auto, max: 3, backoff: 50ms }
+  - name: sink
+    kernels: [ { type: bench_sink, name: sink, params: { type: Bool }, inputs: { in: relay/out } } ]
+    mode: single_step
+    restart: { policy: auto, max: 3, backoff: 50ms }
+)";
+
+std::vector<std::string> command_line(long pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/cmdline");
+  std::vector<std::string> args;
+  for (std::string arg; std::getline(in, arg, '\0');) args.push_back(arg);
+  return args;
+}
+
+// The live processes of the system in `file` whose command line satisfies `match`.
+std::vector<long> processes_of(const std::string& file,
+                               const std::function<bool(const std::vector<std::string>&)>& match) {
+  std::vector<long> out;
+  for (const long pid : test::processes_mentioning(file)) {
+    if (match(command_line(pid))) out.push_back(pid);
+  }
+  return out;
+}
+
+// Every process running module `module` (oscar-run FILE --module M ...).
+std::vector<long> module_processes(const std::string& file, const std::string& module) {
+  return processes_of(file, [&](const auto& args) {
+    for (std::size_t i = 0; i + 1 < args.size(); ++i) {
+      if (args[i] == "--module" && args[i + 1] == module) return true;
+    }
+    return false;
+  });
+}
+
+long registry_pid(const std::string& file) {
+  const auto pids = processes_of(file, [](const auto& args) {
+    return !args.empty() && std::filesystem::path(args[0]).filename() == "oscar-registry";
+  });
+  return pids.size() == 1 ? pids.front() : 0;
+}
+
+bool recovered(const SystemState& s) {
+  return s.state() == "running" && s.message().find("registry recovered") != std::string::npos;
+}
+
+// Boot's output, once it says `text` (it is printed a moment after it happens).
+std::string boot_output_saying(BootedSystem& sys, const std::string& text) {
+  for (int i = 0; i < 100 && sys.boot_output().find(text) == std::string::npos; ++i) {
+    std::this_thread::sleep_for(100ms);
+  }
+  return sys.boot_output();
+}
+
+TEST(RegistryDies, ARestartedRegistryAdoptsTheRunningModulesWithoutDuplicates) {
+  BootedSystem sys("regdies_adopt", kThreeModules);
+  auto s = sys.running();
+  std::map<std::string, long> pids;
+  for (const auto& m : s.modules()) {
+    pids[m.name()] = m.pid();
+    ASSERT_EQ(module_processes(sys.file(), m.name()), std::vector<long>{m.pid()}) << m.name();
+  }
+  const long old_registry = registry_pid(sys.file());
+  ASSERT_GT(old_registry, 0) << "no single oscar-registry process of " << sys.file();
+  ASSERT_EQ(kill(static_cast<pid_t>(old_registry), SIGKILL), 0);
+
+  s = sys.wait_for(recovered, 60s);
+  EXPECT_THAT(s.message(), HasSubstr("3 modules adopted, 0 started"));
+  const long new_registry = registry_pid(sys.file());
+  EXPECT_GT(new_registry, 0);
+  EXPECT_NE(new_registry, old_registry);
+  for (const auto& m : s.modules()) {
+    EXPECT_EQ(m.status(), "running") << m.name();
+    EXPECT_EQ(m.incarnation(), 1u) << m.name();
+    EXPECT_EQ(m.pid(), pids[m.name()]) << m.name() << " was started again";
+    EXPECT_EQ(module_processes(sys.file(), m.name()), std::vector<long>{pids[m.name()]})
+        << m.name() << " runs more than once, or not as before";
+  }
+  // Cues still flow from the source through the relay to the sink.
+  const auto* sink = test::kernel_state(*entry(s, "sink"), "sink");
+  ASSERT_NE(sink, nullptr);
+  const auto cycles = sink->cycles();
+  sys.wait_for([&](const SystemState& st) {
+    const auto* k = test::kernel_state(*entry(st, "sink"), "sink");
+    return recovered(st) && k && k->cycles() > cycles + 10;
+  });
+  EXPECT_THAT(boot_output_saying(sys, "restarting it"),
+              HasSubstr("registry died (killed by signal 9 (Killed)): restarting it (1 of 5 in 60 s)"));
+  EXPECT_EQ(sys.shut_down(), 0) << sys.boot_output();
+  for (const auto& [name, pid] : pids) EXPECT_FALSE(test::alive(pid)) << name << " left running";
+}
+
+}  // namespace
+}  // namespace oscar
