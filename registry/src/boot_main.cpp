@@ -340,13 +340,17 @@ int main(int argc, char** argv) {
     const auto dom = std::to_string(system.domain);
     const auto servers = discovery_servers(system, file, dom);
     for (const auto& [name, command] : servers) children.start(name, 1, command);
+    // What cannot be learnt from the wire after a crash (docs/boot.md).
+    const auto journal = log_dir + "/registry.journal.yaml";
     const std::vector<std::string> registry_command{oscar::sibling_program("oscar-registry"),
                                                     "--system",
                                                     file,
                                                     "--host",
                                                     local.name,
                                                     "--domain",
-                                                    dom};
+                                                    dom,
+                                                    "--journal",
+                                                    journal};
     children.start("registry", 1, registry_command);
     for (const auto& h : system.hosts) {
       const bool remote = h.kind == oscar::HostSpec::Kind::kSsh;

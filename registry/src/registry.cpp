@@ -20,19 +20,23 @@ constexpr std::size_t kMaxRequestNameChars = 256;
 
 }  // namespace
 
-Registry::Registry(const SystemSpec& system, DdsParticipant& participant, bool recovering)
+Registry::Registry(const SystemSpec& system, DdsParticipant& participant, std::string journal_file,
+                   bool recovering)
     : system_(system),
       participant_(participant),
       config_(participant, "registry"),
       state_(recovering ? "recovering" : "booting"),
       recovering_(recovering),
-      recovery_since_(Clock::now()) {
+      recovery_since_(Clock::now()),
+      journal_file_(std::move(journal_file)),
+      wall_at_start_ns_(wall_now()) {
   for (const auto& m : system_.modules) {
     auto t = std::make_unique<Tracked>();
     t->spec = &m;
     t->status = m.standby ? "standby" : "waiting";
     modules_.push_back(std::move(t));
   }
+  if (recovering_) read_journal();
   io_ = std::make_unique<Io>(*this);
 }
 
@@ -147,8 +151,24 @@ void Registry::on_monitor_report(const MonitorReport& r) {
   }
   for (const auto& child : r.children()) {
     auto* m = find(child.module_name());
-    if (!m || m->spec->spec.host != r.host() || m->status != "waiting") continue;
-    adopt(*m, child, r.monitor_pid());
+    if (!m || m->spec->spec.host != r.host()) continue;
+    if (m->status == "waiting") {
+      adopt(*m, child, r.monitor_pid());
+    } else if (m->status == "restarting" && child.incarnation() > m->incarnation) {
+      // The registry before had started the restart the journal says is due: it counts.
+      if (!m->restart_requested) {
+        ++m->restarts;
+        m->budget.record(Clock::now());
+      }
+      m->restart_requested = false;
+      adopt(*m, child, r.monitor_pid());
+    } else if (m->status == "restarting" && child.incarnation() == m->incarnation &&
+               m->process_gone) {
+      // The failed process still runs (a hung module the registry before had not killed yet).
+      m->process_gone = false;
+      m->launched_by = r.monitor_pid();
+      io_->send(LAUNCH_KILL, r.host(), r.monitor_pid(), m->spec->spec.name, m->incarnation);
+    }
   }
 }
 
@@ -251,7 +271,8 @@ void Registry::on_module_lost(const std::string& module, unsigned incarnation) {
 
 void Registry::on_module_state(const ModuleState& s) {
   auto* m = find(s.module_name());
-  if (m && recovering_ && m->status == "waiting") {
+  if (m && recovering_ &&
+      (m->status == "waiting" || (m->status == "restarting" && s.incarnation() > m->incarnation))) {
     // A running module's state, replayed before its monitor's report: kept for the adoption.
     auto& early = early_[s.module_name()];
     if (s.incarnation() >= early.incarnation()) early = s;
@@ -305,7 +326,7 @@ void Registry::take_down(Tracked& m, bool process_gone) {
   const auto& mon = monitors_[m.spec->spec.host];
   // A module whose monitor has been replaced died with its monitor.
   m.process_gone = process_gone || (mon.pid != m.launched_by && mon.alive);
-  if (m.has_state) m.config = m.state;  // what the next incarnation gets back
+  if (m.has_state) m.restore = restore_text(m.state);  // what the next incarnation gets back
   publish();  // what happened is known now; suspending the others comes next
   if (!m.process_gone && mon.alive) {
     io_->send(LAUNCH_KILL, m.spec->spec.host, mon.pid, m.spec->spec.name, m.incarnation);

@@ -18,6 +18,9 @@ int main(int argc, char** argv) {
   app.add_option("--system", file, "the system file")->required();
   app.add_option("--host", host, "the host it runs on (default: the system's first local host)");
   app.add_option("-d,--domain", domain, "DDS domain (default: the file's)");
+  std::string journal;
+  app.add_option("--journal", journal,
+                 "where to keep what a registry after this one needs (docs/boot.md)");
   bool recover = false;
   app.add_flag("--recover", recover,
                "a registry before this one died: adopt the modules the monitors run, start only "
@@ -32,7 +35,7 @@ int main(int argc, char** argv) {
     if (host.empty()) host = system.local_host().name;
     oscar::DdsParticipant participant(system.domain, "oscar-registry",
                                       system.network_for(host, oscar::security_files::kRegistry));
-    oscar::Registry registry(system, participant, recover);
+    oscar::Registry registry(system, participant, journal, recover);
     std::thread signal_waiter([&] {
       int sig = 0;
       sigwait(&signals, &sig);

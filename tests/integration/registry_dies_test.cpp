@@ -96,7 +96,7 @@ TEST(RegistryDies, ARestartedRegistryAdoptsTheRunningModulesWithoutDuplicates) {
   ASSERT_EQ(kill(static_cast<pid_t>(old_registry), SIGKILL), 0);
 
   s = sys.wait_for(recovered, 60s);
-  EXPECT_THAT(s.message(), HasSubstr("3 modules adopted, 0 started"));
+  EXPECT_THAT(s.message(), HasSubstr("3 modules running were adopted, 0 started"));
   const long new_registry = registry_pid(sys.file());
   EXPECT_GT(new_registry, 0);
   EXPECT_NE(new_registry, old_registry);
@@ -119,6 +119,64 @@ TEST(RegistryDies, ARestartedRegistryAdoptsTheRunningModulesWithoutDuplicates) {
               HasSubstr("registry died (killed by signal 9 (Killed)): restarting it (1 of 5 in 60 s)"));
   EXPECT_EQ(sys.shut_down(), 0) << sys.boot_output();
   for (const auto& [name, pid] : pids) EXPECT_FALSE(test::alive(pid)) << name << " left running";
+}
+
+// The sink restarts 3 s after a failure: time enough to kill the registry before it has.
+constexpr const char* kSlowRestart = R"(
+system: regdies_mid
+lease: 1s
+modules:
+  - name: src
+    kernels: [ { type: bench_source, name: src, params: { type: Bool } } ]
+    mode: { continuous: 20ms }
+  - name: sink
+    kernels: [ { type: bench_sink, name: sink, params: { type: Bool }, inputs: { in: src/out } } ]
+    mode: single_step
+    restart: { policy: auto, max: 3, backoff: 3s }
+)";
+
+bool sink_has_its_parameter(const SystemState& s) {
+  const auto* k = test::kernel_state(*entry(s, "sink"), "sink");
+  return k && k->params().find("700ms") != std::string::npos;
+}
+
+TEST(RegistryDies, AKilledRegistryMidRestartFinishesTheRestart) {
+  BootedSystem sys("regdies_mid", kSlowRestart);
+  auto s = sys.running();
+  ASSERT_TRUE(sys.configure("sink", CMD_SET_PARAM, {"sink", "log_every", "700ms"}).ok());
+  s = sys.wait_for(sink_has_its_parameter);
+  const long src_pid = entry(s, "src")->pid();
+  const long old_sink = entry(s, "sink")->pid();
+  const long old_registry = registry_pid(sys.file());
+  ASSERT_GT(old_registry, 0);
+
+  ASSERT_EQ(kill(static_cast<pid_t>(old_sink), SIGKILL), 0);
+  s = sys.wait_for(
+      [](const SystemState& st) { return entry(st, "sink")->status() == "restarting"; });
+  ASSERT_EQ(kill(static_cast<pid_t>(old_registry), SIGKILL), 0);
+
+  s = sys.wait_for(recovered, 60s);
+  const auto* sink = entry(s, "sink");
+  EXPECT_EQ(sink->incarnation(), 2u) << "restarted once";
+  EXPECT_EQ(sink->restarts(), 1u) << "the restart counter continues";
+  EXPECT_THAT(sink->last_failure(), HasSubstr("killed by signal 9"));
+  EXPECT_NE(sink->pid(), old_sink);
+  EXPECT_EQ(module_processes(sys.file(), "sink"), std::vector<long>{sink->pid()});
+  EXPECT_EQ(entry(s, "src")->pid(), src_pid) << "the source was adopted, not started again";
+  EXPECT_EQ(module_processes(sys.file(), "src"), std::vector<long>{src_pid});
+  EXPECT_THAT(s.message(), HasSubstr("1 modules running were adopted, 1 started"));
+  // With its configuration, and the system resumed: the sink runs on the source's cues.
+  const auto* k = test::kernel_state(*sink, "sink");
+  ASSERT_NE(k, nullptr);
+  const auto cycles = k->cycles();
+  s = sys.wait_for([&](const SystemState& st) {
+    const auto* now = test::kernel_state(*entry(st, "sink"), "sink");
+    return sink_has_its_parameter(st) && now && now->cycles() > cycles + 10 &&
+           !entry(st, "src")->state().suspended();
+  });
+  EXPECT_EQ(entry(s, "sink")->incarnation(), 2u);
+  EXPECT_THAT(boot_output_saying(sys, "restarting it"), HasSubstr("registry died"));
+  EXPECT_EQ(sys.shut_down(), 0) << sys.boot_output();
 }
 
 }  // namespace

@@ -28,9 +28,13 @@ namespace oscar {
 class Registry {
  public:
   /// Joins the system's domain on `participant`; acquires no processes until run().
+  /// `journal_file` (none if empty): where it keeps what a registry after it would need
+  /// (configurations to restore, restart counters, restarts in progress).
   /// `recovering`: a registry before this one died; the modules its monitors report running
-  /// are adopted, and a host's modules are started only once its monitor has reported.
-  Registry(const SystemSpec& system, DdsParticipant& participant, bool recovering = false);
+  /// are adopted, a host's modules are started only once its monitor has reported, and what
+  /// the journal says is taken over (a journal that cannot be read is said and skipped).
+  Registry(const SystemSpec& system, DdsParticipant& participant, std::string journal_file = {},
+           bool recovering = false);
   ~Registry();
   Registry(const Registry&) = delete;
   Registry& operator=(const Registry&) = delete;
@@ -84,6 +88,10 @@ class Registry {
   void shutdown();
   void set_system(const std::string& state, const std::string& message);
   void publish();
+  /// Takes over the restart counters, configurations and restarts in progress of the journal.
+  void read_journal();
+  /// Replaces the journal if what it would say changed (publish() calls it).
+  void write_journal();
   Tracked* find(const std::string& name);
 
   const SystemSpec& system_;
@@ -94,11 +102,14 @@ class Registry {
   std::string state_ = "booting";
   std::string message_;
   bool recovering_ = false;                   // until every module is back after a crash
-  Clock::time_point recovery_since_{};        // when this registry started recovering
+  Clock::time_point recovery_since_{};        // when this registry started (recovering or not)
   std::map<std::string, long> reported_;      // by host: the monitor pid whose report came
   std::map<std::string, ModuleState> early_;  // recovering: states that came before adoption
-  int adopted_ = 0;                           // modules found running when recovering
-  int started_in_recovery_ = 0;               // modules no monitor ran when recovering
+  std::string journal_file_;
+  std::string journal_text_;        // what the journal says now (without its time stamp)
+  long long wall_at_start_ns_ = 0;  // the wall clock at recovery_since_: the journal's times
+  int adopted_ = 0;                 // modules found running when recovering
+  int started_in_recovery_ = 0;     // modules no monitor ran when recovering
   bool shutting_down_ = false;
   Clock::time_point last_publish_{};
 
