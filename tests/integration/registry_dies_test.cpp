@@ -115,8 +115,9 @@ TEST(RegistryDies, ARestartedRegistryAdoptsTheRunningModulesWithoutDuplicates) {
     const auto* k = test::kernel_state(*entry(st, "sink"), "sink");
     return recovered(st) && k && k->cycles() > cycles + 10;
   });
-  EXPECT_THAT(boot_output_saying(sys, "restarting it"),
-              HasSubstr("registry died (killed by signal 9 (Killed)): restarting it (1 of 5 in 60 s)"));
+  EXPECT_THAT(
+      boot_output_saying(sys, "restarting it"),
+      HasSubstr("registry died (killed by signal 9 (Killed)): restarting it (1 of 5 in 60 s)"));
   EXPECT_EQ(sys.shut_down(), 0) << sys.boot_output();
   for (const auto& [name, pid] : pids) EXPECT_FALSE(test::alive(pid)) << name << " left running";
 }
@@ -177,6 +178,31 @@ TEST(RegistryDies, AKilledRegistryMidRestartFinishesTheRestart) {
   EXPECT_EQ(entry(s, "sink")->incarnation(), 2u);
   EXPECT_THAT(boot_output_saying(sys, "restarting it"), HasSubstr("registry died"));
   EXPECT_EQ(sys.shut_down(), 0) << sys.boot_output();
+}
+
+TEST(RegistryDies, BootGivesUpAfterFiveDeathsInAMinute) {
+  BootedSystem sys("regdies_limit", kSlowRestart);
+  const auto s = sys.running();
+  const long src_pid = entry(s, "src")->pid();
+  std::vector<long> killed;
+  for (int death = 1; death <= 6; ++death) {
+    long pid = 0;  // the registry boot started after the last death
+    for (int i = 0; i < 500 && pid == 0; ++i) {
+      pid = registry_pid(sys.file());
+      if (!killed.empty() && pid == killed.back()) pid = 0;
+      if (pid == 0) std::this_thread::sleep_for(20ms);
+    }
+    ASSERT_GT(pid, 0) << "no registry after death " << death - 1 << "\n" << sys.boot_output();
+    ASSERT_EQ(kill(static_cast<pid_t>(pid), SIGKILL), 0);
+    killed.push_back(pid);
+  }
+  EXPECT_EQ(sys.boot_exit_code(60s), 1) << sys.boot_output();
+  const auto out = sys.boot_output();
+  EXPECT_THAT(out, HasSubstr("restarting it (5 of 5 in 60 s)"));
+  EXPECT_THAT(out, HasSubstr("for the 6th time within 60 s: giving up, stopping the system"));
+  EXPECT_THAT(out, HasSubstr("all processes stopped"));
+  EXPECT_FALSE(test::alive(src_pid)) << "the modules are stopped";
+  EXPECT_TRUE(test::processes_mentioning(sys.file()).empty()) << "a process of the system is left";
 }
 
 }  // namespace
