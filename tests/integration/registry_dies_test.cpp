@@ -2,15 +2,24 @@
 // the new one adopts the running modules instead of starting them twice.
 #include <signal.h>
 
+#include <condition_variable>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <mutex>
+#include <optional>
 #include <thread>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <oscar/registryPubSubTypes.h>
+
 #include "booted_system.hpp"
+#include "oscar/time.hpp"
+#include "oscar/topic_io.hpp"
+#include "oscar/topics.hpp"
 
 namespace oscar {
 namespace {
@@ -203,6 +212,47 @@ TEST(RegistryDies, BootGivesUpAfterFiveDeathsInAMinute) {
   EXPECT_THAT(out, HasSubstr("all processes stopped"));
   EXPECT_FALSE(test::alive(src_pid)) << "the modules are stopped";
   EXPECT_TRUE(test::processes_mentioning(sys.file()).empty()) << "a process of the system is left";
+}
+
+// Defence in depth: whatever a registry asks, a monitor never starts a module twice.
+TEST(RegistryDies, AMonitorRefusesToStartAModuleItAlreadyRuns) {
+  BootedSystem sys("regdies_refuse", kSlowRestart);
+  const auto s = sys.running();
+  const auto* src = entry(s, "src");
+  const auto monitors = processes_of(sys.file(), [](const auto& args) {
+    return !args.empty() && std::filesystem::path(args[0]).filename() == "oscar-monitor";
+  });
+  ASSERT_EQ(monitors.size(), 1u);
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::optional<ProcessEvent> refused;
+  TopicReader<ProcessEvent, ProcessEventPubSubType> events(
+      sys.participant(), topics::process_events(), [&](const ProcessEvent& e, const auto&) {
+        if (e.module_name() != "src" || e.kind() != PROC_START_FAILED) return;
+        std::lock_guard lock(mutex);
+        refused = e;
+        changed.notify_all();
+      });
+  // What a registry that lost track of `src` would ask (its writer keeps it for the monitor).
+  TopicWriter<LaunchRequest, LaunchRequestPubSubType> launch(sys.participant(), topics::launch());
+  LaunchRequest q;
+  q.id(static_cast<unsigned long long>(wall_now()));
+  q.host(src->host());
+  q.monitor_pid(static_cast<std::int32_t>(monitors.front()));
+  q.kind(LAUNCH_START);
+  q.module_name("src");
+  q.incarnation(src->incarnation() + 1);
+  launch.write(q);
+  {
+    std::unique_lock lock(mutex);
+    ASSERT_TRUE(changed.wait_for(lock, 30s, [&] { return refused.has_value(); }))
+        << "the monitor did not answer the start";
+    EXPECT_THAT(refused->detail(), HasSubstr(fmt::format("already running as pid {}", src->pid())));
+  }
+  EXPECT_EQ(module_processes(sys.file(), "src"), std::vector<long>{src->pid()});
+  const auto after = sys.wait_for([](const SystemState& st) { return st.state() == "running"; });
+  EXPECT_EQ(entry(after, "src")->pid(), src->pid());
+  EXPECT_EQ(entry(after, "src")->incarnation(), src->incarnation());
 }
 
 }  // namespace
