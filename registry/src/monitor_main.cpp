@@ -19,12 +19,12 @@
 #include <oscar/command_line.hpp>
 
 #include "janitor.hpp"
-#include "monitor_report_topic.hpp"
 #include "oscar/cue_types.hpp"
 #include "oscar/kernel_registry.hpp"
 #include "oscar/process_util.hpp"
 #include "oscar/registry/host_check.hpp"
 #include "oscar/registry/launch_command.hpp"
+#include "oscar/registry/monitor_report_topic.hpp"
 #include "oscar/registry/supervisor.hpp"
 #include "oscar/registry/system_spec.hpp"
 #include "oscar/security_files.hpp"

@@ -8,7 +8,7 @@
 #include <oscar/configPubSubTypes.h>
 #include <oscar/registryPubSubTypes.h>
 
-#include "monitor_report_topic.hpp"
+#include "oscar/registry/monitor_report_topic.hpp"
 #include "oscar/registry/registry.hpp"
 #include "oscar/topic_io.hpp"
 

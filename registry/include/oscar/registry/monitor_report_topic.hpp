@@ -1,7 +1,7 @@
 #pragma once
-// The monitors' reports of their module processes (idl/oscar/monitor_report.idl), internal to
-// oscar-monitor and oscar-registry: kept out of oscar/topics.hpp, which nearly everything
-// includes.
+/// @file The monitors' reports of their module processes (idl/oscar/monitor_report.idl): for
+/// oscar-monitor, oscar-registry and the security tool (who may publish it); kept out of
+/// oscar/topics.hpp, which nearly everything includes.
 
 #include <oscar/monitor_reportPubSubTypes.h>
 
