@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <future>
 #include <map>
-#include <optional>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -14,7 +13,6 @@
 #include "oscar/registry/registry.hpp"
 #include "oscar/time.hpp"
 #include "registry_io.hpp"
-#include "registry_journal.hpp"
 #include "registry_tracked.hpp"
 
 namespace oscar {
@@ -111,20 +109,6 @@ void Registry::tick() {
     }
   }
   if (now - last_publish_ > std::chrono::seconds(1)) publish();
-}
-
-// Every module runs again after a crash of the registry: those the registry before suspended
-// (it died during a restart) are resumed.
-void Registry::recovered() {
-  std::vector<Tracked*> targets;
-  for (auto& m : modules_) {
-    if (m->status == "running" && m->suspended) targets.push_back(m.get());
-  }
-  const auto ok = configure_all(targets, CMD_RESUME);
-  for (std::size_t i = 0; i < targets.size(); ++i) targets[i]->suspended = !ok[i];
-  set_system("running",
-             fmt::format("registry recovered: {} modules running were adopted, {} started",
-                         adopted_, started_in_recovery_));
 }
 
 // What the coordinator had made of the module (modes, stub, parameters, wiring), from its last
@@ -299,80 +283,6 @@ void Registry::publish() {
   write_journal();
   io_->publish(s);
   last_publish_ = Clock::now();
-}
-
-void Registry::write_journal() {
-  if (journal_file_.empty()) return;
-  // One fixed mapping from the steady clock: the same instant is written the same each time.
-  const auto to_wall = [&](Clock::time_point t) {
-    return wall_at_start_ns_ +
-           std::chrono::duration_cast<std::chrono::nanoseconds>(t - recovery_since_).count();
-  };
-  internal::RegistryJournal journal;
-  for (const auto& m : modules_) {
-    internal::JournalModule j;
-    j.name = m->spec->spec.name;
-    j.incarnation = m->incarnation;
-    // A running module's own state is what it would get back if it failed now.
-    j.restore = m->status == "running" && m->has_state ? restore_text(m->state) : m->restore;
-    j.restarts = m->restarts;
-    for (const auto t : m->budget.restarts()) j.counted.push_back(to_wall(t));
-    j.last_failure = m->last_failure;
-    j.restart_due = m->status == "restarting";
-    j.restart_requested = m->restart_requested;
-    j.restart_at = j.restart_due ? to_wall(m->restart_at) : 0;
-    journal.modules.push_back(std::move(j));
-  }
-  // Written when it says something new, not for each state published.
-  auto text = journal.to_yaml();
-  if (text == journal_text_) return;
-  journal_text_ = std::move(text);
-  journal.written = wall_now();
-  try {
-    journal.write(journal_file_);
-  } catch (const std::exception& e) {
-    spdlog::error("registry: {} (a registry after this one will not know it)", e.what());
-  }
-}
-
-void Registry::read_journal() {
-  if (journal_file_.empty()) return;
-  std::optional<internal::RegistryJournal> journal;
-  try {
-    journal = internal::RegistryJournal::read(journal_file_);
-  } catch (const std::exception& e) {
-    spdlog::error(
-        "registry: {}; recovering without it: restart counters start again from 0, and a module "
-        "that is not running starts with its configuration from the system file",
-        e.what());
-    return;
-  }
-  if (!journal) {
-    spdlog::warn("registry: no journal {}; recovering from what the modules and monitors say",
-                 journal_file_);
-    return;
-  }
-  const auto now = Clock::now();
-  const auto wall = wall_now();
-  const auto to_steady = [&](Stamp t) { return now - std::chrono::nanoseconds(wall - t); };
-  for (const auto& j : journal->modules) {
-    auto* m = find(j.name);
-    if (!m) continue;  // the system file changed: nothing to take over
-    m->incarnation = j.incarnation;
-    m->restore = j.restore;
-    m->restarts = j.restarts;
-    for (const auto t : j.counted) m->budget.record(to_steady(t));
-    m->last_failure = j.last_failure;
-    if (j.restart_due) {
-      m->status = "restarting";
-      m->restart_at = to_steady(j.restart_at);
-      m->restart_requested = j.restart_requested;
-      m->process_gone = true;  // unless its monitor says otherwise (on_monitor_report)
-      spdlog::info("registry: the journal says '{}' (incarnation {}) is due to restart", j.name,
-                   j.incarnation);
-    }
-  }
-  spdlog::info("registry: journal {} of {} modules read", journal_file_, journal->modules.size());
 }
 
 }  // namespace oscar
