@@ -131,6 +131,30 @@ TEST(RegistryDies, ARestartedRegistryAdoptsTheRunningModulesWithoutDuplicates) {
   for (const auto& [name, pid] : pids) EXPECT_FALSE(test::alive(pid)) << name << " left running";
 }
 
+std::string file_text(const std::string& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+TEST(RegistryDies, AGarbledJournalIsSaidAndTheRecoveryGoesOnWithoutIt) {
+  BootedSystem sys("regdies_garbled", kThreeModules);
+  const auto s = sys.running();
+  const auto journal = sys.log_dir() + "/registry.journal.yaml";
+  ASSERT_THAT(file_text(journal), HasSubstr("oscar_registry_journal")) << journal;
+  std::ofstream(journal, std::ios::trunc) << "oscar_registry_journal: 1\nmodules: [ { name: src";
+  const long old_registry = registry_pid(sys.file());
+  ASSERT_GT(old_registry, 0);
+  ASSERT_EQ(kill(static_cast<pid_t>(old_registry), SIGKILL), 0);
+
+  const auto back = sys.wait_for(recovered, 60s);
+  EXPECT_THAT(back.message(), HasSubstr("3 modules running were adopted, 0 started"));
+  for (const auto& m : back.modules()) EXPECT_EQ(m.pid(), entry(s, m.name())->pid()) << m.name();
+  const auto log = file_text(sys.log_dir() + "/registry.log");
+  EXPECT_THAT(log, HasSubstr(journal + ": not a registry journal (not YAML"));
+  EXPECT_THAT(log, HasSubstr("recovering without it"));
+  EXPECT_THAT(file_text(journal), HasSubstr("end: true")) << "the new registry writes it anew";
+}
+
 // The sink restarts 3 s after a failure: time enough to kill the registry before it has.
 constexpr const char* kSlowRestart = R"(
 system: regdies_mid
