@@ -97,7 +97,11 @@ void Registry::tick() {
   if (state_ == "booting" || state_ == "recovering") {
     std::vector<std::string> missing;
     for (const auto& m : modules_) {
-      if (m->status != "running" && m->status != "standby") missing.push_back(m->spec->spec.name);
+      // Recovering, a module the registry before gave up or replaced stays so.
+      const bool settled =
+          m->status == "running" || m->status == "standby" ||
+          (state_ == "recovering" && (m->status == "failed" || m->status == "replaced"));
+      if (!settled) missing.push_back(m->spec->spec.name);
     }
     if (missing.empty() && state_ == "recovering") {
       recovered();

@@ -16,7 +16,7 @@ namespace {
 
 // The first key of every journal; a file without it (or of another version) is not read.
 constexpr const char* kVersionKey = "oscar_registry_journal";
-constexpr int kVersion = 1;
+constexpr int kVersion = 2;
 // The last key: a file cut short (a full disk) lacks it, whatever else parses.
 constexpr const char* kEndKey = "end";
 
@@ -51,7 +51,8 @@ std::string RegistryJournal::to_yaml() const {
     out << YAML::Key << "restarts" << YAML::Value << m.restarts;
     out << YAML::Key << "counted_ns" << YAML::Value << YAML::Flow << m.counted;
     out << YAML::Key << "last_failure" << YAML::Value << YAML::DoubleQuoted << m.last_failure;
-    out << YAML::Key << "restart_due" << YAML::Value << m.restart_due;
+    out << YAML::Key << "status" << YAML::Value << m.status;
+    out << YAML::Key << "replaced_by" << YAML::Value << YAML::DoubleQuoted << m.replaced_by;
     out << YAML::Key << "restart_requested" << YAML::Value << m.restart_requested;
     out << YAML::Key << "restart_at_ns" << YAML::Value << m.restart_at;
     out << YAML::EndMap;
@@ -103,7 +104,8 @@ RegistryJournal RegistryJournal::parse(const std::string& text, const std::strin
     }
     for (const auto& c : counted) m.counted.push_back(c.as<Stamp>());
     m.last_failure = field<std::string>(n, "last_failure", where);
-    m.restart_due = field<bool>(n, "restart_due", where);
+    m.status = field<std::string>(n, "status", where);
+    m.replaced_by = field<std::string>(n, "replaced_by", where);
     m.restart_requested = field<bool>(n, "restart_requested", where);
     m.restart_at = field<Stamp>(n, "restart_at_ns", where);
     j.modules.push_back(std::move(m));

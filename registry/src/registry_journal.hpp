@@ -16,14 +16,17 @@ namespace oscar::internal {
 /// must mean the same to the next registry process.
 struct JournalModule {
   std::string name{};
-  unsigned incarnation = 0;        ///< the current one, or the failed one a restart replaces
-  std::string restore{};           ///< the configuration its next incarnation gets (--restore)
-  unsigned restarts = 0;           ///< restarts after failures (`oscar ps`)
-  std::vector<Stamp> counted{};    ///< the restarts the restart limit counts, when they were
-  std::string last_failure{};      ///< why it failed last
-  bool restart_due = false;        ///< failed (or asked to restart) and not started again yet
+  unsigned incarnation = 0;      ///< the current one, or the failed one a restart replaces
+  std::string restore{};         ///< the configuration its next incarnation gets (--restore)
+  unsigned restarts = 0;         ///< restarts after failures (`oscar ps`)
+  std::vector<Stamp> counted{};  ///< the restarts the restart limit counts, when they were
+  std::string last_failure{};    ///< why it failed last
+  /// What the registry made of it: "restarting" (a restart is due), "failed" (given up, or
+  /// waiting for the operator), "replaced" (its standby took over), else running or on its way.
+  std::string status{};
+  std::string replaced_by{};       ///< the standby module that takes its place
   bool restart_requested = false;  ///< that restart is an operator's, not a failure's
-  Stamp restart_at = 0;            ///< when the restart is due
+  Stamp restart_at = 0;            ///< when the restart is due (status "restarting")
 
   bool operator==(const JournalModule&) const = default;
 };

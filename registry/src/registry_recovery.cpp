@@ -28,7 +28,7 @@ void Registry::on_monitor_report(const MonitorReport& r) {
   for (const auto& child : r.children()) {
     auto* m = find(child.module_name());
     if (!m || m->spec->spec.host != r.host()) continue;
-    if (m->status == "waiting") {
+    if (m->status == "waiting" || m->status == "standby") {  // standby: it had taken over
       adopt(*m, child, r.monitor_pid());
     } else if (m->status == "restarting" && child.incarnation() > m->incarnation) {
       // The registry before had started the restart the journal says is due: it counts.
@@ -38,8 +38,8 @@ void Registry::on_monitor_report(const MonitorReport& r) {
       }
       m->restart_requested = false;
       adopt(*m, child, r.monitor_pid());
-    } else if (m->status == "restarting" && child.incarnation() == m->incarnation &&
-               m->process_gone) {
+    } else if ((m->status == "restarting" || m->status == "failed" || m->status == "replaced") &&
+               child.incarnation() == m->incarnation && m->process_gone) {
       // The failed process still runs (a hung module the registry before had not killed yet).
       m->process_gone = false;
       m->launched_by = r.monitor_pid();
@@ -81,15 +81,26 @@ bool Registry::may_start_on(const std::string& host) const {
 // Every module runs again after a crash of the registry: those the registry before suspended
 // (it died during a restart) are resumed.
 void Registry::recovered() {
+  const auto summary =
+      fmt::format("registry recovered: {} modules running were adopted, {} started", adopted_,
+                  started_in_recovery_);
+  for (const auto& m : modules_) {
+    const bool given_up =
+        m->spec->restart.kind == RestartPolicy::Kind::kAuto && m->spec->restart.continue_on_limit;
+    if (m->status == "failed" && !given_up) {
+      // As the registry before had left it: suspended until the operator restarts the module.
+      set_system("suspended",
+                 fmt::format("{}; '{}' failed: {}", summary, m->spec->spec.name, m->last_failure));
+      return;
+    }
+  }
   std::vector<Tracked*> targets;
   for (auto& m : modules_) {
     if (m->status == "running" && m->suspended) targets.push_back(m.get());
   }
   const auto ok = configure_all(targets, CMD_RESUME);
   for (std::size_t i = 0; i < targets.size(); ++i) targets[i]->suspended = !ok[i];
-  set_system("running",
-             fmt::format("registry recovered: {} modules running were adopted, {} started",
-                         adopted_, started_in_recovery_));
+  set_system("running", summary);
 }
 
 void Registry::write_journal() {
@@ -109,9 +120,10 @@ void Registry::write_journal() {
     j.restarts = m->restarts;
     for (const auto t : m->budget.restarts()) j.counted.push_back(to_wall(t));
     j.last_failure = m->last_failure;
-    j.restart_due = m->status == "restarting";
+    j.status = m->status;
+    j.replaced_by = m->replaced_by;
     j.restart_requested = m->restart_requested;
-    j.restart_at = j.restart_due ? to_wall(m->restart_at) : 0;
+    j.restart_at = m->status == "restarting" ? to_wall(m->restart_at) : 0;
     journal.modules.push_back(std::move(j));
   }
   // Written when it says something new, not for each state published.
@@ -154,7 +166,13 @@ void Registry::read_journal() {
     m->restarts = j.restarts;
     for (const auto t : j.counted) m->budget.record(to_steady(t));
     m->last_failure = j.last_failure;
-    if (j.restart_due) {
+    m->replaced_by = j.replaced_by;
+    if (j.status == "failed" || j.status == "replaced") {
+      // Given up, waiting for the operator, or replaced: it stays so (its process is gone, or
+      // is killed once its monitor reports it: on_monitor_report).
+      m->status = j.status;
+      m->process_gone = true;
+    } else if (j.status == "restarting") {
       m->status = "restarting";
       m->restart_at = to_steady(j.restart_at);
       m->restart_requested = j.restart_requested;

@@ -21,11 +21,13 @@ RegistryJournal sample() {
   sink.restarts = 2;
   sink.counted = {1'764'000'000'000'000'000, 1'764'000'000'100'000'000};
   sink.last_failure = "killed by signal 9 (last output: \"x: y\")";
-  sink.restart_due = true;
+  sink.status = "restarting";
   sink.restart_at = 1'764'000'000'200'000'000;
   JournalModule src;
   src.name = "src";
   src.incarnation = 1;
+  src.status = "replaced";
+  src.replaced_by = "spare_src";
   j.modules = {sink, src};
   return j;
 }

@@ -238,6 +238,50 @@ TEST(RegistryDies, BootGivesUpAfterFiveDeathsInAMinute) {
   EXPECT_TRUE(test::processes_mentioning(sys.file()).empty()) << "a process of the system is left";
 }
 
+// A module the registry before had replaced stays replaced; its standby is adopted.
+TEST(RegistryDies, AReplacedModuleStaysReplacedAndItsStandbyIsAdopted) {
+  BootedSystem sys("regdies_replace", R"(
+system: regdies_replace
+lease: 1s
+modules:
+  - name: cam
+    kernels: [ { type: bench_source, name: cam, params: { type: Bool } } ]
+    mode: { continuous: 20ms }
+    restart: { replace: cam_spare }
+  - name: cam_spare
+    standby: true
+    kernels: [ { type: bench_source, name: cam2, params: { type: Bool } } ]
+    mode: { continuous: 20ms }
+  - name: view
+    kernels: [ { type: bench_sink, name: view, params: { type: Bool }, inputs: { in: cam/out } } ]
+    mode: single_step
+)");
+  auto s = sys.running();
+  ASSERT_EQ(kill(static_cast<pid_t>(entry(s, "cam")->pid()), SIGKILL), 0);
+  s = sys.wait_for([](const SystemState& st) {
+    const auto* k = test::kernel_state(*entry(st, "view"), "view");
+    return entry(st, "cam")->status() == "replaced" &&
+           entry(st, "cam_spare")->status() == "running" && st.state() == "running" && k &&
+           !k->inputs().empty() && k->inputs()[0] == "in=cam2/out";
+  });
+  const long spare = entry(s, "cam_spare")->pid();
+  const long old_registry = registry_pid(sys.file());
+  ASSERT_GT(old_registry, 0);
+  ASSERT_EQ(kill(static_cast<pid_t>(old_registry), SIGKILL), 0);
+
+  s = sys.wait_for(recovered, 60s);
+  EXPECT_THAT(s.message(), HasSubstr("2 modules running were adopted, 0 started"));
+  EXPECT_EQ(entry(s, "cam")->status(), "replaced");
+  EXPECT_TRUE(module_processes(sys.file(), "cam").empty()) << "the replaced module was started";
+  EXPECT_EQ(entry(s, "cam_spare")->pid(), spare);
+  EXPECT_EQ(module_processes(sys.file(), "cam_spare"), std::vector<long>{spare});
+  const auto cycles = test::kernel_state(*entry(s, "view"), "view")->cycles();
+  sys.wait_for([cycles](const SystemState& st) {
+    const auto* k = test::kernel_state(*entry(st, "view"), "view");
+    return k && k->inputs()[0] == "in=cam2/out" && k->cycles() > cycles + 5;
+  });
+}
+
 // Defence in depth: whatever a registry asks, a monitor never starts a module twice.
 TEST(RegistryDies, AMonitorRefusesToStartAModuleItAlreadyRuns) {
   BootedSystem sys("regdies_refuse", kSlowRestart);
