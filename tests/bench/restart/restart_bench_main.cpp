@@ -241,10 +241,12 @@ void print_json(const char* security, const Run& r, int kills, int hangs, int re
 }
 
 void print_rows(const char* label, const Run& r, int kills, int hangs, int registry_kills) {
-  std::printf("%-34s %6d %14.1f %14.1f %14.1f %14.1f\n",
-              fmt::format("kill -9 (crash){}", label).c_str(), kills,
-              percentile(r.crashes.detect_ms, 0.5), percentile(r.crashes.detect_ms, 0.99),
-              percentile(r.crashes.resume_ms, 0.5), percentile(r.crashes.resume_ms, 0.99));
+  if (kills > 0) {
+    std::printf("%-34s %6d %14.1f %14.1f %14.1f %14.1f\n",
+                fmt::format("kill -9 (crash){}", label).c_str(), kills,
+                percentile(r.crashes.detect_ms, 0.5), percentile(r.crashes.detect_ms, 0.99),
+                percentile(r.crashes.resume_ms, 0.5), percentile(r.crashes.resume_ms, 0.99));
+  }
   if (hangs > 0) {
     std::printf("%-34s %6d %14.1f %14.1f %14.1f %14.1f\n",
                 fmt::format("SIGSTOP (hang){}", label).c_str(), hangs,
