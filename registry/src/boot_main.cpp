@@ -39,6 +39,7 @@
 #include "oscar/time.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
+#include "restart_budget.hpp"
 
 namespace {
 
@@ -208,6 +209,11 @@ std::map<std::string, std::vector<std::string>> discovery_servers(const oscar::S
   return servers;
 }
 
+// A registry that dies while the system runs is started again (with --recover) at most this
+// often within the window; then boot gives up and stops the system (docs/boot.md).
+constexpr int kRegistryRestarts = 5;
+constexpr std::chrono::seconds kRegistryRestartWindow{60};
+
 std::chrono::milliseconds seconds(double s) {
   return std::chrono::milliseconds(static_cast<long>(s * 1000));
 }
@@ -341,9 +347,18 @@ int main(int argc, char** argv) {
     const auto dom = std::to_string(system.domain);
     const auto servers = discovery_servers(system, file, dom);
     for (const auto& [name, command] : servers) children.start(name, 1, command);
-    children.start("registry", 1,
-                   {oscar::sibling_program("oscar-registry"), "--system", file, "--host",
-                    local.name, "--domain", dom});
+    // What cannot be learnt from the wire after a crash (docs/boot.md).
+    const auto journal = log_dir + "/registry.journal.yaml";
+    const std::vector<std::string> registry_command{oscar::sibling_program("oscar-registry"),
+                                                    "--system",
+                                                    file,
+                                                    "--host",
+                                                    local.name,
+                                                    "--domain",
+                                                    dom,
+                                                    "--journal",
+                                                    journal};
+    children.start("registry", 1, registry_command);
     for (const auto& h : system.hosts) {
       const bool remote = h.kind == oscar::HostSpec::Kind::kSsh;
       const auto& host_file = remote ? remote_file : file;
@@ -364,12 +379,38 @@ int main(int argc, char** argv) {
     };
     bool registry_gone = false;
     bool registry_ended_orderly = false;  // exit code 0, asked by someone other than boot
+    bool registry_given_up = false;       // it died too often
+    oscar::internal::RestartBudget registry_restarts;
     bool shutting_down = false;
+    // A registry killed or crashed while the system runs is started again: the modules go on
+    // meanwhile, and the new one adopts them (oscar-registry --recover).
+    const auto restart_registry = [&](const oscar::ProcessExit& x) {
+      const auto now = Clock::now();
+      if (!registry_restarts.allows(now, kRegistryRestarts, kRegistryRestartWindow)) {
+        log.note("boot",
+                 fmt::format("registry died ({}) for the {}th time within {} s: giving up, "
+                             "stopping the system",
+                             x.describe(), kRegistryRestarts + 1, kRegistryRestartWindow.count()),
+                 oscar::LOG_ERROR);
+        return false;
+      }
+      registry_restarts.record(now);
+      log.note("boot",
+               fmt::format("registry died ({}): restarting it ({} of {} in {} s)", x.describe(),
+                           registry_restarts.within(now, kRegistryRestartWindow), kRegistryRestarts,
+                           kRegistryRestartWindow.count()),
+               oscar::LOG_WARN);
+      auto command = registry_command;
+      command.push_back("--recover");
+      children.start("registry", x.incarnation + 1, command);
+      return true;
+    };
     const auto registry_exited = [&] {
       for (const auto& x : children.reap()) {
         // Code 0 is an orderly end (oscar shutdown, SIGTERM), also when its 'stopped' state
         // has not reached boot yet.
-        if (x.exit_code != 0) {
+        // (A registry that dies while the system runs is reported where it is restarted.)
+        if (x.exit_code != 0 && (x.module != "registry" || shutting_down)) {
           log.note("boot", fmt::format("{} {}", x.module, x.describe()), oscar::LOG_ERROR);
         }
         // A discovery server that died is started again: its clients find it at its address and
@@ -379,6 +420,8 @@ int main(int argc, char** argv) {
           children.start(x.module, x.incarnation + 1, it->second);
         }
         if (x.module == "registry") {
+          if (x.exit_code != 0 && !shutting_down && restart_registry(x)) continue;
+          registry_given_up = x.exit_code != 0 && !shutting_down;
           registry_gone = true;
           registry_ended_orderly = x.exit_code == 0;
         }
@@ -410,6 +453,7 @@ int main(int argc, char** argv) {
                  duration_s > 0 ? Clock::duration(seconds(duration_s)) : Clock::duration::max(),
                  stop, log);
     }
+    if (registry_given_up) code = 1;
     const int stops_before = stop.count();
     shutting_down = true;
     // The registry may exit before its 'stopped' state reaches boot; boot asked it for nothing,

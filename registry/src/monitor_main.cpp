@@ -25,6 +25,7 @@
 #include "oscar/process_util.hpp"
 #include "oscar/registry/host_check.hpp"
 #include "oscar/registry/launch_command.hpp"
+#include "oscar/registry/monitor_report_topic.hpp"
 #include "oscar/registry/supervisor.hpp"
 #include "oscar/registry/system_spec.hpp"
 #include "oscar/security_files.hpp"
@@ -48,6 +49,27 @@ oscar::ProcessEvent event(const std::string& host, const std::string& module, un
   e.exit_code(0);
   e.signal(0);
   return e;
+}
+
+// What this monitor runs, for a registry that restarts after a crash (monitor_report.idl).
+oscar::MonitorReport report(const std::string& host, long own_pid,
+                            const oscar::Supervisor& supervisor) {
+  oscar::MonitorReport r;
+  r.host(host);
+  r.monitor_pid(static_cast<std::int32_t>(own_pid));
+  r.stamp_ns(static_cast<unsigned long long>(oscar::wall_now()));
+  for (const auto& c : supervisor.children()) {
+    oscar::MonitorChild child;
+    child.module_name(c.module);
+    child.incarnation(c.incarnation);
+    child.pid(static_cast<std::int32_t>(c.pid));
+    r.children().push_back(std::move(child));
+  }
+  return r;
+}
+
+bool same_children(const oscar::MonitorReport& a, const oscar::MonitorReport& b) {
+  return a.children() == b.children();
 }
 
 // sshd hands the session's command pipes (or sockets) for its output; when the connection ends
@@ -150,6 +172,8 @@ int main(int argc, char** argv) {
         participant, oscar::topics::process_events());
     oscar::TopicWriter<oscar::MonitorBeat, oscar::MonitorBeatPubSubType> beats(
         participant, oscar::topics::monitor_alive(system.lease));
+    oscar::TopicWriter<oscar::MonitorReport, oscar::MonitorReportPubSubType> reports(
+        participant, oscar::topics::monitor_children());
 
     std::mutex mutex;
     std::deque<oscar::LaunchRequest> requests;
@@ -195,6 +219,10 @@ int main(int argc, char** argv) {
         std::this_thread::sleep_until(next);
       }
     });
+    // Written on every change and every lease/3: a registry started after a crash waits for it
+    // before it starts anything on this host.
+    auto last_report = report(host, own_pid, supervisor);
+    auto next_report = Clock::now();
     bool exit_requested = false;
     while (!exit_requested) {
       if (oscar::wait_for_stop(signals, std::chrono::milliseconds(5))) break;
@@ -221,6 +249,12 @@ int main(int argc, char** argv) {
         switch (q.kind()) {
           case oscar::LAUNCH_START: {
             try {
+              // A registry that restarted after a crash must never start a module twice.
+              if (const auto running = supervisor.pid_of(q.module_name());
+                  running && kill(*running, 0) == 0) {
+                throw std::runtime_error(fmt::format("cannot start {}: already running as pid {}",
+                                                     q.module_name(), *running));
+              }
               // The command comes from this monitor's own system file: a request names only the
               // module, its incarnation and the configuration it restores.
               const auto args =
@@ -265,6 +299,12 @@ int main(int argc, char** argv) {
         janitor.after_death(x.module);
       }
       janitor.tick();
+      if (auto now = report(host, own_pid, supervisor);
+          !same_children(now, last_report) || Clock::now() >= next_report) {
+        reports.write(now);
+        last_report = std::move(now);
+        next_report = Clock::now() + system.lease / 3;
+      }
     }
     beater.request_stop();
     beater.join();

@@ -20,14 +20,23 @@ constexpr std::size_t kMaxRequestNameChars = 256;
 
 }  // namespace
 
-Registry::Registry(const SystemSpec& system, DdsParticipant& participant)
-    : system_(system), participant_(participant), config_(participant, "registry") {
+Registry::Registry(const SystemSpec& system, DdsParticipant& participant, std::string journal_file,
+                   bool recovering)
+    : system_(system),
+      participant_(participant),
+      config_(participant, "registry"),
+      state_(recovering ? "recovering" : "booting"),
+      recovering_(recovering),
+      recovery_since_(Clock::now()),
+      journal_file_(std::move(journal_file)),
+      wall_at_start_ns_(wall_now()) {
   for (const auto& m : system_.modules) {
     auto t = std::make_unique<Tracked>();
     t->spec = &m;
     t->status = m.standby ? "standby" : "waiting";
     modules_.push_back(std::move(t));
   }
+  if (recovering_) read_journal();
   io_ = std::make_unique<Io>(*this);
 }
 
@@ -46,8 +55,10 @@ void Registry::stop() {
 }
 
 void Registry::run() {
-  spdlog::info("registry: system '{}' with {} modules on {} hosts, domain {}", system_.name,
-               modules_.size(), system_.hosts.size(), system_.domain);
+  spdlog::info("registry: system '{}' with {} modules on {} hosts, domain {}{}", system_.name,
+               modules_.size(), system_.hosts.size(), system_.domain,
+               recovering_ ? "; recovering after a crash: adopting what the monitors run" : "");
+  if (recovering_) message_ = "a registry before this one died: adopting what the monitors run";
   publish();
   std::unique_lock lock(mutex_);
   while (true) {
@@ -129,6 +140,11 @@ void Registry::on_monitor_lost(const std::string& host, long pid) {
 
 void Registry::on_process_event(const ProcessEvent& e) {
   auto* m = find(e.module_name());
+  if (m && recovering_ && m->status == "waiting") {
+    // A replay of what happened before the crash: the next start counts on from it.
+    m->incarnation = std::max(m->incarnation, static_cast<unsigned>(e.incarnation()));
+    return;
+  }
   if (!m || e.incarnation() != m->incarnation) return;  // an earlier incarnation's news
   if (e.kind() == PROC_STARTED) {
     m->pid = e.pid();
@@ -191,6 +207,13 @@ void Registry::on_module_lost(const std::string& module, unsigned incarnation) {
 
 void Registry::on_module_state(const ModuleState& s) {
   auto* m = find(s.module_name());
+  if (m && recovering_ &&
+      (m->status == "waiting" || (m->status == "restarting" && s.incarnation() > m->incarnation))) {
+    // A running module's state, replayed before its monitor's report: kept for the adoption.
+    auto& early = early_[s.module_name()];
+    if (s.incarnation() >= early.incarnation()) early = s;
+    return;
+  }
   if (!m || s.incarnation() != m->incarnation) return;
   const auto now = Clock::now();
   std::uint64_t published = 0;
@@ -220,6 +243,7 @@ void Registry::on_module_state(const ModuleState& s) {
 void Registry::started(Tracked& m, const ModuleState& now) {
   m.status = "running";
   m.running_since = Clock::now();
+  m.suspended = now.suspended();  // an adopted module may have been suspended before the crash
   spdlog::info("registry: module '{}' running (incarnation {}, pid {})", m.spec->spec.name,
                m.incarnation, now.pid());
   for (auto& other : modules_) {
@@ -238,7 +262,7 @@ void Registry::take_down(Tracked& m, bool process_gone) {
   const auto& mon = monitors_[m.spec->spec.host];
   // A module whose monitor has been replaced died with its monitor.
   m.process_gone = process_gone || (mon.pid != m.launched_by && mon.alive);
-  if (m.has_state) m.config = m.state;  // what the next incarnation gets back
+  if (m.has_state) m.restore = restore_text(m.state);  // what the next incarnation gets back
   publish();  // what happened is known now; suspending the others comes next
   if (!m.process_gone && mon.alive) {
     io_->send(LAUNCH_KILL, m.spec->spec.host, mon.pid, m.spec->spec.name, m.incarnation);

@@ -35,8 +35,7 @@ void Registry::launch(Tracked& m, unsigned incarnation) {
   m.process_gone = false;
   m.has_state = false;
   m.held = false;
-  io_->send(LAUNCH_START, host, mon.pid, m.spec->spec.name, incarnation,
-            m.config ? restore_text(*m.config) : std::string());
+  io_->send(LAUNCH_START, host, mon.pid, m.spec->spec.name, incarnation, m.restore);
   spdlog::info("registry: starting '{}' on '{}' (incarnation {})", m.spec->spec.name, host,
                incarnation);
 }
@@ -53,16 +52,22 @@ void Registry::tick() {
     const auto& mon = monitors_[m->spec->spec.host];
     if (!mon.alive) continue;
     if (m->status == "waiting") {
-      if (starting[m->spec->spec.host] >= kStartingPerHost) continue;
+      if (starting[m->spec->spec.host] >= kStartingPerHost || !may_start_on(m->spec->spec.host)) {
+        continue;
+      }
       ++starting[m->spec->spec.host];
-      launch(*m, 1);
+      if (state_ == "recovering") ++started_in_recovery_;
+      // 1 at boot; when recovering, one more than the last incarnation its monitor reported.
+      launch(*m, m->incarnation + 1);
       publish();
-    } else if (m->status == "restarting" && m->process_gone && now >= m->restart_at) {
+    } else if (m->status == "restarting" && m->process_gone && now >= m->restart_at &&
+               may_start_on(m->spec->spec.host)) {
       if (m->incarnation > 0 && !m->restart_requested) {
         ++m->restarts;
         m->budget.record(now);
       }
       m->restart_requested = false;
+      if (state_ == "recovering") ++started_in_recovery_;
       launch(*m, m->incarnation + 1);
       publish();
     }
@@ -84,12 +89,23 @@ void Registry::tick() {
       spdlog::info("registry: module '{}' sends its heartbeat again", m->spec->spec.name);
     }
   }
-  if (state_ == "booting") {
+  if (recovering_ && std::all_of(modules_.begin(), modules_.end(), [&](const auto& m) {
+        return m->status != "waiting" && may_start_on(m->spec->spec.host);
+      })) {
+    recovering_ = false;  // every host reported; every module was adopted or started
+  }
+  if (state_ == "booting" || state_ == "recovering") {
     std::vector<std::string> missing;
     for (const auto& m : modules_) {
-      if (m->status != "running" && m->status != "standby") missing.push_back(m->spec->spec.name);
+      // Recovering, a module the registry before gave up or replaced stays so.
+      const bool settled =
+          m->status == "running" || m->status == "standby" ||
+          (state_ == "recovering" && (m->status == "failed" || m->status == "replaced"));
+      if (!settled) missing.push_back(m->spec->spec.name);
     }
-    if (missing.empty()) {
+    if (missing.empty() && state_ == "recovering") {
+      recovered();
+    } else if (missing.empty()) {
       set_system("running", "all modules announced");
     } else if (message_ != "waiting for: " + fmt::format("{}", fmt::join(missing, ", "))) {
       message_ = fmt::format("waiting for: {}", fmt::join(missing, ", "));
@@ -267,6 +283,8 @@ void Registry::publish() {
     if (m->has_state) e.state(m->state);
     s.modules().push_back(std::move(e));
   }
+  // The journal first: what anyone saw published, a registry after this one knows.
+  write_journal();
   io_->publish(s);
   last_publish_ = Clock::now();
 }

@@ -1,5 +1,6 @@
 #include "registry_io.hpp"
 
+#include "oscar/time.hpp"
 #include "oscar/topics.hpp"
 
 #include <oscar/configPubSubTypes.h>
@@ -8,6 +9,7 @@ namespace oscar {
 
 Registry::Io::Io(Registry& r)
     : r_(r),
+      next_id_(static_cast<unsigned long long>(wall_now())),
       launch_(r.participant_, topics::launch()),
       reply_(r.participant_, topics::registry_reply()),
       system_(r.participant_, topics::system_state()),
@@ -55,7 +57,11 @@ Registry::Io::Io(Registry& r)
                   auto origin =
                       r_.participant_.modules_in_process_of(info.sample_identity.writer_guid());
                   r_.post([this, q, origin] { r_.on_request(q, origin); });
-                }) {}
+                }),
+      reports_(r.participant_, topics::monitor_children(),
+               [this](const MonitorReport& report, const auto&) {
+                 r_.post([this, report] { r_.on_monitor_report(report); });
+               }) {}
 
 void Registry::Io::send(LaunchKind kind, const std::string& host, long monitor_pid,
                         const std::string& module, unsigned incarnation,

@@ -8,6 +8,7 @@
 #include <oscar/configPubSubTypes.h>
 #include <oscar/registryPubSubTypes.h>
 
+#include "oscar/registry/monitor_report_topic.hpp"
 #include "oscar/registry/registry.hpp"
 #include "oscar/topic_io.hpp"
 
@@ -35,7 +36,9 @@ class Registry::Io {
   std::map<Handle, std::pair<std::string, long>> monitor_handles_;     // -> host, pid
   std::map<Handle, std::pair<std::string, unsigned>> module_handles_;  // -> module, incarnation
   std::map<std::pair<std::string, unsigned>, Clock::time_point> beats_at_;
-  unsigned long long next_id_ = 1;
+  // Monitors ignore a request id they have seen: a registry started after a crash must not
+  // reuse its predecessor's, so ids count on from the wall clock at start (ns since the epoch).
+  unsigned long long next_id_ = 0;
 
   TopicWriter<LaunchRequest, LaunchRequestPubSubType> launch_;
   TopicWriter<RegistryReply, RegistryReplyPubSubType> reply_;
@@ -45,6 +48,7 @@ class Registry::Io {
   TopicReader<ModuleState, ModuleStatePubSubType> states_;
   TopicReader<ModuleBeat, ModuleBeatPubSubType> beats_;
   TopicReader<RegistryRequest, RegistryRequestPubSubType> requests_;
+  TopicReader<MonitorReport, MonitorReportPubSubType> reports_;
 };
 
 }  // namespace oscar

@@ -19,6 +19,13 @@ int main(int argc, char** argv) {
   app.add_option("--system", file, "the system file")->required();
   app.add_option("--host", host, "the host it runs on (default: the system's first local host)");
   app.add_option("-d,--domain", domain, "DDS domain (default: the file's)");
+  std::string journal;
+  app.add_option("--journal", journal,
+                 "where to keep what a registry after this one needs (docs/boot.md)");
+  bool recover = false;
+  app.add_flag("--recover", recover,
+               "a registry before this one died: adopt the modules the monitors run, start only "
+               "the others (oscar boot passes it when it restarts a registry)");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 
   auto signals = oscar::block_stop_signals();
@@ -30,7 +37,7 @@ int main(int argc, char** argv) {
     {
       oscar::DdsParticipant participant(system.domain, "oscar-registry",
                                         system.network_for(host, oscar::security_files::kRegistry));
-      oscar::Registry registry(system, participant);
+      oscar::Registry registry(system, participant, journal, recover);
       std::thread signal_waiter([&] {
         int sig = 0;
         sigwait(&signals, &sig);

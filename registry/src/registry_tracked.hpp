@@ -1,7 +1,7 @@
 #pragma once
 // The registry's record of one module (internal to Registry).
 
-#include <optional>
+#include <string>
 
 #include "oscar/registry/registry.hpp"
 #include "restart_budget.hpp"
@@ -27,7 +27,9 @@ struct Registry::Tracked {
   std::string replaced_by;  // set when a replacement takes over
   ModuleState state;        // the last announcement of the current incarnation
   bool has_state = false;
-  std::optional<ModuleState> config;  // what to re-apply to the next incarnation
+  // What the next incarnation gets back (oscar-run --restore): the configuration of the last
+  // one, kept when it ended (take_down), or read from the journal by a recovering registry.
+  std::string restore;
   double cues_per_s = 0;
   Clock::time_point rate_since{};
   std::uint64_t rate_published = 0;

@@ -19,6 +19,8 @@ class RestartBudget {
   void record(Clock::time_point now) { restarts_.push_back(now); }
   /// Restarts within the `window` before `now` (what `allows` compares with `max`).
   int within(Clock::time_point now, Clock::duration window);
+  /// The restarts recorded (oldest first); older ones may be forgotten once out of the window.
+  const std::deque<Clock::time_point>& restarts() const { return restarts_; }
 
  private:
   std::deque<Clock::time_point> restarts_;  // oldest first, none older than the last window

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "oscar/registry/monitor_report_topic.hpp"
 #include "oscar/security_files.hpp"
 #include "oscar/topics.hpp"
 
@@ -84,7 +85,7 @@ std::vector<IdentityPolicy> identities_of(const SystemSpec& system) {
   for (const auto& h : system.hosts) {
     all.push_back(make(files::monitor_identity(h.name),
                        {log, topics::monitor_alive(std::chrono::milliseconds(1)).name,
-                        topics::process_events().name}));
+                        topics::process_events().name, topics::monitor_children().name}));
   }
   for (const auto& m : system.modules) {
     auto publish = module_topics(m);

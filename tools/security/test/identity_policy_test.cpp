@@ -82,6 +82,8 @@ TEST(IdentityPolicy, OnlyCoordinatorRegistryAndBootConfigureAndOnlyTheRegistryLa
   EXPECT_THAT(writers_of(all, "oscar/system/state"), ::testing::ElementsAre("registry"));
   EXPECT_THAT(writers_of(all, "oscar/registry/process"),
               ::testing::ElementsAre("monitor.a", "monitor.b"));
+  EXPECT_THAT(writers_of(all, "oscar/registry/children"),
+              ::testing::ElementsAre("monitor.a", "monitor.b"));
   EXPECT_THAT(writers_of(all, "oscar/coordinator/plan"),
               ::testing::ElementsAre("module.coordinator"));
   EXPECT_THAT(writers_of(all, "oscar/sched/hello"), ::testing::ElementsAre("module.helpers"));

@@ -3,6 +3,8 @@
 /// §2.4). Launches every module through its host's monitor, learns of failures three ways
 /// (process events from monitors, lapsed module heartbeats, lost monitors), suspends the
 /// system, restarts/replaces per policy, re-applies configuration and wiring, and resumes.
+/// Started again after a crash (`--recover`), it adopts the modules that still run and starts
+/// only the others (docs/boot.md, "When the registry dies").
 
 #include <chrono>
 #include <condition_variable>
@@ -14,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include <oscar/monitor_report.h>
 #include <oscar/registry.h>
 
 #include "oscar/config_client.hpp"
@@ -25,7 +28,13 @@ namespace oscar {
 class Registry {
  public:
   /// Joins the system's domain on `participant`; acquires no processes until run().
-  Registry(const SystemSpec& system, DdsParticipant& participant);
+  /// `journal_file` (none if empty): where it keeps what a registry after it would need
+  /// (configurations to restore, restart counters, restarts in progress).
+  /// `recovering`: a registry before this one died; the modules its monitors report running
+  /// are adopted, a host's modules are started only once its monitor has reported, and what
+  /// the journal says is taken over (a journal that cannot be read is said and skipped).
+  Registry(const SystemSpec& system, DdsParticipant& participant, std::string journal_file = {},
+           bool recovering = false);
   ~Registry();
   Registry(const Registry&) = delete;
   Registry& operator=(const Registry&) = delete;
@@ -50,6 +59,7 @@ class Registry {
   void post(std::function<void()> event);
   void on_monitor_beat(const MonitorBeat& beat);
   void on_monitor_lost(const std::string& host, long pid);
+  void on_monitor_report(const MonitorReport& report);
   void on_process_event(const ProcessEvent& event);
   void on_module_state(const ModuleState& state);
   void on_module_lost(const std::string& module, unsigned incarnation);
@@ -64,15 +74,24 @@ class Registry {
   void take_down(Tracked& m, bool process_gone);
   void launch(Tracked& m, unsigned incarnation);
   void started(Tracked& m, const ModuleState& state);
+  /// Takes over a process a monitor runs (recovery): as if launched, waiting for its state.
+  void adopt(Tracked& m, const MonitorChild& child, long monitor_pid);
+  /// While recovering: whether modules of `host` may be started (its monitor has reported).
+  bool may_start_on(const std::string& host) const;
   static std::string restore_text(const ModuleState& last);
   void rewire_consumers(const Tracked& failed, const Tracked& replacement);
   void suspend_all();
   void resume_if_whole();
+  void recovered();
   bool configure(const std::string& module, CommandKind kind, std::vector<std::string> args);
   std::vector<bool> configure_all(const std::vector<Tracked*>& targets, CommandKind kind);
   void shutdown();
   void set_system(const std::string& state, const std::string& message);
   void publish();
+  /// Takes over the restart counters, configurations and restarts in progress of the journal.
+  void read_journal();
+  /// Replaces the journal if what it would say changed (publish() calls it).
+  void write_journal();
   Tracked* find(const std::string& name);
 
   const SystemSpec& system_;
@@ -82,7 +101,15 @@ class Registry {
   std::map<std::string, Monitor> monitors_;        // by host
   std::string state_ = "booting";
   std::string message_;
-  unsigned long long next_request_id_ = 1;
+  bool recovering_ = false;                   // until every module is back after a crash
+  Clock::time_point recovery_since_{};        // when this registry started (recovering or not)
+  std::map<std::string, long> reported_;      // by host: the monitor pid whose report came
+  std::map<std::string, ModuleState> early_;  // recovering: states that came before adoption
+  std::string journal_file_;
+  std::string journal_text_;        // what the journal says now (without its time stamp)
+  long long wall_at_start_ns_ = 0;  // the wall clock at recovery_since_: the journal's times
+  int adopted_ = 0;                 // modules found running when recovering
+  int started_in_recovery_ = 0;     // modules no monitor ran when recovering
   bool shutting_down_ = false;
   Clock::time_point last_publish_{};
 

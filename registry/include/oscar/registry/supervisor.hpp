@@ -27,6 +27,13 @@ struct ProcessExit {
 
 class Supervisor {
  public:
+  /// A process it started that has not been reaped yet.
+  struct Child {
+    std::string module;
+    unsigned incarnation = 0;
+    pid_t pid = 0;
+  };
+
   /// Module output goes to `<log_dir>/<module>.log` (appended, one header line per start).
   /// Children get `death_signal` when the supervisor's process dies (PR_SET_PDEATHSIG): SIGKILL
   /// for a monitor's modules (they die with their host), SIGTERM for boot's registry and
@@ -48,15 +55,12 @@ class Supervisor {
   /// SIGTERM to each module in reverse start order, SIGKILL after `grace`; returns their exits.
   std::vector<ProcessExit> stop_all(std::chrono::milliseconds grace);
   std::optional<pid_t> pid_of(const std::string& module) const;
+  /// What it started and has not reaped yet, in start order.
+  const std::vector<Child>& children() const { return children_; }
   const std::string& log_dir() const { return log_dir_; }
   std::string log_path(const std::string& module) const;
 
  private:
-  struct Child {
-    std::string module;
-    unsigned incarnation;
-    pid_t pid;
-  };
   ProcessExit finished(const Child& child, int status) const;
 
   std::string log_dir_;
