@@ -1,5 +1,7 @@
 #include "registry_io.hpp"
 
+#include "oscar/registry/clock_topics.hpp"
+#include "oscar/time.hpp"
 #include "oscar/topics.hpp"
 
 #include <oscar/configPubSubTypes.h>
@@ -55,7 +57,20 @@ Registry::Io::Io(Registry& r)
                   auto origin =
                       r_.participant_.modules_in_process_of(info.sample_identity.writer_guid());
                   r_.post([this, q, origin] { r_.on_request(q, origin); });
-                }) {}
+                }),
+      clock_echoes_(r.participant_, topics::clock_echo()),
+      clock_probes_(r.participant_, topics::clock_probe(),
+                    [this](const ClockProbe& p, const auto&) {
+                      const auto t2 = wall_now();  // first, before anything else delays it
+                      ClockEcho e;
+                      e.host(p.host());
+                      e.monitor_pid(p.monitor_pid());
+                      e.seq(p.seq());
+                      e.t1_ns(p.t1_ns());
+                      e.t2_ns(t2);
+                      e.t3_ns(wall_now());  // last, just before it leaves
+                      clock_echoes_.write(e);
+                    }) {}
 
 void Registry::Io::send(LaunchKind kind, const std::string& host, long monitor_pid,
                         const std::string& module, unsigned incarnation,

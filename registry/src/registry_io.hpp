@@ -6,6 +6,7 @@
 #include <utility>
 
 #include <oscar/configPubSubTypes.h>
+#include <oscar/host_clockPubSubTypes.h>
 #include <oscar/registryPubSubTypes.h>
 
 #include "oscar/registry/registry.hpp"
@@ -45,6 +46,10 @@ class Registry::Io {
   TopicReader<ModuleState, ModuleStatePubSubType> states_;
   TopicReader<ModuleBeat, ModuleBeatPubSubType> beats_;
   TopicReader<RegistryRequest, RegistryRequestPubSubType> requests_;
+  // The monitors' clock probes, echoed at once from the reader's thread: the registry's own
+  // loop would add its latency to the round trip (docs/boot.md, "Clocks").
+  TopicWriter<ClockEcho, ClockEchoPubSubType> clock_echoes_;
+  TopicReader<ClockProbe, ClockProbePubSubType> clock_probes_;
 };
 
 }  // namespace oscar
