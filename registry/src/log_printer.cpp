@@ -33,7 +33,40 @@ LogPrinter::LogPrinter(std::FILE* out, bool colour, unsigned long long delay_ns)
 
 void LogPrinter::add(const LogRecord& record) {
   std::lock_guard lock(mutex_);
-  pending_.emplace(record.stamp_ns(), record);
+  const auto host = module_hosts_.find(record.module_name());
+  if (host == module_hosts_.end()) {
+    pending_.emplace(record.stamp_ns(), record);
+    return;
+  }
+  const auto offset = host_offsets_.find(host->second);
+  if (offset == host_offsets_.end()) {
+    pending_.emplace(record.stamp_ns(), record);
+    return;
+  }
+  auto corrected = record;
+  corrected.stamp_ns(record.stamp_ns() - static_cast<unsigned long long>(offset->second.count()));
+  pending_.emplace(corrected.stamp_ns(), std::move(corrected));
+}
+
+void LogPrinter::module_host(const std::string& module, const std::string& host) {
+  std::lock_guard lock(mutex_);
+  module_hosts_[module] = host;
+}
+
+void LogPrinter::host_clock(const std::string& host, std::chrono::nanoseconds offset,
+                            std::chrono::nanoseconds uncertainty) {
+  {
+    std::lock_guard lock(mutex_);
+    host_offsets_[host] = offset;
+    if (std::chrono::abs(offset) <= kClockWarning || !hosts_warned_.insert(host).second) return;
+  }
+  note("clocks",
+       fmt::format("host {}'s clock is {:+.1f} ms (± {:.1f} ms) from the registry's: the merged "
+                   "log orders its records by corrected time, but cue stamps stay off; keep the "
+                   "hosts in sync with chrony or PTP (docs/boot.md, \"Clocks\")",
+                   host, std::chrono::duration<double, std::milli>(offset).count(),
+                   std::chrono::duration<double, std::milli>(uncertainty).count()),
+       LOG_WARN);
 }
 
 void LogPrinter::note(const std::string& who, const std::string& message, LogLevel level) {
