@@ -72,6 +72,22 @@ TEST(LogPrinter, OrdersRecordsByTheirHostsCorrectedTime) {
   EXPECT_THAT(text, HasSubstr(".950 info  [camera] first"));  // printed with the corrected time
 }
 
+TEST(LogPrinter, ReordersRecordsHeldBackWhenTheirHostsFirstEstimateComes) {
+  std::FILE* out = std::tmpfile();
+  {
+    LogPrinter printer(out, /*colour=*/false, /*delay_ns=*/0);
+    printer.module_host("camera", "fast");
+    printer.add(record(1'000'000'000, "planner", "second"));
+    printer.add(record(1'200'000'000, "camera", "first"));  // before fast's first estimate
+    printer.host_clock("fast", std::chrono::milliseconds(250), std::chrono::milliseconds(1));
+    printer.flush(/*all=*/true);
+  }
+  const auto text = read_all(out);
+  std::fclose(out);
+  EXPECT_LT(text.find("[camera] first"), text.find("[planner] second")) << text;
+  EXPECT_THAT(text, HasSubstr(".950 info  [camera] first"));
+}
+
 TEST(LogPrinter, KeepsStampsOfHostsWithoutAnEstimate) {
   std::FILE* out = std::tmpfile();
   {

@@ -23,7 +23,8 @@ class LogPrinter {
   /// `module` runs on `host`.
   void module_host(const std::string& module, const std::string& host);
   /// The latest estimate of how far `host`'s clock is ahead of the registry's (docs/boot.md,
-  /// "Clocks"). Says once per host when it is more than kClockWarning off.
+  /// "Clocks"); the records held back are ordered again. Says once per host when it is more
+  /// than kClockWarning off.
   void host_clock(const std::string& host, std::chrono::nanoseconds offset,
                   std::chrono::nanoseconds uncertainty);
   static constexpr std::chrono::milliseconds kClockWarning{10};
@@ -34,6 +35,8 @@ class LogPrinter {
 
  private:
   std::string format(const LogRecord& r);
+  /// The record's stamp minus its host's offset, where both are known (mutex_ held).
+  unsigned long long corrected_stamp(const LogRecord& record) const;
   std::FILE* out_;
   bool colour_;
   unsigned long long delay_ns_;
