@@ -43,8 +43,8 @@ class HostClocks {
                   std::lock_guard lock(mutex_);
                   latest_[c.host()] = c;
                 }) {}
-  /// Waits up to `timeout` until every host of `s` has an estimate (they arrive just after the
-  /// system state: both are kept for late readers).
+  /// Waits up to `timeout` until every host of `s` has an estimate (both are kept for late
+  /// readers, but a monitor's writer may be discovered after the registry's).
   std::map<std::string, oscar::HostClock> wait_for_hosts_of(const oscar::SystemState& s,
                                                             std::chrono::milliseconds timeout) {
     std::set<std::string> hosts;
@@ -69,8 +69,16 @@ class HostClocks {
 
 double ms(long long ns) { return static_cast<double>(ns) / 1e6; }
 
-void print_clocks(const std::map<std::string, oscar::HostClock>& clocks) {
+void print_clocks(const oscar::SystemState& s,
+                  const std::map<std::string, oscar::HostClock>& clocks) {
   std::printf("\n%-10s %s\n", "HOST", "CLOCK (vs the registry's)");
+  std::set<std::string> without;
+  for (const auto& m : s.modules()) {
+    if (clocks.count(m.host()) == 0) without.insert(m.host());
+  }
+  for (const auto& host : without) {
+    std::printf("%-10s no estimate (yet)\n", host.c_str());
+  }
   for (const auto& [host, c] : clocks) {
     const bool off = std::abs(c.offset_ns()) >
                      std::chrono::nanoseconds(oscar::LogPrinter::kClockWarning).count();
@@ -154,7 +162,9 @@ int main(int argc, char** argv) {
                    oscar::where_systems_run(participant->domain()).c_str());
       return 1;
     }
-    const auto clocks = host_clocks.wait_for_hosts_of(*s, std::chrono::seconds(1));
+    // The monitors' writers may be discovered a little after the registry's.
+    const auto clocks = host_clocks.wait_for_hosts_of(
+        *s, std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));
     if (json) {
       auto j = to_json(*s);
       j["clocks"] = to_json(clocks);
@@ -179,7 +189,7 @@ int main(int argc, char** argv) {
                     static_cast<unsigned long long>(k.failures()), k.last_failure().c_str());
       }
     }
-    print_clocks(clocks);
+    print_clocks(*s, clocks);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "oscar ps: %s\n", e.what());
