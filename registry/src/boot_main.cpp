@@ -26,6 +26,7 @@
 #include "oscar/cue_types.hpp"
 #include "oscar/kernel_registry.hpp"
 #include "oscar/process_util.hpp"
+#include "oscar/registry/clock_topics.hpp"
 #include "oscar/registry/host_check.hpp"
 #include "oscar/registry/launch_command.hpp"
 #include "oscar/registry/log_printer.hpp"
@@ -334,6 +335,14 @@ int main(int argc, char** argv) {
       std::lock_guard lock(last_line_mutex);
       booted = true;
     }
+    // Records are ordered by their host's corrected time once its monitor has measured its
+    // clock (docs/boot.md, "Clocks").
+    for (const auto& m : system.modules) log.module_host(m.spec.name, m.spec.host);
+    oscar::TopicReader<oscar::HostClock, oscar::HostClockPubSubType> host_clocks(
+        participant, oscar::topics::host_clocks(), [&](const oscar::HostClock& c, const auto&) {
+          log.host_clock(c.host(), std::chrono::nanoseconds(c.offset_ns()),
+                         std::chrono::nanoseconds(c.uncertainty_ns()));
+        });
     oscar::TopicReader<oscar::LogRecord, oscar::LogRecordPubSubType> logs(
         participant, oscar::topics::log(),
         [&](const oscar::LogRecord& r, const auto&) { log.add(r); });

@@ -33,7 +33,44 @@ LogPrinter::LogPrinter(std::FILE* out, bool colour, unsigned long long delay_ns)
 
 void LogPrinter::add(const LogRecord& record) {
   std::lock_guard lock(mutex_);
-  pending_.emplace(record.stamp_ns(), record);
+  pending_.emplace(corrected_stamp(record), record);
+}
+
+unsigned long long LogPrinter::corrected_stamp(const LogRecord& record) const {
+  const auto host = module_hosts_.find(record.module_name());
+  if (host == module_hosts_.end()) return record.stamp_ns();
+  const auto offset = host_offsets_.find(host->second);
+  if (offset == host_offsets_.end()) return record.stamp_ns();
+  return record.stamp_ns() - static_cast<unsigned long long>(offset->second.count());
+}
+
+void LogPrinter::module_host(const std::string& module, const std::string& host) {
+  std::lock_guard lock(mutex_);
+  module_hosts_[module] = host;
+}
+
+void LogPrinter::host_clock(const std::string& host, std::chrono::nanoseconds offset,
+                            std::chrono::nanoseconds uncertainty) {
+  {
+    std::lock_guard lock(mutex_);
+    const auto [it, first] = host_offsets_.emplace(host, offset);
+    if (first || it->second != offset) {
+      it->second = offset;
+      // Records held back were ordered by what was known when they came (the first ones of a
+      // host often come before its first estimate): order them again.
+      std::multimap<unsigned long long, LogRecord> reordered;
+      for (auto& [stamp, r] : pending_) reordered.emplace(corrected_stamp(r), std::move(r));
+      pending_.swap(reordered);
+    }
+    if (std::chrono::abs(offset) <= kClockWarning || !hosts_warned_.insert(host).second) return;
+  }
+  note("clocks",
+       fmt::format("host {}'s clock is {:+.1f} ms (± {:.1f} ms) from the registry's: the merged "
+                   "log orders its records by corrected time, but cue stamps stay off; keep the "
+                   "hosts in sync with chrony or PTP (docs/boot.md, \"Clocks\")",
+                   host, std::chrono::duration<double, std::milli>(offset).count(),
+                   std::chrono::duration<double, std::milli>(uncertainty).count()),
+       LOG_WARN);
 }
 
 void LogPrinter::note(const std::string& who, const std::string& message, LogLevel level) {
@@ -70,7 +107,9 @@ void LogPrinter::flush(bool all) {
   std::lock_guard lock(mutex_);
   const auto horizon = static_cast<unsigned long long>(wall_now()) - delay_ns_;
   while (!pending_.empty() && (all || pending_.begin()->first <= horizon)) {
-    std::fputs(format(pending_.begin()->second).c_str(), out_);
+    auto& [stamp, record] = *pending_.begin();
+    record.stamp_ns(stamp);  // the corrected time
+    std::fputs(format(record).c_str(), out_);
     pending_.erase(pending_.begin());
   }
   std::fflush(out_);

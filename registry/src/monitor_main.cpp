@@ -19,6 +19,7 @@
 #include <CLI/CLI.hpp>
 #include <oscar/command_line.hpp>
 
+#include "clock_prober.hpp"
 #include "janitor.hpp"
 #include "oscar/cue_types.hpp"
 #include "oscar/kernel_registry.hpp"
@@ -156,6 +157,7 @@ int main(int argc, char** argv) {
     if (log_dir.empty()) {
       log_dir = fmt::format("/tmp/oscar/{}-{}/{}", system.name, system.domain, host);
     }
+    const auto test_clock_offset = oscar::test_clock_offset_from_environment();
     oscar::Supervisor supervisor(log_dir);
     if (over_ssh) {
       // What this monitor says after the connection is gone (stopping the host's modules) would
@@ -201,6 +203,14 @@ int main(int argc, char** argv) {
       }
     };
     HeadlessWatch headless(system.headless_limit);
+    if (test_clock_offset != std::chrono::nanoseconds::zero()) {
+      spdlog::warn(
+          "OSCAR_CLOCK_OFFSET_MS: this monitor's clock probes are shifted by {} ms (a "
+          "test hook, for tests only)",
+          std::chrono::duration_cast<std::chrono::milliseconds>(test_clock_offset).count());
+    }
+    // How far this host's clock is from the registry's (docs/boot.md, "Clocks").
+    oscar::ClockProber clock(participant, host, own_pid, test_clock_offset);
 
     oscar::MonitorBeat beat;
     beat.host(host);

@@ -1,5 +1,6 @@
 #include "registry_io.hpp"
 
+#include "oscar/registry/clock_topics.hpp"
 #include "oscar/time.hpp"
 #include "oscar/topics.hpp"
 
@@ -61,7 +62,20 @@ Registry::Io::Io(Registry& r)
       reports_(r.participant_, topics::monitor_children(),
                [this](const MonitorReport& report, const auto&) {
                  r_.post([this, report] { r_.on_monitor_report(report); });
-               }) {}
+               }),
+      clock_echoes_(r.participant_, topics::clock_echo()),
+      clock_probes_(r.participant_, topics::clock_probe(),
+                    [this](const ClockProbe& p, const auto&) {
+                      const auto t2 = wall_now();  // first, before anything else delays it
+                      ClockEcho e;
+                      e.host(p.host());
+                      e.monitor_pid(p.monitor_pid());
+                      e.seq(p.seq());
+                      e.t1_ns(p.t1_ns());
+                      e.t2_ns(t2);
+                      e.t3_ns(wall_now());  // last, just before it leaves
+                      clock_echoes_.write(e);
+                    }) {}
 
 void Registry::Io::send(LaunchKind kind, const std::string& host, long monitor_pid,
                         const std::string& module, unsigned incarnation,

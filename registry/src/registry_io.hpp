@@ -6,6 +6,7 @@
 #include <utility>
 
 #include <oscar/configPubSubTypes.h>
+#include <oscar/host_clockPubSubTypes.h>
 #include <oscar/registryPubSubTypes.h>
 
 #include "oscar/registry/monitor_report_topic.hpp"
@@ -49,6 +50,10 @@ class Registry::Io {
   TopicReader<ModuleBeat, ModuleBeatPubSubType> beats_;
   TopicReader<RegistryRequest, RegistryRequestPubSubType> requests_;
   TopicReader<MonitorReport, MonitorReportPubSubType> reports_;
+  // The monitors' clock probes, echoed at once from the reader's thread: the registry's own
+  // loop would add its latency to the round trip (docs/boot.md, "Clocks").
+  TopicWriter<ClockEcho, ClockEchoPubSubType> clock_echoes_;
+  TopicReader<ClockProbe, ClockProbePubSubType> clock_probes_;
 };
 
 }  // namespace oscar

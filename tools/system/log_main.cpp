@@ -1,4 +1,5 @@
-// oscar log: the merged log of the running system, time-ordered, one colour per module.
+// oscar log: the merged log of the running system, time-ordered (by corrected time where a
+// host's clock is off), one colour per module.
 #include <unistd.h>
 
 #include <csignal>
@@ -9,6 +10,7 @@
 #include <oscar/command_line.hpp>
 
 #include "oscar/process_util.hpp"
+#include "oscar/registry/clock_topics.hpp"
 #include "oscar/registry/log_printer.hpp"
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/registry/system_options.hpp"
@@ -28,6 +30,16 @@ int main(int argc, char** argv) {
   try {
     auto participant = tool.participant("oscar-log");
     oscar::LogPrinter printer(stdout, !no_colour && isatty(1) != 0);
+    // Records are ordered by their host's corrected time once the printer knows the host
+    // (from the system state) and its clock (from its monitor; docs/boot.md, "Clocks").
+    oscar::RegistryClient registry(*participant, "log", [&](const oscar::SystemState& s) {
+      for (const auto& m : s.modules()) printer.module_host(m.name(), m.host());
+    });
+    oscar::TopicReader<oscar::HostClock, oscar::HostClockPubSubType> host_clocks(
+        *participant, oscar::topics::host_clocks(), [&](const oscar::HostClock& c, const auto&) {
+          printer.host_clock(c.host(), std::chrono::nanoseconds(c.offset_ns()),
+                             std::chrono::nanoseconds(c.uncertainty_ns()));
+        });
     oscar::TopicReader<oscar::LogRecord, oscar::LogRecordPubSubType> logs(
         *participant, oscar::topics::log(),
         [&](const oscar::LogRecord& r, const auto&) { printer.add(r); });

@@ -1,15 +1,24 @@
 // oscar ps: the modules of the running system — host, pid, mode, state, restarts, cue rates,
-// and whether one runs under a debugger.
+// whether one runs under a debugger, and how far each host's clock is from the registry's.
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <mutex>
+#include <set>
+#include <thread>
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 #include <oscar/command_line.hpp>
 
+#include "oscar/registry/clock_topics.hpp"
+#include "oscar/registry/log_printer.hpp"
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/registry/system_options.hpp"
 #include "oscar/time.hpp"
+#include "oscar/topic_io.hpp"
 
 namespace {
 
@@ -23,6 +32,71 @@ std::string modes(const oscar::ModuleState& s) {
     if (k.stub()) out += "+stub";
   }
   return out.empty() ? "-" : out;
+}
+
+// Each host's latest clock estimate (docs/boot.md, "Clocks"), as its monitor publishes it.
+class HostClocks {
+ public:
+  explicit HostClocks(oscar::DdsParticipant& participant)
+      : reader_(participant, oscar::topics::host_clocks(),
+                [this](const oscar::HostClock& c, const auto&) {
+                  std::lock_guard lock(mutex_);
+                  latest_[c.host()] = c;
+                }) {}
+  /// Waits up to `timeout` until every host of `s` has an estimate (both are kept for late
+  /// readers, but a monitor's writer may be discovered after the registry's).
+  std::map<std::string, oscar::HostClock> wait_for_hosts_of(const oscar::SystemState& s,
+                                                            std::chrono::milliseconds timeout) {
+    std::set<std::string> hosts;
+    for (const auto& m : s.modules()) hosts.insert(m.host());
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    while (true) {
+      {
+        std::lock_guard lock(mutex_);
+        const bool all = std::all_of(hosts.begin(), hosts.end(),
+                                     [&](const auto& h) { return latest_.count(h) != 0; });
+        if (all || std::chrono::steady_clock::now() >= until) return latest_;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+
+ private:
+  std::mutex mutex_;
+  std::map<std::string, oscar::HostClock> latest_;
+  oscar::TopicReader<oscar::HostClock, oscar::HostClockPubSubType> reader_;
+};
+
+double ms(long long ns) { return static_cast<double>(ns) / 1e6; }
+
+void print_clocks(const oscar::SystemState& s,
+                  const std::map<std::string, oscar::HostClock>& clocks) {
+  std::printf("\n%-10s %s\n", "HOST", "CLOCK (vs the registry's)");
+  std::set<std::string> without;
+  for (const auto& m : s.modules()) {
+    if (clocks.count(m.host()) == 0) without.insert(m.host());
+  }
+  for (const auto& host : without) {
+    std::printf("%-10s no estimate (yet)\n", host.c_str());
+  }
+  for (const auto& [host, c] : clocks) {
+    const bool off = std::abs(c.offset_ns()) >
+                     std::chrono::nanoseconds(oscar::LogPrinter::kClockWarning).count();
+    std::printf("%-10s %+9.3f ms ± %.3f ms  (%u samples)%s\n", host.c_str(), ms(c.offset_ns()),
+                ms(c.uncertainty_ns()), c.samples(),
+                off ? "  ! over 10 ms: sync the hosts (chrony, PTP)" : "");
+  }
+}
+
+nlohmann::json to_json(const std::map<std::string, oscar::HostClock>& clocks) {
+  auto j = nlohmann::json::array();
+  for (const auto& [host, c] : clocks) {
+    j.push_back({{"host", host},
+                 {"offset_ns", c.offset_ns()},
+                 {"uncertainty_ns", c.uncertainty_ns()},
+                 {"samples", c.samples()}});
+  }
+  return j;
 }
 
 nlohmann::json to_json(const oscar::SystemState& s) {
@@ -78,6 +152,7 @@ int main(int argc, char** argv) {
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     auto participant = tool.participant("oscar-ps");
+    HostClocks host_clocks(*participant);
     oscar::RegistryClient client(*participant, "ps");
     const auto s = client.wait_for([](const oscar::SystemState&) { return true; },
                                    std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));
@@ -87,8 +162,13 @@ int main(int argc, char** argv) {
                    oscar::where_systems_run(participant->domain()).c_str());
       return 1;
     }
+    // The monitors' writers may be discovered a little after the registry's.
+    const auto clocks = host_clocks.wait_for_hosts_of(
+        *s, std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));
     if (json) {
-      std::printf("%s\n", to_json(*s).dump().c_str());
+      auto j = to_json(*s);
+      j["clocks"] = to_json(clocks);
+      std::printf("%s\n", j.dump().c_str());
       return 0;
     }
     std::printf("system %s: %s (%s)\n", s->system().c_str(), s->state().c_str(),
@@ -109,6 +189,7 @@ int main(int argc, char** argv) {
                     static_cast<unsigned long long>(k.failures()), k.last_failure().c_str());
       }
     }
+    print_clocks(*s, clocks);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "oscar ps: %s\n", e.what());

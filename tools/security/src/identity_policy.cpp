@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "oscar/registry/clock_topics.hpp"
 #include "oscar/registry/monitor_report_topic.hpp"
 #include "oscar/security_files.hpp"
 #include "oscar/topics.hpp"
@@ -76,8 +77,9 @@ std::vector<IdentityPolicy> identities_of(const SystemSpec& system) {
   auto operator_boot = boot;
   operator_boot.push_back(topics::swarm_request().name);
   std::vector<IdentityPolicy> all{
-      make(files::kRegistry, {log, kAnyModulesConfig, topics::launch().name,
-                              topics::registry_reply().name, topics::system_state().name}),
+      make(files::kRegistry,
+           {log, kAnyModulesConfig, topics::launch().name, topics::registry_reply().name,
+            topics::system_state().name, topics::clock_echo().name}),
       make(files::kBoot, boot),
       make(files::kOperator, {}),
       make(files::kOperatorBoot, operator_boot),
@@ -85,7 +87,8 @@ std::vector<IdentityPolicy> identities_of(const SystemSpec& system) {
   for (const auto& h : system.hosts) {
     all.push_back(make(files::monitor_identity(h.name),
                        {log, topics::monitor_alive(std::chrono::milliseconds(1)).name,
-                        topics::process_events().name, topics::monitor_children().name}));
+                        topics::process_events().name, topics::monitor_children().name,
+                        topics::clock_probe().name, topics::host_clocks().name}));
   }
   for (const auto& m : system.modules) {
     auto publish = module_topics(m);

@@ -86,6 +86,12 @@ TEST(IdentityPolicy, OnlyCoordinatorRegistryAndBootConfigureAndOnlyTheRegistryLa
               ::testing::ElementsAre("monitor.a", "monitor.b"));
   EXPECT_THAT(writers_of(all, "oscar/coordinator/plan"),
               ::testing::ElementsAre("module.coordinator"));
+  // Clock probes and estimates come from the monitors, echoes from the registry only.
+  EXPECT_THAT(writers_of(all, "oscar/registry/clock/probe"),
+              ::testing::ElementsAre("monitor.a", "monitor.b"));
+  EXPECT_THAT(writers_of(all, "oscar/registry/clocks"),
+              ::testing::ElementsAre("monitor.a", "monitor.b"));
+  EXPECT_THAT(writers_of(all, "oscar/registry/clock/echo"), ::testing::ElementsAre("registry"));
   EXPECT_THAT(writers_of(all, "oscar/sched/hello"), ::testing::ElementsAre("module.helpers"));
   // Jobs and world changes for the swarm: the coordinator's and other applets, and the operator
   // acting with boot's authority (`oscar swarm submit`); not boot itself.
