@@ -33,5 +33,9 @@ for sanitizer in ${SANITIZERS-address thread}; do
   echo "== $sanitizer sanitizer: unit and integration tests"
   BUILD_DIR="build-$sanitizer" BUILD_TYPE=RelWithDebInfo bash scripts/build.sh \
     -DOSCAR_SANITIZE="$sanitizer" -DOSCAR_BUILD_TESTS=ON -DOSCAR_BUILD_BENCHMARKS=OFF -DOSCAR_WERROR=OFF
-  ctest --test-dir "build-$sanitizer" --output-on-failure --timeout 300 -L "$sanitized"
+  # Tests of code that starts no thread (label threadless) give ThreadSanitizer nothing to find.
+  skip=""
+  [ "$sanitizer" = thread ] && skip="threadless"
+  ctest --test-dir "build-$sanitizer" --output-on-failure --timeout 300 -L "$sanitized" \
+    ${skip:+-LE "$skip"}
 done
