@@ -13,8 +13,8 @@
 #include <gtest/gtest.h>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
 
-#include "oscar/dds_participant.hpp"
 #include "dds/participant_identity.hpp"  // framework/src
+#include "oscar/dds_participant.hpp"
 
 namespace oscar {
 namespace {
@@ -54,20 +54,35 @@ class Discovery : public eprosima::fastdds::dds::DomainParticipantListener {
 // the others remove it as one that left (REMOVED), not drop it when its lease ends (DROPPED).
 TEST(DeadParticipants, TheDepartureOfAKilledParticipantIsAnnouncedInItsName) {
   const int domain = 100 + getpid() % 50;
-  int ready[2];
+  int go[2], ready[2];
+  ASSERT_EQ(pipe(go), 0);
   ASSERT_EQ(pipe(ready), 0);
   const pid_t child = fork();  // before this process has any DDS thread
   if (child == 0) {
+    close(go[1]);
+    char byte = 0;
+    // Made only once the observer listens: discovery may see it before any listener is set.
+    if (read(go[0], &byte, 1) != 1) _exit(1);
     DdsParticipant doomed(domain, "doomed");
     // Its prefix is in its claim once the constructor returns; discovery can see it before.
     if (write(ready[1], "r", 1) != 1) _exit(1);
     pause();
     _exit(0);
   }
+  close(go[0]);
   close(ready[1]);
+  // Whatever fails below, the child goes: alive, it would hold the test's output open.
+  struct Reaper {
+    pid_t pid;
+    ~Reaper() {
+      if (pid > 0 && kill(pid, SIGKILL) == 0) waitpid(pid, nullptr, 0);
+    }
+  } reaper{child};
   Discovery discovery;
   DdsParticipant observer(domain, "observer");
   observer.get().set_listener(&discovery, eprosima::fastdds::dds::StatusMask::none());
+  ASSERT_EQ(write(go[1], "g", 1), 1);
+  close(go[1]);
   std::size_t seen = 0;
   ASSERT_EQ(discovery.next(seen, 20s), ParticipantDiscoveryInfo::DISCOVERED_PARTICIPANT);
   const auto doomed = discovery.prefix(0);
@@ -80,6 +95,7 @@ TEST(DeadParticipants, TheDepartureOfAKilledParticipantIsAnnouncedInItsName) {
 
   kill(child, SIGKILL);
   waitpid(child, nullptr, 0);
+  reaper.pid = 0;
   const auto announced = announce_killed_participants(domain, {});
   ASSERT_EQ(announced.size(), 1u);
   EXPECT_EQ(announced[0], expected.str()) << "the killed one's prefix, from its claim";
