@@ -64,9 +64,9 @@ enum class ToolAuthority { kLook, kActAsBoot };
 /// network of its host `host` (default: its local host); `domain` >= 0 overrides the domain.
 /// Without a file it takes the domain given, else $OSCAR_DOMAIN, else that of the system booted
 /// on this machine (see default_system()), else domain 0; and the file of the system booted on
-/// that domain here, if any (its network: addresses, discovery servers), else loopback. It authenticates with the
-/// system's keystore ($OSCAR_KEYSTORE, the file's, or the one boot was given) as the identity
-/// `authority` names, if the system has one.
+/// that domain here, if any (its network: addresses, discovery servers), else loopback. It
+/// authenticates with the system's keystore ($OSCAR_KEYSTORE, the file's, or the one boot was
+/// given) as the identity `authority` names, if the system has one.
 /// @throws std::invalid_argument if several systems run and none was named.
 std::unique_ptr<DdsParticipant> tool_participant(const std::string& name, std::string system_file,
                                                  const std::string& host, int domain,
