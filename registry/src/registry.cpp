@@ -135,6 +135,7 @@ void Registry::on_monitor_lost(const std::string& host, long pid) {
       m->last_failure = fmt::format("host '{}' lost ({})", host, m->last_failure);
     }
   }
+  resume_if_whole();  // its modules that failed first no longer hold the rest (on_lost)
   publish();
 }
 
@@ -267,7 +268,7 @@ void Registry::take_down(Tracked& m, bool process_gone) {
   if (!m.process_gone && mon.alive) {
     io_->send(LAUNCH_KILL, m.spec->spec.host, mon.pid, m.spec->spec.name, m.incarnation);
   }
-  suspend_all();
+  if (!left_behind(m)) suspend_all();
 }
 
 void Registry::fail(Tracked& m, const std::string& reason, bool process_gone) {
@@ -277,16 +278,22 @@ void Registry::fail(Tracked& m, const std::string& reason, bool process_gone) {
   m.last_failure = reason;
   spdlog::error("registry: module '{}' failed: {}", name, reason);
   take_down(m, process_gone);
+  // On a lost host the system goes on without (on_lost: continue): it waits for nobody.
+  const bool go_on = left_behind(m);
+  const auto hold = [&](const std::string& why) {
+    if (!go_on) return set_system("suspended", why);
+    spdlog::warn("registry: {}; the rest runs on (host '{}' lost, on_lost: continue)", why,
+                 m.spec->spec.host);
+  };
   const auto& policy = m.spec->restart;
   switch (policy.kind) {
     case RestartPolicy::Kind::kAuto:
       if (m.budget.allows(failed_at, policy.max, policy.window)) {
         m.status = "restarting";
         m.restart_at = failed_at + policy.backoff;
-        set_system("suspended",
-                   fmt::format("'{}' {}; restart {} of {} within {} in {}", name, reason,
-                               m.budget.within(failed_at, policy.window) + 1, policy.max,
-                               format_duration(policy.window), format_duration(policy.backoff)));
+        hold(fmt::format("'{}' {}; restart {} of {} within {} in {}", name, reason,
+                         m.budget.within(failed_at, policy.window) + 1, policy.max,
+                         format_duration(policy.window), format_duration(policy.backoff)));
       } else {
         m.last_failure =
             fmt::format("{} (restart limit {} reached within {}; the module is given up)", reason,
@@ -298,13 +305,12 @@ void Registry::fail(Tracked& m, const std::string& reason, bool process_gone) {
         if (policy.continue_on_limit) {
           resume_if_whole();
         } else {
-          set_system("suspended", fmt::format("'{}' failed: {}", name, m.last_failure));
+          hold(fmt::format("'{}' failed: {}", name, m.last_failure));
         }
       }
       break;
     case RestartPolicy::Kind::kManual:
-      set_system("suspended",
-                 fmt::format("'{}' {}; waiting for `oscar restart {}`", name, reason, name));
+      hold(fmt::format("'{}' {}; waiting for `oscar restart {}`", name, reason, name));
       break;
     case RestartPolicy::Kind::kReplace: {
       auto* r = find(policy.replacement);

@@ -176,15 +176,33 @@ void Registry::suspend_all() {
   state_ = "suspended";
 }
 
-// Resumes once no module is on its way back; a module given up (or replaced) no longer counts.
+bool Registry::left_behind(const Tracked& m) const {
+  const auto& host = m.spec->spec.host;
+  const auto mon = monitors_.find(host);
+  if (mon == monitors_.end() || mon->second.alive || mon->second.pid == 0) return false;
+  for (const auto& h : system_.hosts) {
+    if (h.name == host) return h.continue_when_lost;
+  }
+  return false;
+}
+
+// Resumes once no module is on its way back; a module given up (or replaced) no longer counts,
+// nor one left behind on a lost host that the system goes on without.
 void Registry::resume_if_whole() {
   if (state_ != "suspended") return;
   for (const auto& m : modules_) {
-    if (m->status == "starting" || m->status == "restarting") return;
+    if (m->status != "starting" && m->status != "restarting" && m->status != "failed") continue;
     const bool given_up = m->status == "failed" &&
                           m->spec->restart.kind == RestartPolicy::Kind::kAuto &&
                           m->spec->restart.continue_on_limit;
-    if (m->status == "failed" && !given_up) return;
+    if (!given_up && !left_behind(*m)) return;
+  }
+  std::vector<std::string> without;  // lost hosts the rest runs on without
+  for (const auto& m : modules_) {
+    const auto& host = m->spec->spec.host;
+    if (left_behind(*m) && std::find(without.begin(), without.end(), host) == without.end()) {
+      without.push_back(host);
+    }
   }
   // A restarted module starts running (configured by --restore): only the others wait.
   std::vector<Tracked*> targets;
@@ -193,7 +211,10 @@ void Registry::resume_if_whole() {
   }
   const auto ok = configure_all(targets, CMD_RESUME);
   for (std::size_t i = 0; i < targets.size(); ++i) targets[i]->suspended = !ok[i];
-  set_system("running", "resumed");
+  set_system("running", without.empty() ? std::string("resumed")
+                                        : fmt::format("resumed without the modules of lost host "
+                                                      "'{}' (on_lost: continue)",
+                                                      fmt::join(without, "', '")));
 }
 
 bool Registry::configure(const std::string& module, CommandKind kind,

@@ -41,7 +41,7 @@ HostSpec parse_host(const std::string& name, const YAML::Node& node, const std::
   h.where = yaml_where(file, node);
   const auto what = "hosts." + name;
   if (!node.IsMap()) fail(h.where, what + ": expected {local: true} | {netns: NAME} | {ssh: U@H}");
-  check_yaml_keys(node, file, what, {"local", "netns", "ssh", "address", "ssh_options"});
+  check_yaml_keys(node, file, what, {"local", "netns", "ssh", "address", "ssh_options", "on_lost"});
   const int kinds = (node["local"] ? 1 : 0) + (node["netns"] ? 1 : 0) + (node["ssh"] ? 1 : 0);
   if (kinds != 1) fail(h.where, what + ": give exactly one of local, netns, ssh");
   if (node["netns"]) {
@@ -81,6 +81,16 @@ HostSpec parse_host(const std::string& name, const YAML::Node& node, const std::
       fail(yaml_where(file, node["address"]),
            fmt::format("{}.address '{}' is not an IPv4 address", what, h.address));
     }
+  }
+  if (const auto on_lost = node["on_lost"]) {
+    const auto policy = on_lost.IsScalar() ? on_lost.Scalar() : std::string();
+    if (policy != "suspend" && policy != "continue") {
+      fail(yaml_where(file, on_lost),
+           fmt::format("{}.on_lost '{}': expected suspend (the system waits for the host) or "
+                       "continue (the rest runs on without its modules)",
+                       what, policy));
+    }
+    h.continue_when_lost = policy == "continue";
   }
   // Without an address the remote host's processes would use loopback and never meet the rest.
   if (h.kind == HostSpec::Kind::kSsh && h.address.empty()) {

@@ -109,6 +109,22 @@ TEST(SystemSpec, HeadlessLimitIsADurationOrNone) {
               HasSubstr("headless_limit (or none)"));
 }
 
+TEST(SystemSpec, OnLostIsSuspendOrContinuePerHost) {
+  const auto plain = parse(kTwoHosts);
+  EXPECT_FALSE(plain.hosts[1].continue_when_lost) << "the default: the system waits for the host";
+  auto yaml = std::string(kTwoHosts);
+  const std::string b = "b: { netns: hb, address: 10.77.0.2 }";
+  yaml.replace(yaml.find(b), b.size(), "b: { netns: hb, address: 10.77.0.2, on_lost: continue }");
+  const auto going_on = parse(yaml);
+  EXPECT_FALSE(going_on.hosts[0].continue_when_lost);
+  EXPECT_TRUE(going_on.hosts[1].continue_when_lost);
+  yaml.replace(yaml.find("continue }"), 8, "suspend");
+  EXPECT_FALSE(parse(yaml).hosts[1].continue_when_lost);
+  yaml.replace(yaml.find("suspend }"), 7, "resume");
+  EXPECT_THAT(error_of(yaml), HasSubstr("hosts.b.on_lost 'resume': expected suspend (the system "
+                                        "waits for the host) or continue"));
+}
+
 TEST(SystemSpec, SecuritySectionIsOptionalAndReadsKeystoreAndCueProtection) {
   EXPECT_FALSE(parse(kOneModule).security);
   const auto s =

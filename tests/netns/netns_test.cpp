@@ -1,8 +1,8 @@
 // Three test hosts in network namespaces (issue 3, test f): modules spread across them, cues
 // crossing hosts over UDP between the test addresses; a killed monitor is a lost host whose
 // modules are failed; a monitor started again brings them back; a host cut off stops its modules
-// and rejoins when healed; a killed boot leaves no process on any host. Root only; skipped
-// otherwise.
+// and rejoins when healed (with `on_lost: continue` the rest runs on meanwhile); a killed boot
+// leaves no process on any host. Root only; skipped otherwise.
 #include <signal.h>
 
 #include <algorithm>
@@ -32,7 +32,7 @@ system: three
 lease: 1s
 hosts:
   h1: {{ local: true, address: {} }}
-  h2: {{ netns: {}, address: {} }}
+  h2: {{ netns: {}, address: {}{} }}
   h3: {{ netns: {}, address: {} }}
 modules:
   - name: src
@@ -50,7 +50,7 @@ modules:
     mode: single_step
 )",
                                         hosts_->address(1), hosts_->netns(2), hosts_->address(2),
-                                        hosts_->netns(3), hosts_->address(3));
+                                        h2_options(), hosts_->netns(3), hosts_->address(3));
     log_dir_ = test::temp_path("netns_logs");
     std::filesystem::remove_all(log_dir_);
     auto argv = hosts_->on(1);  // boot and the registry run on h1
@@ -68,6 +68,8 @@ modules:
   }
 
   static std::string domain() { return std::to_string(test::test_domain()); }
+  // More keys of h2 in the system file (", key: value").
+  virtual std::string h2_options() const { return ""; }
 
   // `oscar ps --json`, run on h1 (the test process itself is on no test host).
   json ps() {
@@ -241,6 +243,50 @@ TEST_F(ThreeHosts, AKilledBootLeavesNoProcessOnAnyHost) {
     EXPECT_THAT(log, ::testing::HasSubstr("stopped")) << host << ":\n" << log;
   }
   boot_.reset();  // already dead
+}
+
+// The same system with `on_lost: continue` on h2: a robot out of range, say.
+class ThreeHostsGoingOn : public ThreeHosts {
+ protected:
+  std::string h2_options() const override { return ", on_lost: continue"; }
+};
+
+// h2 cut off: its relay fails as "host 'h2' lost", and the rest of the system runs on without it
+// (src keeps publishing) instead of staying suspended until h2 is back; healed, h2's relay starts
+// again, once, and the system never stopped.
+TEST_F(ThreeHostsGoingOn, TheRestRunsOnWithoutALostHostsModulesAndTheyRejoinWhenHealed) {
+  until([&](const json& st) { return st["state"] == "running"; });
+  hosts_->cut(2);
+  auto s = until(
+      [&](const json& st) {
+        return !st["hosts_lost"].empty() && st["hosts_lost"][0] == "h2" &&
+               module(st, "relay")["last_failure"].get<std::string>().find("host 'h2' lost") !=
+                   std::string::npos &&
+               st["state"] == "running";
+      },
+      60s);
+  EXPECT_THAT(s["message"].get<std::string>(),
+              ::testing::HasSubstr("without the modules of lost host 'h2' (on_lost: continue)"));
+  const auto published = module(s, "src")["kernels"][0]["published"].get<std::uint64_t>();
+  s = until([&](const json& st) {
+    return module(st, "src")["kernels"][0]["published"].get<std::uint64_t>() > published + 20;
+  });
+  EXPECT_EQ(s["hosts_lost"].size(), 1u) << "src ran on only once h2 was back: " << s.dump();
+  EXPECT_EQ(s["state"], "running");
+
+  hosts_->heal(2);
+  s = until(
+      [&](const json& st) {
+        return st["state"] == "running" && st["hosts_lost"].empty() &&
+               module(st, "relay")["incarnation"] == 2 &&
+               module(st, "relay")["status"] == "running";
+      },
+      60s);
+  EXPECT_EQ(processes_with({"--module", "relay"}).size(), 1u) << "two relays after healing";
+  const auto relayed = module(s, "relay")["kernels"][0]["published"].get<std::uint64_t>();
+  until([&](const json& st) {
+    return module(st, "relay")["kernels"][0]["published"].get<std::uint64_t>() > relayed + 10;
+  });
 }
 
 }  // namespace

@@ -81,6 +81,9 @@ class Registry {
   static std::string restore_text(const ModuleState& last);
   void rewire_consumers(const Tracked& failed, const Tracked& replacement);
   void suspend_all();
+  /// Whether `m` is on a lost host whose system file says `on_lost: continue`: the rest does not
+  /// wait for it (it is restarted when the host is back).
+  bool left_behind(const Tracked& m) const;
   void resume_if_whole();
   void recovered();
   bool configure(const std::string& module, CommandKind kind, std::vector<std::string> args);

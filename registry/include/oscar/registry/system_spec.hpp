@@ -24,6 +24,9 @@ struct HostSpec {
   std::string where;    ///< "file:line"
   /// kSsh: ssh client options, each "Key=Value" as after `ssh -o` (Port, IdentityFile, ...).
   std::vector<std::string> ssh_options;
+  /// When the host is lost (its monitor's lease lapsed: a cut link, a robot out of range), the
+  /// rest of the system resumes without its modules instead of staying suspended until it is back.
+  bool continue_when_lost = false;
 };
 
 /// What the registry does when the module fails (docs/boot.md).
