@@ -2,12 +2,15 @@
 // crossing hosts over UDP between the test addresses; a killed monitor is a lost host whose
 // modules are failed; a monitor started again brings them back; a host cut off stops its modules
 // and rejoins when healed (with `on_lost: continue` the rest runs on meanwhile); a killed boot
-// leaves no process on any host. Root only; skipped otherwise.
+// leaves no process on any host; each host's clock offset is estimated across the network. Root
+// only; skipped otherwise.
 #include <signal.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -119,6 +122,21 @@ modules:
     return pids;
   }
 
+  // The pids of the monitors of `host` (not the `ip netns exec` that started one).
+  std::vector<long> monitors_of(const std::string& host) const {
+    std::vector<long> pids;
+    for (const auto& e : std::filesystem::directory_iterator("/proc")) {
+      std::ifstream in(e.path() / "cmdline");
+      const std::string cmd((std::istreambuf_iterator<char>(in)), {});
+      if (cmd.find("oscar-monitor") != std::string::npos && cmd.find(file_) != std::string::npos &&
+          cmd.find(host + '\0') != std::string::npos &&
+          cmd.find("ip\0netns", 0, 8) == std::string::npos) {
+        pids.push_back(std::stol(e.path().filename()));
+      }
+    }
+    return pids;
+  }
+
   std::unique_ptr<test::TestHosts> hosts_;
   std::string file_, log_dir_;
   std::unique_ptr<test::Process> boot_;
@@ -133,16 +151,7 @@ TEST_F(ThreeHosts, CuesCrossHostsALostHostFailsItsModulesAndComesBack) {
   });
 
   // Kill h2's monitor: the host is lost, its module dies with it and is marked failed.
-  std::vector<long> monitors;
-  for (const auto& e : std::filesystem::directory_iterator("/proc")) {
-    std::ifstream in(e.path() / "cmdline");
-    std::string cmd((std::istreambuf_iterator<char>(in)), {});
-    if (cmd.find("oscar-monitor") != std::string::npos && cmd.find(file_) != std::string::npos &&
-        cmd.find(std::string("h2") + '\0') != std::string::npos &&
-        cmd.find("ip\0netns", 0, 8) == std::string::npos) {
-      monitors.push_back(std::stol(e.path().filename()));
-    }
-  }
+  const auto monitors = monitors_of("h2");
   ASSERT_EQ(monitors.size(), 1u);
   ASSERT_EQ(kill(static_cast<pid_t>(monitors[0]), SIGKILL), 0);
   // The failure is published as soon as it is seen, the suspension right after.
@@ -222,6 +231,40 @@ TEST_F(ThreeHosts, ACutHostStopsItsModulesAndRejoinsWithTheirConfigurationWhenHe
   until([&](const json& st) {
     return module(st, "relay")["kernels"][0]["published"].get<std::uint64_t>() > published + 10;
   });
+}
+
+// Each host's clock is estimated over the network (the probes cross the test hosts' bridge):
+// h2's monitor, started again with a clock 250 ms ahead (the test hook), is reported so by
+// `oscar ps`, while h1 and h3, on the same kernel clock, are reported near 0.
+TEST_F(ThreeHosts, EachHostsClockOffsetIsEstimatedAcrossTheNetwork) {
+  until([&](const json& st) { return st["state"] == "running"; });
+  const auto monitors = monitors_of("h2");
+  ASSERT_EQ(monitors.size(), 1u);
+  ASSERT_EQ(kill(static_cast<pid_t>(monitors[0]), SIGKILL), 0);
+  auto argv = hosts_->on(2);
+  argv.insert(argv.end(),
+              {"env", "OSCAR_CLOCK_OFFSET_MS=250", test::bin("oscar-monitor"), "--system", file_,
+               "--host", "h2", "--domain", domain(), "--log-dir", log_dir_ + "/h2"});
+  test::Process monitor(argv, test::temp_path("netns_monitor_skewed.log"));
+  const auto offset_ms = [](const json& st, const std::string& host) -> std::optional<double> {
+    for (const auto& c : st["clocks"]) {
+      if (c["host"] == host && c["samples"].get<int>() >= 5) {
+        return c["offset_ns"].get<double>() / 1e6;
+      }
+    }
+    return std::nullopt;
+  };
+  const auto s = until(
+      [&](const json& st) {
+        const auto h2 = offset_ms(st, "h2");
+        return h2 && std::abs(*h2 - 250) < 25 && offset_ms(st, "h1") && offset_ms(st, "h3");
+      },
+      60s);
+  EXPECT_NEAR(offset_ms(s, "h1").value_or(1e9), 0, 25) << s["clocks"].dump();
+  EXPECT_NEAR(offset_ms(s, "h3").value_or(1e9), 0, 25) << s["clocks"].dump();
+  for (const auto& c : s["clocks"]) {
+    EXPECT_LT(c["uncertainty_ns"].get<double>() / 1e6, 25) << c.dump();
+  }
 }
 
 // Boot killed with SIGKILL on h1: every host's monitor stops its modules in order (SIGTERM from
