@@ -3,7 +3,8 @@
 // DDS with the same type and QoS, measured in the same run: multi-core and local in its fastest
 // configuration (a pre-pass tries delivery, publish mode and transport per row), remote over UDP
 // between two test hosts. --all adds the peers (Fast DDS data sharing, Cyclone DDS, iceoryx, a
-// memcpy + futex floor) to the multi-core and local rows, each its own program in peers/. Prints
+// memcpy + futex floor) to the multi-core and local rows and Cyclone DDS to the remote ones, each
+// its own program in peers/. Prints
 // a table, or JSON (--json). docs/benchmarks.md explains the rows.
 #include <algorithm>
 #include <cmath>
@@ -219,8 +220,10 @@ int main(int argc, char** argv) {
             ++failures;
           }
         }
-        for (const auto& peer : remote ? std::vector<Peer>{} : peers) {  // on one host only
-          if (const auto l = bench.program(peer.program, {}, r, multicore)) {
+        for (const auto& peer : peers) {
+          if (remote && !peer.remote) continue;  // a same-host mechanism
+          if (const auto l = remote ? bench.peer_remote(peer.program, r, *hosts)
+                                    : bench.program(peer.program, {}, r, multicore)) {
             peer_runs[peer.system].push_back(*l);
           } else {
             std::cerr << fmt::format("bench cueflow: {} {} {}: no report (logs in {})\n",

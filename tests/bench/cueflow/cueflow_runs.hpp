@@ -153,6 +153,36 @@ class Bench {
                   join(hosts.on(1), {bin("oscar-bench-raw")}, join(pub, common, {})));
   }
 
+  // A peer's program across the test hosts: subscriber on host 2, publisher on host 1, each on
+  // its host's address only (oscar-bench-cyclonedds' --address, --peer).
+  std::optional<Latency> peer_remote(const std::string& program, const Row& r,
+                                     const oscar::bench::RemoteHosts& hosts) {
+    const auto report = remote_file(program.c_str(), r);
+    const auto reach = [&](int i) {
+      return std::vector<std::string>{"--address",
+                                      hosts.address(i),
+                                      "--peer",
+                                      hosts.address(1),
+                                      "--peer",
+                                      hosts.address(2),
+                                      "--udp-buffer-bytes",
+                                      std::to_string(hosts.udp_buffer_bytes())};
+    };
+    const std::vector<std::string> common{"--type", r.type,        "--domain",
+                                          dom(),    "--period-us", std::to_string(r.period_us)};
+    const std::vector<std::string> sub{"sub",
+                                       "--report",
+                                       report,
+                                       "--expect",
+                                       std::to_string(count_ + warmup_),
+                                       "--warmup",
+                                       std::to_string(warmup_)};
+    const std::vector<std::string> pub{"pub", "--count", std::to_string(10 * (count_ + warmup_))};
+    return across(r, hosts, report,
+                  join(hosts.on(2), {bin(program.c_str())}, join(sub, common, reach(2))),
+                  join(hosts.on(1), {bin(program.c_str())}, join(pub, common, reach(1))));
+  }
+
  private:
   std::optional<Latency> across(const Row& r, const oscar::bench::RemoteHosts& hosts,
                                 const std::string& report, const std::vector<std::string>& sink,

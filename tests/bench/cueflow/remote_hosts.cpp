@@ -29,6 +29,8 @@ std::vector<std::string> RemoteHosts::on(int i) const {
   return argv;
 }
 
+std::string RemoteHosts::address(int i) const { return hosts_->address(i); }
+
 std::string RemoteHosts::network(int i) const {
   return fmt::format("{{interfaces: [{}], peers: [{}, {}], shared_memory: false}}",
                      hosts_->address(i), hosts_->address(1), hosts_->address(2));

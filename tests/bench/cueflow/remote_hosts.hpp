@@ -42,6 +42,10 @@ class RemoteHosts {
   /// both hosts, no shared memory (shared memory would work across network namespaces on one
   /// machine, and the constellation would not be remote).
   std::string network(int i) const;
+  /// The test address of host `i`.
+  std::string address(int i) const;
+  /// The UDP socket buffer size both sides ask for (OSCAR's 4 MiB unless the settings say).
+  std::uint32_t udp_buffer_bytes() const { return udp_.buffer_bytes.value_or(4u << 20); }
   /// Received on host `i` so far.
   LinkCounters received(int i) const;
 

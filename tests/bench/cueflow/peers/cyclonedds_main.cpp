@@ -1,12 +1,19 @@
 // oscar-bench-cyclonedds: Cyclone DDS 0.10 (C API) for `oscar bench cueflow --all`. One writer,
 // one reader, reliable, keep last 16, volatile (as the Fast DDS programs); the reader waits on a
-// wait set with a read condition and takes loaned samples. Confined to the loopback interface:
-// no multicast, unicast discovery to localhost. `both` runs writer and reader in one process.
+// wait set with a read condition and takes loaned samples. Confined to the loopback interface
+// (no multicast, unicast discovery to localhost), or for the remote constellation to a test
+// host's address with unicast discovery to the peers given. `both` runs writer and reader in one
+// process.
 //   oscar-bench-cyclonedds sub --type T --expect N --warmup W --report FILE --domain D
 //   oscar-bench-cyclonedds pub --type T --count N --period-us P --domain D
+//   ... [--address A --peer P1 --peer P2 --udp-buffer-bytes B]   (remote: between test hosts)
+#include <arpa/inet.h>
+
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include <dds/dds.h>
 
@@ -16,13 +23,42 @@
 namespace {
 using namespace oscar::bench;
 
-// Loopback only, whatever the environment says (docs/benchmarks.md).
-constexpr const char* kLoopbackConfig =
-    "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\"/>"
-    "</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery>"
-    "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>30"
-    "</MaxAutoParticipantIndex><Peers><Peer address=\"localhost\"/></Peers></Discovery>"
-    "</Domain></CycloneDDS>";
+// Where the program may talk: loopback (the default), or one test host's address.
+struct Reach {
+  std::string address;                 // "": the loopback interface
+  std::vector<std::string> peers;      // unicast discovery to these (with an address)
+  std::uint32_t udp_buffer_bytes = 0;  // asked for (the kernel may give less); 0: Cyclone's
+};
+
+bool is_ipv4(const std::string& s) {
+  in_addr a{};
+  return inet_pton(AF_INET, s.c_str(), &a) == 1;
+}
+
+// Loopback only, or the given address only, whatever the environment says
+// (docs/benchmarks.md): no multicast, discovery by unicast to the peers.
+std::string cyclone_config(const Reach& reach) {
+  std::string peers;
+  for (const auto& p :
+       reach.address.empty() ? std::vector<std::string>{"localhost"} : reach.peers) {
+    peers += fmt::format("<Peer address=\"{}\"/>", p);
+  }
+  const auto interface = reach.address.empty()
+                             ? std::string("<NetworkInterface name=\"lo\"/>")
+                             : fmt::format("<NetworkInterface address=\"{}\"/>", reach.address);
+  const auto buffers = reach.udp_buffer_bytes == 0
+                           ? std::string()
+                           : fmt::format(
+                                 "<Internal><SocketReceiveBufferSize min=\"default\" max=\"{0}B\"/>"
+                                 "<SocketSendBufferSize min=\"default\" max=\"{0}B\"/></Internal>",
+                                 reach.udp_buffer_bytes);
+  return fmt::format(
+      "<CycloneDDS><Domain id=\"any\"><General><Interfaces>{}</Interfaces>"
+      "<AllowMulticast>false</AllowMulticast></General><Discovery>"
+      "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>30"
+      "</MaxAutoParticipantIndex><Peers>{}</Peers></Discovery>{}</Domain></CycloneDDS>",
+      interface, peers, buffers);
+}
 
 dds_entity_t check(dds_entity_t e, const char* what) {
   if (e < 0) throw std::runtime_error(fmt::format("{}: {}", what, dds_strretcode(e)));
@@ -89,9 +125,29 @@ int main(int argc, char** argv) {
   CLI::App app{"oscar-bench-cyclonedds: Cyclone DDS peer of oscar bench cueflow"};
   PeerOptions o;
   add_peer_options(app, o);
+  Reach reach;
+  app.add_option("--address", reach.address,
+                 "the IPv4 address of a test host to use instead of loopback (remote)");
+  app.add_option("--peer", reach.peers, "with --address: where discovery looks, one per host");
+  app.add_option("--udp-buffer-bytes", reach.udp_buffer_bytes,
+                 "with --address: the UDP socket buffers to ask for (as OSCAR's 4 MiB)");
   CLI11_PARSE(app, argc, argv);
+  for (const auto& a : reach.peers) {
+    if (!is_ipv4(a)) {
+      std::fprintf(stderr, "oscar-bench-cyclonedds: --peer '%s' is not an IPv4 address\n",
+                   a.c_str());
+      return 2;
+    }
+  }
+  if (!reach.address.empty() && (!is_ipv4(reach.address) || reach.peers.empty())) {
+    std::fprintf(stderr,
+                 "oscar-bench-cyclonedds: --address '%s' needs to be an IPv4 address and to come "
+                 "with --peer\n",
+                 reach.address.c_str());
+    return 2;
+  }
   install_stop_handler();
-  setenv("CYCLONEDDS_URI", kLoopbackConfig, 1);
+  setenv("CYCLONEDDS_URI", cyclone_config(reach).c_str(), 1);
   try {
     const auto participant =
         check(dds_create_participant(static_cast<dds_domainid_t>(o.domain), nullptr, nullptr),

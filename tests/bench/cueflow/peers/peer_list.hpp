@@ -14,14 +14,16 @@
 
 namespace oscar::bench {
 
-// A peer of --all: its system name in the JSON and the program that measures it (peers/).
+// A peer of --all: its system name in the JSON, the program that measures it (peers/), and
+// whether it also crosses hosts (the remote constellation; the others are same-host mechanisms).
 struct Peer {
   const char* system;
   const char* program;
+  bool remote = false;
 };
 inline constexpr Peer kPeers[] = {
     {"fastdds_datasharing", "oscar-bench-fastdds-plain"},
-    {"cyclonedds", "oscar-bench-cyclonedds"},
+    {"cyclonedds", "oscar-bench-cyclonedds", true},
     {"iceoryx", "oscar-bench-iceoryx"},
     {"floor", "oscar-bench-floor"},
 };
