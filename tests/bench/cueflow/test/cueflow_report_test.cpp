@@ -1,9 +1,11 @@
-// The arithmetic of `oscar bench cueflow` (cueflow_report.hpp and peer_common.hpp), no timing.
+// The arithmetic of `oscar bench cueflow` (cueflow_report.hpp and peer_common.hpp) and the
+// Cyclone peer's reach (cyclone_reach.hpp), no timing.
 #include <gtest/gtest.h>
 
 #include <fstream>
 
 #include "cueflow_report.hpp"
+#include "peers/cyclone_reach.hpp"
 #include "peers/peer_common.hpp"
 
 namespace oscar::bench {
@@ -135,6 +137,38 @@ TEST(PeerCommon, PayloadsAreTheRowsSizes) {
   EXPECT_EQ(payload_bytes("Bool"), 1u);
   EXPECT_EQ(payload_bytes("LineSeg3DSeq"), 4800u);
   EXPECT_EQ(payload_bytes("GvImage"), 442368u);
+}
+
+TEST(CycloneReach, LoopbackOnlyByDefault) {
+  const auto xml = cyclone_config({});
+  EXPECT_NE(xml.find("<NetworkInterface name=\"lo\"/>"), std::string::npos) << xml;
+  EXPECT_NE(xml.find("<Peer address=\"localhost\"/>"), std::string::npos) << xml;
+  EXPECT_NE(xml.find("<AllowMulticast>false</AllowMulticast>"), std::string::npos) << xml;
+  EXPECT_EQ(xml.find("SocketReceiveBufferSize"), std::string::npos) << xml;
+}
+
+TEST(CycloneReach, ATestHostsAddressWithItsPeersAndBuffers) {
+  const Reach reach{"10.77.5.2", {"10.77.5.1", "10.77.5.2"}, 4u << 20};
+  EXPECT_EQ(reach_error(reach), "");
+  const auto xml = cyclone_config(reach);
+  EXPECT_NE(xml.find("<NetworkInterface address=\"10.77.5.2\"/>"), std::string::npos) << xml;
+  EXPECT_EQ(xml.find("name=\"lo\""), std::string::npos) << xml;
+  EXPECT_NE(xml.find("<Peer address=\"10.77.5.1\"/><Peer address=\"10.77.5.2\"/>"),
+            std::string::npos)
+      << xml;
+  EXPECT_EQ(xml.find("localhost"), std::string::npos) << xml;
+  EXPECT_NE(xml.find("max=\"4194304B\""), std::string::npos) << xml;
+  EXPECT_NE(xml.find("<AllowMulticast>false</AllowMulticast>"), std::string::npos) << xml;
+}
+
+TEST(CycloneReach, BadOptionsAreNamedWithTheRule) {
+  EXPECT_EQ(reach_error({"10.77.5.x", {"10.77.5.1"}, 0}),
+            "--address '10.77.5.x': not an IPv4 address");
+  EXPECT_EQ(reach_error({"10.77.5.2", {}, 0}),
+            "--address needs --peer (where discovery looks, one per host)");
+  EXPECT_EQ(reach_error({"10.77.5.2", {"robot"}, 0}), "--peer 'robot': not an IPv4 address");
+  EXPECT_EQ(reach_error({"", {"10.77.5.1"}, 0}),
+            "--peer goes with --address (without it: loopback only)");
 }
 
 }  // namespace
