@@ -190,18 +190,16 @@ bool Registry::left_behind(const Tracked& m) const {
 // nor one left behind on a lost host that the system goes on without.
 void Registry::resume_if_whole() {
   if (state_ != "suspended") return;
+  std::vector<std::string> without;  // lost hosts the rest runs on without
   for (const auto& m : modules_) {
     if (m->status != "starting" && m->status != "restarting" && m->status != "failed") continue;
     const bool given_up = m->status == "failed" &&
                           m->spec->restart.kind == RestartPolicy::Kind::kAuto &&
                           m->spec->restart.continue_on_limit;
-    if (!given_up && !left_behind(*m)) return;
-  }
-  std::vector<std::string> without;  // lost hosts the rest runs on without
-  for (const auto& m : modules_) {
-    const auto& host = m->spec->spec.host;
-    if (left_behind(*m) && std::find(without.begin(), without.end(), host) == without.end()) {
-      without.push_back(host);
+    if (given_up) continue;
+    if (!left_behind(*m)) return;
+    if (std::find(without.begin(), without.end(), m->spec->spec.host) == without.end()) {
+      without.push_back(m->spec->spec.host);
     }
   }
   // A restarted module starts running (configured by --restore): only the others wait.
