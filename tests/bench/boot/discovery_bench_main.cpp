@@ -2,10 +2,13 @@
 // host, without OSCAR. N processes, each with one bare Fast DDS participant configured as
 // OSCAR's are (UDP on loopback, unicast discovery to the participant ids started before it,
 // lease 3 s announced every second) and E writers of topics nobody reads (a module announces
-// about six endpoints). It reports how long until every participant has discovered every other
-// one, the CPU the processes used until then, and the CPU they use per second afterwards, when
-// nothing happens but discovery's upkeep. The figures sit beside `oscar bench boot`'s: the part
-// of a boot that is Fast DDS's and grows with the square of the participants.
+// about six endpoints), started all at once or, with --at-a-time K, as boot starts a host's
+// modules (the next while fewer than K are still finding those before them). It reports how
+// long until every participant has discovered every other one, the CPU the processes used until
+// then, and the CPU they use per second afterwards, when nothing happens but discovery's upkeep.
+// The figures sit beside `oscar bench boot`'s: the part of a boot that is Fast DDS's and grows
+// faster than the square of the participants.
+#include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -14,6 +17,7 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <mutex>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -44,6 +48,7 @@ struct Options {
   int upkeep_s = 5;
   int timeout_s = 120;
   int initial_announcements = 5;  // Fast DDS's default
+  int at_a_time = 0;              // 0: all at once
   bool shared_memory = false;
   bool json = false;
 };
@@ -124,15 +129,17 @@ class CountingListener final : public dds::DomainParticipantListener {
     writer_qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
     publisher->create_datawriter(topic, writer_qos);
   }
-  // SIGTERM ends it also before it has discovered everyone (the run timed out).
+  // Reports 'j' once it has found every participant started before it (it has joined), 'c'
+  // once it has found all. SIGTERM ends it also before (the run timed out).
   const timespec poll{0, 5'000'000};
   bool stopped = false;
-  while (!stopped && listener.discovered.load() < o.participants - 1) {
-    stopped = sigtimedwait(&term, nullptr, &poll) == SIGTERM;
+  for (const auto& [seen, news] : {std::pair{id, 'j'}, std::pair{o.participants - 1, 'c'}}) {
+    while (!stopped && listener.discovered.load() < seen) {
+      stopped = sigtimedwait(&term, nullptr, &poll) == SIGTERM;
+    }
+    if (!stopped && write(report, &news, 1) != 1) _exit(1);
   }
   if (!stopped) {
-    const char done = 1;
-    if (write(report, &done, 1) != 1) _exit(1);
     int signal = 0;
     sigwait(&term, &signal);
   }
@@ -178,6 +185,10 @@ int main(int argc, char** argv) {
   app.add_option("--initial-announcements", o.initial_announcements,
                  "announcements a new participant sends 100 ms apart (Fast DDS: 5)")
       ->check(CLI::Range(1, 10));
+  app.add_option("--at-a-time", o.at_a_time,
+                 "start the next participant only while fewer than this many have not yet found "
+                 "those before them (0: all at once)")
+      ->check(CLI::NonNegativeNumber);
   app.add_flag("--shared-memory", o.shared_memory, "shared memory for user data too, as OSCAR");
   app.add_flag("--json", o.json, "print one JSON line");
   CLI11_PARSE(app, argc, argv);
@@ -186,18 +197,8 @@ int main(int argc, char** argv) {
   int report[2];
   if (pipe(report) != 0) return 1;
   std::vector<pid_t> pids;
+  std::mutex pids_mutex;  // the watchdog kills what has been started
   const auto start = Clock::now();
-  for (int id = 0; id < o.participants; ++id) {
-    const pid_t pid = fork();
-    if (pid == 0) {
-      close(report[0]);
-      participate(o, domain, id, report[1]);
-    }
-    pids.push_back(pid);
-  }
-  close(report[1]);
-  // Every participant writes one byte once it has discovered all others.
-  int done = 0;
   std::atomic<bool> timed_out{false};
   std::thread watchdog([&] {
     const auto until = start + std::chrono::seconds(o.timeout_s);
@@ -205,10 +206,33 @@ int main(int argc, char** argv) {
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
     if (!timed_out.exchange(true)) {
-      for (const auto pid : pids) kill(pid, SIGTERM);  // ends their pipe ends
+      std::lock_guard lock(pids_mutex);
+      for (const auto pid : pids) kill(pid, SIGTERM);
     }
   });
-  for (char byte = 0; done < o.participants && read(report[0], &byte, 1) == 1;) ++done;
+  // Started one after another; with --at-a-time K the next only while fewer than K have not
+  // yet found those before them (as boot starts a host's modules, 8 at a time).
+  int joined = 0, done = 0;
+  const int at_a_time = o.at_a_time > 0 ? o.at_a_time : o.participants;
+  pollfd news{report[0], POLLIN, 0};
+  while (done < o.participants && !timed_out.load()) {
+    while (static_cast<int>(pids.size()) < o.participants &&
+           static_cast<int>(pids.size()) - joined < at_a_time) {
+      const int id = static_cast<int>(pids.size());
+      const pid_t pid = fork();
+      if (pid == 0) {
+        close(report[0]);
+        participate(o, domain, id, report[1]);
+      }
+      std::lock_guard lock(pids_mutex);
+      pids.push_back(pid);
+    }
+    if (poll(&news, 1, 100) != 1) continue;
+    char byte = 0;
+    if (read(report[0], &byte, 1) != 1) break;
+    (byte == 'j' ? joined : done) += 1;
+  }
+  close(report[1]);
   const auto discovered_ms =
       std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   const double discovery_cpu_s = cpu_seconds(pids);
@@ -225,11 +249,12 @@ int main(int argc, char** argv) {
   close(report[0]);
   if (o.json) {
     std::printf(
-        "{\"participants\":%d,\"endpoints\":%d,\"initial_announcements\":%d,\"complete\":%s,"
+        "{\"participants\":%d,\"endpoints\":%d,\"initial_announcements\":%d,\"at_a_time\":%d,"
+        "\"complete\":%s,"
         "\"discovered\":%d,"
         "\"discovery_ms\":%.0f,\"discovery_cpu_s\":%.2f,\"upkeep_cpu_s_per_s\":%.3f}\n",
-        o.participants, o.endpoints, o.initial_announcements, complete ? "true" : "false", done,
-        discovered_ms, discovery_cpu_s, upkeep_cpu_per_s);
+        o.participants, o.endpoints, o.initial_announcements, o.at_a_time,
+        complete ? "true" : "false", done, discovered_ms, discovery_cpu_s, upkeep_cpu_per_s);
   } else {
     std::printf(
         "oscar bench discovery: %d bare Fast DDS participants, %d writers each\n"
