@@ -14,10 +14,11 @@ namespace oscar::internal {
 std::string restore_text(const ModuleState& last);
 
 /// restore_text() of a module's announcements, made again only when what it reads changed.
-/// A module announces itself every second with new counters, and the registry writes every
+/// A module announces itself every second with new counters, and the registry puts every
 /// running module's restore text into its journal on each state it publishes: made each time
-/// (a YAML emitter and a parse of each kernel's parameters), that was most of the registry's
-/// CPU while a system of 60 modules booted, the square of the modules (docs/benchmarks.md).
+/// (a YAML emitter and a parse of each kernel's parameters), that was a third of the registry's
+/// CPU samples while a system of 60 modules booted, the square of the modules
+/// (docs/benchmarks.md).
 class RestoreTextCache {
  public:
   const std::string& of(const ModuleState& last);
