@@ -263,7 +263,8 @@ void Registry::take_down(Tracked& m, bool process_gone) {
   const auto& mon = monitors_[m.spec->spec.host];
   // A module whose monitor has been replaced died with its monitor.
   m.process_gone = process_gone || (mon.pid != m.launched_by && mon.alive);
-  if (m.has_state) m.restore = restore_text(m.state);  // what the next incarnation gets back
+  // What the next incarnation gets back.
+  if (m.has_state) m.restore = m.restore_of_state.of(m.state);
   publish();  // what happened is known now; suspending the others comes next
   if (!m.process_gone && mon.alive) {
     io_->send(LAUNCH_KILL, m.spec->spec.host, mon.pid, m.spec->spec.name, m.incarnation);

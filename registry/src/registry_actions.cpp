@@ -7,13 +7,13 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
-#include <yaml-cpp/yaml.h>
 
 #include "oscar/registry/launch_command.hpp"
 #include "oscar/registry/registry.hpp"
 #include "oscar/time.hpp"
 #include "registry_io.hpp"
 #include "registry_tracked.hpp"
+#include "restore_text.hpp"
 
 namespace oscar {
 namespace {
@@ -113,31 +113,6 @@ void Registry::tick() {
     }
   }
   if (now - last_publish_ > std::chrono::seconds(1)) publish();
-}
-
-// What the coordinator had made of the module (modes, stub, parameters, wiring), from its last
-// announcement, as `oscar-run --restore` takes it: the new incarnation starts configured.
-std::string Registry::restore_text(const ModuleState& last) {
-  YAML::Emitter out;
-  out << YAML::Flow << YAML::BeginMap;
-  for (const auto& k : last.kernels()) {
-    out << YAML::Key << k.name() << YAML::Value << YAML::BeginMap;
-    out << YAML::Key << "mode" << YAML::Value
-        << (k.mode() == "continuous"    ? fmt::format("continuous:{}ns", k.cycle_ns())
-            : k.mode() == "deactivated" ? std::string("deactivated")
-            : k.trigger() == "default" || k.trigger().empty() ? std::string("single_step")
-                                                              : "single_step:" + k.trigger());
-    out << YAML::Key << "stub" << YAML::Value << k.stub();
-    out << YAML::Key << "params" << YAML::Value << YAML::Load(k.params());
-    out << YAML::Key << "inputs" << YAML::Value << YAML::BeginMap;
-    for (const auto& wire : k.inputs()) {
-      const auto eq = wire.find('=');
-      out << YAML::Key << wire.substr(0, eq) << YAML::Value << wire.substr(eq + 1);
-    }
-    out << YAML::EndMap << YAML::EndMap;
-  }
-  out << YAML::EndMap;
-  return out.c_str();
 }
 
 // `replacement` takes over: inputs that read kernel i of the failed module now read kernel i

@@ -111,12 +111,14 @@ void Registry::write_journal() {
            std::chrono::duration_cast<std::chrono::nanoseconds>(t - recovery_since_).count();
   };
   internal::RegistryJournal journal;
+  bool changed = false;
   for (const auto& m : modules_) {
     internal::JournalModule j;
     j.name = m->spec->spec.name;
     j.incarnation = m->incarnation;
     // A running module's own state is what it would get back if it failed now.
-    j.restore = m->status == "running" && m->has_state ? restore_text(m->state) : m->restore;
+    j.restore =
+        m->status == "running" && m->has_state ? m->restore_of_state.of(m->state) : m->restore;
     j.restarts = m->restarts;
     for (const auto t : m->budget.restarts()) j.counted.push_back(to_wall(t));
     j.last_failure = m->last_failure;
@@ -124,12 +126,14 @@ void Registry::write_journal() {
     j.replaced_by = m->replaced_by;
     j.restart_requested = m->restart_requested;
     j.restart_at = m->status == "restarting" ? to_wall(m->restart_at) : 0;
+    changed = changed || j != m->journaled;
     journal.modules.push_back(std::move(j));
   }
-  // Written when it says something new, not for each state published.
-  auto text = journal.to_yaml();
-  if (text == journal_text_) return;
-  journal_text_ = std::move(text);
+  // Written when it says something new, not for each state published: compared field by field,
+  // not as YAML text (making the text for every module on each publish cost the registry the
+  // square of the modules while a system booted, docs/benchmarks.md).
+  if (!changed) return;
+  for (std::size_t i = 0; i < modules_.size(); ++i) modules_[i]->journaled = journal.modules[i];
   journal.written = wall_now();
   try {
     journal.write(journal_file_);

@@ -4,7 +4,9 @@
 #include <string>
 
 #include "oscar/registry/registry.hpp"
+#include "registry_journal.hpp"
 #include "restart_budget.hpp"
+#include "restore_text.hpp"
 
 namespace oscar {
 
@@ -30,6 +32,8 @@ struct Registry::Tracked {
   // What the next incarnation gets back (oscar-run --restore): the configuration of the last
   // one, kept when it ended (take_down), or read from the journal by a recovering registry.
   std::string restore;
+  internal::RestoreTextCache restore_of_state;  // what `state` would give back (restore_text)
+  internal::JournalModule journaled{};          // what the journal says of it now
   double cues_per_s = 0;
   Clock::time_point rate_since{};
   std::uint64_t rate_published = 0;

@@ -78,7 +78,6 @@ class Registry {
   void adopt(Tracked& m, const MonitorChild& child, long monitor_pid);
   /// While recovering: whether modules of `host` may be started (its monitor has reported).
   bool may_start_on(const std::string& host) const;
-  static std::string restore_text(const ModuleState& last);
   void rewire_consumers(const Tracked& failed, const Tracked& replacement);
   void suspend_all();
   /// Whether `m` is on a lost host whose system file says `on_lost: continue`: the rest does not
@@ -109,7 +108,6 @@ class Registry {
   std::map<std::string, long> reported_;      // by host: the monitor pid whose report came
   std::map<std::string, ModuleState> early_;  // recovering: states that came before adoption
   std::string journal_file_;
-  std::string journal_text_;        // what the journal says now (without its time stamp)
   long long wall_at_start_ns_ = 0;  // the wall clock at recovery_since_: the journal's times
   int adopted_ = 0;                 // modules found running when recovering
   int started_in_recovery_ = 0;     // modules no monitor ran when recovering
