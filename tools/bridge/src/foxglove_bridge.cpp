@@ -12,6 +12,7 @@
 
 #include "channel_directory.hpp"
 #include "config_service.hpp"
+#include "jpeg_encoder.hpp"
 #include "oscar/idl_texts.hpp"
 #include "oscar/topics.hpp"
 #include "raw_tap.hpp"
@@ -40,6 +41,13 @@ void check_listen_address(const std::string& address) {
   }
 }
 
+void check_jpeg_quality(int quality) {
+  if (quality < kMinJpegQuality || quality > kMaxJpegQuality) {
+    throw std::invalid_argument(fmt::format("--jpeg-quality {}: must be {} (smallest) to {} (best)",
+                                            quality, kMinJpegQuality, kMaxJpegQuality));
+  }
+}
+
 // Everything below runs on the one thread that runs io (Fast DDS threads and the configuration
 // worker only post to it).
 struct FoxgloveBridge::Impl final : SessionHost {
@@ -57,7 +65,8 @@ struct FoxgloveBridge::Impl final : SessionHost {
   std::string started_ns = std::to_string(inspect::now_ns());  // the session id
   net::io_context io{1};
   tcp::acceptor acceptor{io};
-  ChannelDirectory directory{idl_texts(), side_channel_for};
+  ChannelDirectory directory{idl_texts(), side_channels_for};
+  ConversionSettings conversion{.jpeg_quality = options.jpeg_quality};
   std::set<std::shared_ptr<Session>> sessions;
   std::map<std::uint32_t, int> wanted;   // channel -> subscribers
   std::map<std::string, int> readers;    // DDS topic -> channels wanting it; read while > 0
@@ -77,7 +86,13 @@ struct FoxgloveBridge::Impl final : SessionHost {
       }};
 
   Impl(DdsParticipant& p, BridgeOptions o) : options(std::move(o)), participant(p) {
+    check_jpeg_quality(options.jpeg_quality);
     listen();
+    if (!jpeg_available()) {
+      fmt::print(stderr,
+                 "oscar bridge: images get no foxglove.CompressedImage side channel: this bridge "
+                 "was built without libjpeg (install libjpeg-dev and rebuild)\n");
+    }
     if (!options.allow_config) return;
     config = std::make_unique<ConfigWorker>(participant, kConfigSender);
     if (!net::ip::make_address(options.address).is_loopback()) {
@@ -126,28 +141,32 @@ struct FoxgloveBridge::Impl final : SessionHost {
     if (const auto raw = directory.id_of(topic); raw && wanted[*raw] > 0) {
       deliver(*raw, payload, receive_ns);
     }
-    const auto side = directory.side_of(topic);
-    if (!side) return;
-    const auto& k = known[*side];
+    for (const auto side : directory.sides_of(topic)) convert(side, payload, receive_ns);
+  }
+
+  // One sample for its side channel `side`, if some client subscribes to it.
+  void convert(std::uint32_t side, const Payload& payload, std::uint64_t receive_ns) {
+    const auto& k = known[side];
     if (k.schema_name == kSystemGraphSchema) {
       last_system_state = payload;
-      return send_graph(*side, receive_ns);
+      return send_graph(side, receive_ns);
     }
-    if (wanted[*side] == 0) return;  // the raw channel alone is read: nothing to convert
-    auto& a = activity[*side];
+    if (wanted[side] == 0) return;  // the raw channel alone is read: nothing to convert
+    auto& a = activity[side];
     try {
-      if (auto message = convert_sample(k.source_type, *payload)) {
+      if (auto message = convert_sample(k.source_type, k.schema_name, *payload, conversion)) {
         ++a.converted;
-        deliver(*side,
+        deliver(side,
                 std::make_shared<const std::vector<std::uint8_t>>(message->begin(), message->end()),
                 receive_ns);
       } else {
         ++a.skipped;
       }
-    } catch (const std::runtime_error& e) {
+    } catch (const std::exception& e) {
       ++a.skipped;
-      if (reported_malformed.insert(topic).second) {
-        fmt::print(stderr, "oscar bridge: {} not converted for {}: {}\n", topic, k.topic, e.what());
+      if (reported_malformed.insert(k.topic).second) {
+        fmt::print(stderr, "oscar bridge: {} not converted for {}: {}\n", k.source, k.topic,
+                   e.what());
       }
     }
   }

@@ -4,7 +4,8 @@
 // messages, OMG IDL schema); a topic is read only while some client subscribes to it, and its
 // raw CDR goes to each subscriber as it came, through a bounded per-client queue. Images, poses,
 // robot states and the system state have side channels in Foxglove's schemas (JSON), converted
-// only while subscribed; with `allow_config`, the service oscar/config configures modules.
+// only while subscribed; with
+// `allow_config`, the service oscar/config configures modules.
 
 #include <atomic>
 #include <chrono>
@@ -22,6 +23,7 @@ struct BridgeOptions {
   std::uint16_t port = 8765;          ///< 0: any free port (see FoxgloveBridge::port())
   QueueLimits queue;                  ///< per client
   double image_rate = 0;              ///< images per second and channel to a client (0: all)
+  int jpeg_quality = 80;              ///< foxglove.CompressedImage side channels, 1..100
   std::chrono::milliseconds discovery_period{200};
   std::chrono::milliseconds report_period{1000};  ///< how often drops are reported
   /// Offer the service oscar/config (configuration commands with the coordinator's authority;
@@ -32,6 +34,8 @@ struct BridgeOptions {
 /// @throws std::invalid_argument if `address` is no IP address (checked before anything joins
 ///         the domain).
 void check_listen_address(const std::string& address);
+/// @throws std::invalid_argument naming --jpeg-quality and its range if `quality` is outside it.
+void check_jpeg_quality(int quality);
 
 class FoxgloveBridge {
  public:
