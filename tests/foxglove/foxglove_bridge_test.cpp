@@ -235,6 +235,34 @@ modules:
   EXPECT_TRUE(rates["told"].get<bool>()) << rates;
   throttled.stop();
 
+  // A bridge whose every conversion takes a second more (its test hook): the image side
+  // channels fall to about one message a second, the newer samples skipped and counted, while
+  // the raw Bool channel of the same client goes on at its rate. Conversion on the I/O thread
+  // would hold every raw message up for the encoder (50 Bools a second would become a few).
+  Process slow({test::bin("oscar-bridge"), "foxglove", "-d", domain, "--port", "0",
+                "--test-conversion-delay-ms", "1000"},
+               test::temp_path("slow_conversion_bridge") + ".log");
+  const auto slow_port = served_port(slow);
+  ASSERT_NE(slow_port, 0) << slow.output();
+  std::vector<std::string> slow_args{
+      node,     std::string(OSCAR_FOXGLOVE_TEST_DIR) + "/slow_conversion.js",
+      "--url",  "ws://127.0.0.1:" + std::to_string(slow_port),
+      "--bool", "oscar/cue/sig/out",
+      "--side", "foxglove/cam/out"};
+  if (bridge::jpeg_available()) {
+    slow_args.insert(slow_args.end(), {"--side", "foxglove/cam/out/compressed"});
+  }
+  Process slow_client(slow_args, test::temp_path("slow_conversion_client") + ".log");
+  ASSERT_EQ(slow_client.wait(60s), 0) << slow_client.output();
+  std::cout << "slow conversion: " << slow_client.output();
+  const auto slowed = nlohmann::json::parse(slow_client.output());
+  EXPECT_GE(slowed["bools_per_s"].get<double>(), 40.0) << slowed;
+  EXPECT_LT(slowed["max_bool_gap_ms"].get<double>(), 1000.0) << slowed;
+  EXPECT_GT(slowed["side_per_s"]["foxglove/cam/out"].get<double>(), 0.0) << slowed;
+  EXPECT_LE(slowed["side_per_s"]["foxglove/cam/out"].get<double>(), 1.5) << slowed;
+  EXPECT_GT(slowed["skipped"]["foxglove/cam/out"].get<double>(), 10.0) << slowed;
+  slow.stop();
+
   // The bridge read the topics only while subscribed, and said whom it dropped what for.
   const auto log = bridge.output();
   EXPECT_THAT(log, HasSubstr("subscribes to oscar/cue/sig/out"));

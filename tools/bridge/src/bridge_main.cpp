@@ -54,7 +54,12 @@ int main(int argc, char** argv) {
       "--allow-config", options.allow_config,
       "offer the service oscar/config: Foxglove users may then configure modules with the "
       "coordinator's authority (with a keystore, as the identity operator_boot)");
+  int conversion_delay_ms = 0;  // a test hook (tests/foxglove), hidden from --help
+  foxglove->add_option("--test-conversion-delay-ms", conversion_delay_ms)
+      ->group("")
+      ->check(CLI::Range(0, 10000));
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
+  options.test_conversion_delay = std::chrono::milliseconds(conversion_delay_ms);
   options.queue.bytes = queue_mib << 20;
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);

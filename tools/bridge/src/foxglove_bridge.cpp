@@ -3,6 +3,7 @@
 #include <functional>
 #include <optional>
 #include <set>
+#include <thread>
 
 #include <fmt/format.h>
 #include <boost/asio/io_context.hpp>
@@ -12,6 +13,7 @@
 
 #include "channel_directory.hpp"
 #include "config_service.hpp"
+#include "conversion_worker.hpp"
 #include "jpeg_encoder.hpp"
 #include "oscar/idl_texts.hpp"
 #include "oscar/topics.hpp"
@@ -48,8 +50,8 @@ void check_jpeg_quality(int quality) {
   }
 }
 
-// Everything below runs on the one thread that runs io (Fast DDS threads and the configuration
-// worker only post to it).
+// Everything below runs on the one thread that runs io (Fast DDS threads and the conversion and
+// configuration workers only post to it).
 struct FoxgloveBridge::Impl final : SessionHost {
   // What the bridge knows of a channel it advertised, live or not.
   struct Known {
@@ -76,6 +78,16 @@ struct FoxgloveBridge::Impl final : SessionHost {
   Payload last_system_state;  // while oscar/system/state is read
   Clock::time_point last_graph_sent{};
   std::unique_ptr<ConfigWorker> config;  // with allow_config
+  // Side channel messages are made on the worker's thread; results come back through `io`.
+  ConversionWorker converter{
+      [settings = conversion,
+       delay = options.test_conversion_delay](const ConversionWorker::Job& job) {
+        if (delay.count() > 0) std::this_thread::sleep_for(delay);
+        return convert_sample(job.source_type, job.schema_name, *job.cdr, settings);
+      },
+      [this](ConversionWorker::Result r) {
+        net::post(io, [this, r = std::move(r)] { on_converted(r); });
+      }};
   // Last: deleted first, so no Fast DDS thread posts to `io` once it is gone.
   inspect::RawTap tap{
       participant,
@@ -144,7 +156,8 @@ struct FoxgloveBridge::Impl final : SessionHost {
     for (const auto side : directory.sides_of(topic)) convert(side, payload, receive_ns);
   }
 
-  // One sample for its side channel `side`, if some client subscribes to it.
+  // One sample of `topic` for its side channel `side`, if some client subscribes to it: to the
+  // conversion worker, whose result comes back in on_converted().
   void convert(std::uint32_t side, const Payload& payload, std::uint64_t receive_ns) {
     const auto& k = known[side];
     if (k.schema_name == kSystemGraphSchema) {
@@ -152,21 +165,32 @@ struct FoxgloveBridge::Impl final : SessionHost {
       return send_graph(side, receive_ns);
     }
     if (wanted[side] == 0) return;  // the raw channel alone is read: nothing to convert
-    auto& a = activity[side];
-    try {
-      if (auto message = convert_sample(k.source_type, k.schema_name, *payload, conversion)) {
-        ++a.converted;
-        deliver(side,
-                std::make_shared<const std::vector<std::uint8_t>>(message->begin(), message->end()),
-                receive_ns);
-      } else {
-        ++a.skipped;
+    const bool replaced = converter.submit({.channel = side,
+                                            .source_type = k.source_type,
+                                            .schema_name = k.schema_name,
+                                            .cdr = payload,
+                                            .receive_ns = receive_ns});
+    if (replaced) ++activity[side].skipped;  // a newer sample came before it was converted
+  }
+
+  void on_converted(const ConversionWorker::Result& r) {
+    const auto a = activity.find(r.channel);
+    if (a == activity.end()) return;  // the side channel went meanwhile
+    if (!r.error.empty()) {
+      ++a->second.skipped;
+      if (reported_malformed.insert(a->second.topic).second) {
+        fmt::print(stderr, "oscar bridge: {} not converted for {}: {}\n", a->second.source,
+                   a->second.topic, r.error);
       }
-    } catch (const std::exception& e) {
-      ++a.skipped;
-      if (reported_malformed.insert(k.topic).second) {
-        fmt::print(stderr, "oscar bridge: {} not converted for {}: {}\n", k.source, k.topic,
-                   e.what());
+    } else if (!r.message) {
+      ++a->second.skipped;
+    } else {
+      ++a->second.converted;
+      if (wanted[r.channel] > 0) {
+        deliver(
+            r.channel,
+            std::make_shared<const std::vector<std::uint8_t>>(r.message->begin(), r.message->end()),
+            r.receive_ns);
       }
     }
   }

@@ -4,7 +4,7 @@
 // messages, OMG IDL schema); a topic is read only while some client subscribes to it, and its
 // raw CDR goes to each subscriber as it came, through a bounded per-client queue. Images, poses,
 // robot states and the system state have side channels in Foxglove's schemas (JSON), converted
-// only while subscribed; with
+// only while subscribed, on a thread of their own (newest sample wins per side channel); with
 // `allow_config`, the service oscar/config configures modules.
 
 #include <atomic>
@@ -29,6 +29,9 @@ struct BridgeOptions {
   /// Offer the service oscar/config (configuration commands with the coordinator's authority;
   /// the participant must be allowed to write them, see ToolAuthority::kActAsBoot).
   bool allow_config = false;
+  /// Test hook: each side channel conversion takes at least this long more (0: none), to show
+  /// that a slow encoder delays no raw channel.
+  std::chrono::milliseconds test_conversion_delay{0};
 };
 
 /// @throws std::invalid_argument if `address` is no IP address (checked before anything joins
