@@ -8,7 +8,7 @@ packages=(
   libfastrtps-dev fastddsgen fastdds-tools libssl-dev
   libeigen3-dev libopencv-dev libapriltag-dev libompl-dev libboost-dev libboost-graph-dev
   libgtest-dev libgmock-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
-  nlohmann-json3-dev libexpected-dev libzstd-dev liblz4-dev zlib1g-dev
+  nlohmann-json3-dev libexpected-dev libzstd-dev liblz4-dev zlib1g-dev libjpeg-dev
   graphviz iproute2 procps gdb gdbserver openssh-client openssh-server nodejs npm
   cyclonedds-dev cyclonedds-tools libiceoryx-posh-dev iceoryx
 )

@@ -3,13 +3,14 @@
 // @foxglove/omgidl-serialization (how Foxglove decodes `omgidl` + `cdr` channels).
 //
 //   node bridge_client.js --url ws://127.0.0.1:PORT --config-url ws://127.0.0.1:PORT2
-//        --late oscar-run ARGS...
+//        [--expect-jpeg | --no-jpeg] --late oscar-run ARGS...
 //
 // The system under test publishes oscar::Bool on oscar/cue/sig/out every 20 ms, oscar::GvImage
 // (640 x 480) on oscar/cue/cam/out every 50 ms and robot r7's oscar::RobotState every 100 ms;
 // --url is a bridge started without --allow-config, --config-url one started with it; --late is
 // the command of a module whose topic oscar/cue/late/out appears only when this script starts
-// it. The side channels are checked in bridge_views.js, the services in bridge_services.js.
+// it; --no-jpeg: the bridge was built without libjpeg (no CompressedImage channel). The side
+// channels are checked in bridge_views.js, the services in bridge_services.js.
 // Prints what it measured as JSON and exits 1 if a check failed.
 "use strict";
 const { spawn } = require("child_process");
@@ -197,7 +198,7 @@ async function main() {
         `the Bool messages this client did not get were dropped and reported (${lost} missing, ${told} reported)`);
 
   // 3b. Side channels in Foxglove's schemas, the system graph, converting only when subscribed.
-  await checkSideChannels(a, { check, until, sleep, figures, imageComplete });
+  await checkSideChannels(a, { check, until, sleep, figures, imageComplete, expectJpeg: !process.argv.slice(0, process.argv.indexOf("--late")).includes("--no-jpeg") });
 
   // 4. A topic that appears later is advertised, served, and unadvertised when it goes.
   const child = spawn(lateCommand[0], lateCommand.slice(1), { stdio: "ignore" });

@@ -1,5 +1,5 @@
 // The Foxglove bridge's side channels, checked with Foxglove's own client and published schemas
-// (@foxglove/schemas): images as foxglove.RawImage, robot states as foxglove.SceneUpdate, the
+// (@foxglove/schemas): images as foxglove.RawImage and foxglove.CompressedImage (JPEG), robot states as foxglove.SceneUpdate, the
 // system graph as JSON — each decoded the way Foxglove decodes a `json` channel, from the
 // advertised JSON schema alone (JSON.parse, then every field the schema marks
 // contentEncoding "base64" to bytes). The bridge's schemas for Foxglove's types are its own;
@@ -9,7 +9,7 @@
 const published = require("@foxglove/schemas/jsonschema");
 const { mismatch, undeclared, publishedDrift } = require("./schema_checks");
 
-const CAM = "oscar/cue/cam/out", CAM_SIDE = "foxglove/cam/out";
+const CAM = "oscar/cue/cam/out", CAM_SIDE = "foxglove/cam/out", CAM_JPEG = "foxglove/cam/out/compressed";
 const ROBOT_SIDE = "foxglove/r7/state", GRAPH = "foxglove/system/graph";
 
 // A `json` channel's message as Foxglove reads it, using only its schema.
@@ -49,12 +49,61 @@ function subscribeJson(client, topic) {
   return id;
 }
 
+// What a JPEG file's bytes say of themselves: SOI first, EOI last, and the size and components
+// of its first start-of-frame header (SOF0..SOF2), found by walking the marker segments.
+function jpegFrame(bytes) {
+  const out = { soi: bytes[0] === 0xff && bytes[1] === 0xd8,
+                eoi: bytes[bytes.length - 2] === 0xff && bytes[bytes.length - 1] === 0xd9 };
+  for (let i = 2; i + 9 < bytes.length && bytes[i] === 0xff;) {
+    const marker = bytes[i + 1], length = (bytes[i + 2] << 8) | bytes[i + 3];
+    if (marker >= 0xc0 && marker <= 0xc2) {
+      return { ...out, height: (bytes[i + 5] << 8) | bytes[i + 6], width: (bytes[i + 7] << 8) | bytes[i + 8],
+               components: bytes[i + 9] };
+    }
+    i += 2 + length;
+  }
+  return out;
+}
+
+// foxglove/cam/out/compressed: the camera's images as foxglove.CompressedImage, a JPEG each of
+// the source's size, decoded with the advertised schema alone; converted only while subscribed.
+async function checkCompressedImages(a, { check, until, sleep, figures, lastGraph }) {
+  const c = a.channels.get(CAM_JPEG);
+  if (!check(c, `${CAM_JPEG} is advertised beside its source`)) return;
+  const drift = publishedDrift(JSON.parse(c.schema), published.CompressedImage);
+  check(c.encoding === "json" && c.schemaEncoding === "jsonschema" && c.schemaName === "foxglove.CompressedImage" &&
+        drift.length === 0,
+        `${CAM_JPEG}: json, a jsonschema foxglove.CompressedImage that follows the published one (${c.encoding}, ${c.schemaEncoding}, ${c.schemaName}) ${drift.join("; ")}`);
+  check(sideCounter(lastGraph(), CAM_JPEG) === 0, `before anyone subscribes, no JPEG is made (${sideCounter(lastGraph(), CAM_JPEG)})`);
+  const sub = subscribeJson(a, CAM_JPEG);
+  await until(() => a.received.get(sub).length >= 20, 10000);
+  a.client.unsubscribe(sub);
+  const jpegs = a.received.get(sub);
+  const bad = jpegs.find((m) => {
+    if (!m.msg || m.msg.error || m.msg.format !== "jpeg" || m.msg.frame_id !== "cam" || !(m.msg.data instanceof Uint8Array)) return true;
+    const f = jpegFrame(m.msg.data);
+    return !(f.soi && f.eoi && f.width === 640 && f.height === 480 && f.components === 1);
+  });
+  check(jpegs.length >= 20, `${jpegs.length} CompressedImages (20 Hz source)`);
+  check(jpegs.length > 0 && !bad,
+        "every CompressedImage decodes with only its schema: format jpeg, frame cam, a JPEG from SOI to EOI whose " +
+        "frame header says 640 x 480, one component (the source image's size)" +
+        (bad ? ` (first bad: ${JSON.stringify(bad.msg && { ...bad.msg, data: bad.msg.data && jpegFrame(bad.msg.data) }).slice(0, 200)})` : ""));
+  const sizes = jpegs.map((m) => (m.msg.data || []).length).sort((x, y) => x - y);
+  figures.side_jpegs = { received: jpegs.length, median_bytes: sizes[Math.floor(sizes.length / 2)] };
+  await sleep(1500);
+  const converted = sideCounter(lastGraph(), CAM_JPEG);
+  await sleep(1500);
+  check(converted >= jpegs.length && sideCounter(lastGraph(), CAM_JPEG) === converted,
+        `once unsubscribed, JPEG conversion stops: ${converted} made for the ${jpegs.length} received, ${sideCounter(lastGraph(), CAM_JPEG)} later`);
+}
+
 function sideCounter(graph, topic) {
   const s = ((graph && graph.side_channels) || []).find((x) => x.topic === topic);
   return s ? s.converted : undefined;
 }
 
-async function checkSideChannels(a, { check, until, sleep, figures, imageComplete }) {
+async function checkSideChannels(a, { check, until, sleep, figures, imageComplete, expectJpeg }) {
   await until(() => a.channels.has(CAM_SIDE) && a.channels.has(ROBOT_SIDE) && a.channels.has(GRAPH), 10000);
   for (const [topic, name] of [[CAM_SIDE, "RawImage"], [ROBOT_SIDE, "SceneUpdate"]]) {
     const c = a.channels.get(topic);
@@ -116,6 +165,11 @@ async function checkSideChannels(a, { check, until, sleep, figures, imageComplet
   check(stopped >= images.length && later === stopped && a.received.get(camSub).length > 0,
         `once unsubscribed, conversion stops: ${stopped} converted for the ${images.length} received, ${later} two seconds later, the raw topic still read`);
   a.client.unsubscribe(camSub);
+  if (expectJpeg) {
+    await checkCompressedImages(a, { check, until, sleep, figures, lastGraph });
+  } else {
+    check(!a.channels.has(CAM_JPEG), `a bridge built without libjpeg advertises no ${CAM_JPEG}`);
+  }
 
   // A robot state as a SceneUpdate: the robot as an entity where it stands.
   const sceneSub = subscribeJson(a, ROBOT_SIDE);

@@ -17,6 +17,7 @@
 
 #include "booted_system.hpp"  // tests/integration
 #include "foxglove_messages.hpp"
+#include "jpeg_encoder.hpp"
 #include "json_schemas.hpp"
 
 namespace oscar {
@@ -110,10 +111,19 @@ TEST(FoxgloveBridge, ItsSchemasForFoxglovesTypesFollowThePublishedOnes) {
   p.q({1.0, 0.0, 0.0, 0.0});
   pose.pose(p);
   json messages = {{"foxglove.RawImage", json::array()},
+                   {"foxglove.CompressedImage", json::array()},
                    {"foxglove.PoseInFrame", json::array()},
                    {"foxglove.SceneUpdate", json::array()}};
   messages["foxglove.RawImage"].push_back(json::parse(*bridge::raw_image_json(grey)));
   messages["foxglove.RawImage"].push_back(json::parse(*bridge::raw_image_json(camera)));
+  if (bridge::jpeg_available()) {
+    messages["foxglove.CompressedImage"].push_back(
+        json::parse(*bridge::compressed_image_json(grey, 80)));
+    messages["foxglove.CompressedImage"].push_back(
+        json::parse(*bridge::compressed_image_json(camera, 80)));
+  } else {
+    messages.erase("foxglove.CompressedImage");
+  }
   messages["foxglove.PoseInFrame"].push_back(json::parse(*bridge::pose_in_frame_json(pose)));
   for (const auto& [job, broken] : {std::pair{"j1", false}, {"", false}, {"", true}}) {
     RobotState robot;
@@ -194,9 +204,10 @@ modules:
   // After --late: the command of a module the client starts later (its topic appears then).
   Process client({node, std::string(OSCAR_FOXGLOVE_TEST_DIR) + "/bridge_client.js", "--url",
                   "ws://127.0.0.1:" + std::to_string(port), "--config-url",
-                  "ws://127.0.0.1:" + std::to_string(config_port), "--late", test::bin("oscar-run"),
-                  "--name", "late", "--domain", domain, "-k", "bench_source:late", "-p",
-                  "late.type=Bool", "-m", "continuous:50ms"},
+                  "ws://127.0.0.1:" + std::to_string(config_port),
+                  bridge::jpeg_available() ? "--expect-jpeg" : "--no-jpeg", "--late",
+                  test::bin("oscar-run"), "--name", "late", "--domain", domain, "-k",
+                  "bench_source:late", "-p", "late.type=Bool", "-m", "continuous:50ms"},
                  test::temp_path("bridge_client") + ".log");
   const auto rc = client.wait(240s);
   std::cout << client.output();
@@ -224,6 +235,34 @@ modules:
   EXPECT_TRUE(rates["told"].get<bool>()) << rates;
   throttled.stop();
 
+  // A bridge whose every conversion takes a second more (its test hook): the image side
+  // channels fall to about one message a second, the newer samples skipped and counted, while
+  // the raw Bool channel of the same client goes on at its rate. Conversion on the I/O thread
+  // would hold every raw message up for the encoder (50 Bools a second would become a few).
+  Process slow({test::bin("oscar-bridge"), "foxglove", "-d", domain, "--port", "0",
+                "--test-conversion-delay-ms", "1000"},
+               test::temp_path("slow_conversion_bridge") + ".log");
+  const auto slow_port = served_port(slow);
+  ASSERT_NE(slow_port, 0) << slow.output();
+  std::vector<std::string> slow_args{
+      node,     std::string(OSCAR_FOXGLOVE_TEST_DIR) + "/slow_conversion.js",
+      "--url",  "ws://127.0.0.1:" + std::to_string(slow_port),
+      "--bool", "oscar/cue/sig/out",
+      "--side", "foxglove/cam/out"};
+  if (bridge::jpeg_available()) {
+    slow_args.insert(slow_args.end(), {"--side", "foxglove/cam/out/compressed"});
+  }
+  Process slow_client(slow_args, test::temp_path("slow_conversion_client") + ".log");
+  ASSERT_EQ(slow_client.wait(60s), 0) << slow_client.output();
+  std::cout << "slow conversion: " << slow_client.output();
+  const auto slowed = nlohmann::json::parse(slow_client.output());
+  EXPECT_GE(slowed["bools_per_s"].get<double>(), 40.0) << slowed;
+  EXPECT_LT(slowed["max_bool_gap_ms"].get<double>(), 1000.0) << slowed;
+  EXPECT_GT(slowed["side_per_s"]["foxglove/cam/out"].get<double>(), 0.0) << slowed;
+  EXPECT_LE(slowed["side_per_s"]["foxglove/cam/out"].get<double>(), 1.5) << slowed;
+  EXPECT_GT(slowed["skipped"]["foxglove/cam/out"].get<double>(), 10.0) << slowed;
+  slow.stop();
+
   // The bridge read the topics only while subscribed, and said whom it dropped what for.
   const auto log = bridge.output();
   EXPECT_THAT(log, HasSubstr("subscribes to oscar/cue/sig/out"));
@@ -231,13 +270,18 @@ modules:
                                             "oscar/cue/cam/out"));
   EXPECT_THAT(log, HasSubstr("oscar/cue/late/out is gone"));
   // The image side channel converted only while the client subscribed to it: once.
-  const std::regex converting("bridge: converting oscar/cue/cam/out for foxglove/cam/out");
+  const std::regex converting(
+      "bridge: converting oscar/cue/cam/out for foxglove/cam/out \\(subscribed\\)");
   EXPECT_EQ(std::distance(std::sregex_iterator(log.begin(), log.end(), converting),
                           std::sregex_iterator()),
             1)
       << log;
   EXPECT_THAT(log, ::testing::ContainsRegex(
                        "stopped converting oscar/cue/cam/out for foxglove/cam/out after [1-9]"));
+  if (bridge::jpeg_available()) {
+    EXPECT_THAT(log, ::testing::ContainsRegex("stopped converting oscar/cue/cam/out for "
+                                              "foxglove/cam/out/compressed after [1-9]"));
+  }
   // Malformed calls did not stop the bridge that takes them; the valid one was carried out.
   const auto config_log = config_bridge.output();
   EXPECT_THAT(config_log, HasSubstr("oscar/config robot set-cycle r7 50ms: accepted"));

@@ -1,7 +1,10 @@
 // oscar bench bridge: the delay `oscar bridge foxglove` adds, from the moment a cue is made
 // (its first stamp) to the moment a Foxglove client is delivered it, for Bool and GvImage cues
 // with 1 and 4 clients, and the CPU the bridge costs; beside it `oscar echo` on the same topic,
-// run alternately. Prints a table, or JSON (--json). docs/benchmarks.md, "Foxglove bridge".
+// run alternately. With --side-channels, rows "Bool+img" too: the Bool clients measured while
+// one more client subscribes to a 30 Hz camera's side channels (foxglove.RawImage and
+// foxglove.CompressedImage), whose conversion must not delay the raw Bools. Prints a table, or
+// JSON (--json). docs/benchmarks.md, "Foxglove bridge".
 #include <unistd.h>
 
 #include <atomic>
@@ -98,6 +101,7 @@ int bridge_port(const Process& bridge, std::chrono::seconds limit) {
 struct Figures {
   std::vector<double> delays_us;
   double cpu_pct = 0;
+  std::size_t side_messages = 0;  // received by the side channel client
 };
 
 class Bench {
@@ -108,7 +112,9 @@ class Bench {
         seconds_(seconds),
         dir_(std::move(dir)) {}
 
-  Figures bridge(const std::string& topic, int clients) {
+  // `side_topics`: subscribed by one more client, whose messages are counted, not measured.
+  Figures bridge(const std::string& topic, int clients,
+                 const std::vector<std::string>& side_topics = {}) {
     Process bridge({sibling("oscar-bridge"), "foxglove", "-d", domain_, "--port", "0"},
                    fmt::format("{}/bridge_{}.log", dir_, ++runs_));
     const int port = bridge_port(bridge, 20s);
@@ -118,7 +124,12 @@ class Bench {
     std::vector<oscar::bench::ClientResult> results(static_cast<std::size_t>(clients));
     std::vector<std::thread> threads;
     for (auto& r : results) {
-      threads.emplace_back([&, port] { r = oscar::bench::run_client(port, topic, from, stop); });
+      threads.emplace_back([&, port] { r = oscar::bench::run_client(port, {topic}, from, stop); });
+    }
+    oscar::bench::ClientResult side;
+    if (!side_topics.empty()) {
+      threads.emplace_back(
+          [&, port] { side = oscar::bench::run_client(port, side_topics, from, stop); });
     }
     std::this_thread::sleep_until(from);
     const double cpu0 = cpu_seconds(bridge.pid());
@@ -132,6 +143,9 @@ class Bench {
       if (!r.error.empty()) throw std::runtime_error("a Foxglove client failed: " + r.error);
       f.delays_us.insert(f.delays_us.end(), r.delays_us.begin(), r.delays_us.end());
     }
+    if (!side.error.empty())
+      throw std::runtime_error("the side channel client failed: " + side.error);
+    f.side_messages = side.messages;
     return f;
   }
 
@@ -149,12 +163,13 @@ class Bench {
     return {delays, 0};
   }
 
-  std::unique_ptr<Process> source(const Type& t) {
+  // A module `name` with one bench_source kernel `name`: topic oscar/cue/<name>/out.
+  std::unique_ptr<Process> source(const Type& t, const std::string& name = "src") {
     return std::make_unique<Process>(
-        std::vector<std::string>{sibling("oscar-run"), "--name", "src", "--domain", domain_, "-k",
-                                 "bench_source:src", "-p", "src.type=" + t.name, "-m",
+        std::vector<std::string>{sibling("oscar-run"), "--name", name, "--domain", domain_, "-k",
+                                 "bench_source:" + name, "-p", name + ".type=" + t.name, "-m",
                                  fmt::format("continuous:{}ms", t.period_ms)},
-        dir_ + "/src.log");
+        fmt::format("{}/{}.log", dir_, name));
   }
 
  private:
@@ -172,7 +187,7 @@ int main(int argc, char** argv) {
   std::vector<int> client_counts{1, 4};
   double seconds = 10, warmup = 2;
   int domain = 95, repeat = 1;
-  bool json = false;
+  bool json = false, side_channels = false;
   app.add_option("--types", types, "cue types (Bool: 100 Hz, GvImage: 30 Hz)")->delimiter(',');
   app.add_option("--clients", client_counts, "Foxglove clients at once, per row")
       ->delimiter(',')
@@ -183,6 +198,9 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--domain", domain, "DDS domain for the run")->check(CLI::Range(0, 232));
   app.add_flag("--json", json, "print JSON instead of a table");
+  app.add_flag("--side-channels", side_channels,
+               "also Bool rows while another client subscribes to a 30 Hz GvImage's side "
+               "channels (foxglove.RawImage and foxglove.CompressedImage)");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
 
   const auto dir =
@@ -192,30 +210,42 @@ int main(int argc, char** argv) {
   nlohmann::json rows = nlohmann::json::array();
   if (!json) {
     std::cout << "delays in µs, from the cue's first stamp to its delivery\n"
-              << fmt::format("{:<8} {:>7} {:>11} {:>11} {:>11} {:>11} {:>9} {:>8}\n", "type",
+              << fmt::format("{:<8} {:>7} {:>11} {:>11} {:>11} {:>11} {:>9} {:>8}", "type",
                              "clients", "bridge p50", "bridge p99", "echo p50", "echo p99",
-                             "messages", "CPU %");
+                             "messages", "CPU %")
+              << (side_channels ? "  side msgs/s\n" : "\n");
   }
   try {
-    for (const auto& name : types) {
-      const Type type{name, name == "GvImage" ? 33 : 10};
+    std::vector<std::string> rows_of = types;
+    if (side_channels) rows_of.push_back("Bool+img");
+    for (const auto& name : rows_of) {
+      const bool with_images = name == "Bool+img";
+      const Type type{with_images ? "Bool" : name, name == "GvImage" ? 33 : 10};
       const auto topic = std::string("oscar/cue/src/out");
       auto source = bench.source(type);
+      std::unique_ptr<Process> camera;
+      std::vector<std::string> side_topics;
+      if (with_images) {
+        camera = bench.source({"GvImage", 33}, "cam");
+        side_topics = {"foxglove/cam/out", "foxglove/cam/out/compressed"};
+      }
       std::this_thread::sleep_for(500ms);
       for (const int clients : client_counts) {
         Figures ours, echo;
         for (int i = 1; i <= repeat; ++i) {
           std::cerr << fmt::format("bench bridge: {} with {} client(s), run {}/{}...\n", name,
                                    clients, i, repeat);
-          auto b = bench.bridge(topic, clients);
+          auto b = bench.bridge(topic, clients, side_topics);
           auto e = bench.echo(topic, type.period_ms);
           ours.delays_us.insert(ours.delays_us.end(), b.delays_us.begin(), b.delays_us.end());
           ours.cpu_pct += b.cpu_pct / repeat;
+          ours.side_messages += b.side_messages;
           echo.delays_us.insert(echo.delays_us.end(), e.delays_us.begin(), e.delays_us.end());
         }
         using oscar::test::percentile;
         const double p50 = percentile(ours.delays_us, 0.5), p99 = percentile(ours.delays_us, 0.99);
         const double e50 = percentile(echo.delays_us, 0.5), e99 = percentile(echo.delays_us, 0.99);
+        const double side_per_s = static_cast<double>(ours.side_messages) / (seconds * repeat);
         rows.push_back({{"type", name},
                         {"clients", clients},
                         {"bridge_p50_us", p50},
@@ -224,11 +254,13 @@ int main(int argc, char** argv) {
                         {"echo_p99_us", e99},
                         {"messages", ours.delays_us.size()},
                         {"echo_messages", echo.delays_us.size()},
-                        {"bridge_cpu_pct", ours.cpu_pct}});
+                        {"bridge_cpu_pct", ours.cpu_pct},
+                        {"side_messages_per_s", side_per_s}});
         if (!json) {
           std::cout << fmt::format(
-                           "{:<8} {:>7} {:>11.0f} {:>11.0f} {:>11.0f} {:>11.0f} {:>9} {:>8.1f}\n",
+                           "{:<8} {:>7} {:>11.0f} {:>11.0f} {:>11.0f} {:>11.0f} {:>9} {:>8.1f}",
                            name, clients, p50, p99, e50, e99, ours.delays_us.size(), ours.cpu_pct)
+                    << (side_channels ? fmt::format(" {:>12.1f}\n", side_per_s) : "\n")
                     << std::flush;
         }
       }

@@ -3,6 +3,7 @@
 #include <sys/socket.h>
 #include <sys/time.h>
 
+#include <algorithm>
 #include <cstring>
 
 #include <boost/asio/connect.hpp>
@@ -29,14 +30,17 @@ T little_endian(const std::uint8_t* p) {
   return v;
 }
 
-// The id of the channel advertised for `topic` in an "advertise" message, or -1.
-long channel_of(const std::string& text, const std::string& topic) {
+// The ids of the channels advertised for `topics` in an "advertise" message.
+std::vector<long> channels_of(const std::string& text, const std::vector<std::string>& topics) {
+  std::vector<long> ids;
   const auto j = nlohmann::json::parse(text, nullptr, false);
-  if (!j.is_object() || j.value("op", "") != "advertise") return -1;
+  if (!j.is_object() || j.value("op", "") != "advertise") return ids;
   for (const auto& c : j["channels"]) {
-    if (c.value("topic", "") == topic) return c["id"].get<long>();
+    if (std::find(topics.begin(), topics.end(), c.value("topic", "")) != topics.end()) {
+      ids.push_back(c["id"].get<long>());
+    }
   }
-  return -1;
+  return ids;
 }
 
 }  // namespace
@@ -49,7 +53,7 @@ std::uint64_t first_stamp(const std::uint8_t* cdr, std::size_t size) {
   return little_endian<std::uint64_t>(body + 8);
 }
 
-ClientResult run_client(int port, const std::string& topic,
+ClientResult run_client(int port, const std::vector<std::string>& topics,
                         std::chrono::steady_clock::time_point measure_from,
                         const std::atomic<bool>& stop) {
   ClientResult result;
@@ -64,7 +68,7 @@ ClientResult run_client(int port, const std::string& topic,
       request.set(beast::http::field::sec_websocket_protocol, "foxglove.websocket.v1");
     }));
     ws.handshake("127.0.0.1:" + std::to_string(port), "/");
-    bool subscribed = false;
+    std::size_t subscribed = 0;
     beast::flat_buffer buffer;
     while (!stop) {
       buffer.clear();
@@ -72,21 +76,22 @@ ClientResult run_client(int port, const std::string& topic,
       const auto* data = static_cast<const std::uint8_t*>(buffer.data().data());
       const auto size = buffer.size();
       if (ws.got_text()) {
-        const auto channel =
-            subscribed ? -1 : channel_of(beast::buffers_to_string(buffer.data()), topic);
-        if (channel >= 0) {
+        for (const auto channel : channels_of(beast::buffers_to_string(buffer.data()), topics)) {
+          if (subscribed == topics.size()) break;
           ws.text(true);
-          ws.write(boost::asio::buffer(nlohmann::json{
-              {"op", "subscribe"}, {"subscriptions", {{{"id", 1}, {"channelId", channel}}}}}
-                                           .dump()));
-          subscribed = true;
+          ws.write(boost::asio::buffer(
+              nlohmann::json{{"op", "subscribe"},
+                             {"subscriptions", {{{"id", ++subscribed}, {"channelId", channel}}}}}
+                  .dump()));
         }
         continue;
       }
       const auto now = std::chrono::system_clock::now();
       if (size <= kFrameHeader || data[0] != 0x01) continue;
+      if (std::chrono::steady_clock::now() < measure_from) continue;
+      ++result.messages;
       const auto stamp = first_stamp(data + kFrameHeader, size - kFrameHeader);
-      if (stamp == 0 || std::chrono::steady_clock::now() < measure_from) continue;
+      if (stamp == 0) continue;
       const auto arrival =
           std::chrono::duration_cast<std::chrono::nanoseconds>(now.time_since_epoch()).count();
       result.delays_us.push_back(static_cast<double>(arrival - static_cast<long long>(stamp)) /

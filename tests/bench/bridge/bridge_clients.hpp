@@ -18,13 +18,15 @@ namespace oscar::bench {
 std::uint64_t first_stamp(const std::uint8_t* cdr, std::size_t size);
 
 struct ClientResult {
-  std::vector<double> delays_us;  ///< one per message, arrival minus the cue's first stamp
+  std::vector<double> delays_us;  ///< one per CDR message, arrival minus the cue's first stamp
+  std::size_t messages = 0;       ///< every message after the warm-up (JSON side channels too)
   std::string error;              ///< why the client stopped early, or ""
 };
 
-/// Connects to ws://127.0.0.1:`port`, subscribes to `topic` and records delays until `stop`;
-/// messages before `measure_from` (steady clock) are not counted (the warm-up).
-ClientResult run_client(int port, const std::string& topic,
+/// Connects to ws://127.0.0.1:`port`, subscribes to each of `topics` once advertised and
+/// records delays until `stop`; messages before `measure_from` (steady clock) are not counted
+/// (the warm-up).
+ClientResult run_client(int port, const std::vector<std::string>& topics,
                         std::chrono::steady_clock::time_point measure_from,
                         const std::atomic<bool>& stop);
 

@@ -20,7 +20,8 @@ int main(int argc, char** argv) {
   auto* foxglove = app.add_subcommand(
       "foxglove",
       "a Foxglove WebSocket server (protocol v1): every topic as a channel with its OMG IDL "
-      "schema and raw CDR messages; images, poses, robot states and the system graph also in "
+      "schema and raw CDR messages; images (raw and JPEG), poses, robot states and the system "
+      "graph also in "
       "Foxglove's schemas (JSON)");
   oscar::SystemOptions tool;
   tool.add_to(*foxglove);
@@ -44,16 +45,27 @@ int main(int argc, char** argv) {
                    "per client and image channel: images per second at most (0: every image)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  foxglove
+      ->add_option("--jpeg-quality", options.jpeg_quality,
+                   "JPEG quality of the foxglove.CompressedImage side channels, 1 (smallest) to "
+                   "100 (best)")
+      ->capture_default_str();
   foxglove->add_flag(
       "--allow-config", options.allow_config,
       "offer the service oscar/config: Foxglove users may then configure modules with the "
       "coordinator's authority (with a keystore, as the identity operator_boot)");
+  int conversion_delay_ms = 0;  // a test hook (tests/foxglove), hidden from --help
+  foxglove->add_option("--test-conversion-delay-ms", conversion_delay_ms)
+      ->group("")
+      ->check(CLI::Range(0, 10000));
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
+  options.test_conversion_delay = std::chrono::milliseconds(conversion_delay_ms);
   options.queue.bytes = queue_mib << 20;
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {
     oscar::bridge::check_listen_address(options.address);
+    oscar::bridge::check_jpeg_quality(options.jpeg_quality);
     // Only with --allow-config does the bridge act: otherwise it takes the identity that may
     // only look (docs/security.md).
     auto participant =

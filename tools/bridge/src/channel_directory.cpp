@@ -37,10 +37,10 @@ ChannelDirectory::Change ChannelDirectory::update(
     }
     add({.id = 0, .topic = topic, .schema_name = writer.type, .schema = idl->second}, change);
     if (!side_channel_) continue;
-    if (auto side = side_channel_(topic, writer.type)) {
-      const auto side_topic = side->topic;
-      add(std::move(*side), change);
-      side_by_source_[topic] = live_.at(side_topic).id;
+    for (auto& side : side_channel_(topic, writer.type)) {
+      const auto side_topic = side.topic;
+      add(std::move(side), change);
+      side_by_source_[topic].push_back(live_.at(side_topic).id);
     }
   }
   return change;
@@ -75,9 +75,9 @@ std::optional<std::uint32_t> ChannelDirectory::id_of(const std::string& topic) c
   return it == live_.end() ? std::nullopt : std::optional(it->second.id);
 }
 
-std::optional<std::uint32_t> ChannelDirectory::side_of(const std::string& source) const {
+std::vector<std::uint32_t> ChannelDirectory::sides_of(const std::string& source) const {
   const auto it = side_by_source_.find(source);
-  return it == side_by_source_.end() ? std::nullopt : std::optional(it->second);
+  return it == side_by_source_.end() ? std::vector<std::uint32_t>{} : it->second;
 }
 
 }  // namespace oscar::bridge

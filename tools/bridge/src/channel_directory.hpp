@@ -1,8 +1,8 @@
 #pragma once
 // ChannelDirectory: the bridge's channels, one per topic of the running system that a writer
 // publishes now and whose type has an IDL text; updated from what discovery shows, so a topic
-// that appears is advertised and one whose last writer went is unadvertised. A topic may have a
-// side channel too (side_channels.hpp): it comes and goes with its source.
+// that appears is advertised and one whose last writer went is unadvertised. A topic may have
+// side channels too (side_channels.hpp): they come and go with their source.
 
 #include <cstdint>
 #include <functional>
@@ -19,9 +19,9 @@ namespace oscar::bridge {
 
 class ChannelDirectory {
  public:
-  /// The side channel of a topic of a type, if it has one (side_channel_for()).
+  /// The side channels of a topic of a type, if it has any (side_channels_for()).
   using SideChannelFn =
-      std::function<std::optional<ChannelInfo>(const std::string& topic, const std::string& type)>;
+      std::function<std::vector<ChannelInfo>(const std::string& topic, const std::string& type)>;
 
   /// `idl_texts`: the self-contained IDL text of each type by scoped name (oscar::idl_texts());
   /// `side_channel`: none if empty.
@@ -45,18 +45,18 @@ class ChannelDirectory {
   const ChannelInfo* find(std::uint32_t id) const;
   /// The id of the channel advertised now for `topic`.
   std::optional<std::uint32_t> id_of(const std::string& topic) const;
-  /// The id of the side channel advertised now for the DDS topic `source`.
-  std::optional<std::uint32_t> side_of(const std::string& source) const;
+  /// The ids of the side channels advertised now for the DDS topic `source` (none if none).
+  std::vector<std::uint32_t> sides_of(const std::string& source) const;
 
  private:
   void add(ChannelInfo channel, Change& change);
 
   const std::map<std::string, std::string>& idl_texts_;
   SideChannelFn side_channel_;
-  std::map<std::string, ChannelInfo> live_;              // by topic
-  std::map<std::string, ChannelInfo> known_;             // every channel ever made, by topic
-  std::map<std::string, std::uint32_t> side_by_source_;  // live side channels
-  std::set<std::string> unknown_;                        // topics reported as having no IDL
+  std::map<std::string, ChannelInfo> live_;   // by topic
+  std::map<std::string, ChannelInfo> known_;  // every channel ever made, by topic
+  std::map<std::string, std::vector<std::uint32_t>> side_by_source_;  // live side channels
+  std::set<std::string> unknown_;  // topics reported as having no IDL
   std::uint32_t next_id_ = 1;
 };
 

@@ -3,6 +3,7 @@
 #include <functional>
 #include <optional>
 #include <set>
+#include <thread>
 
 #include <fmt/format.h>
 #include <boost/asio/io_context.hpp>
@@ -12,6 +13,8 @@
 
 #include "channel_directory.hpp"
 #include "config_service.hpp"
+#include "conversion_worker.hpp"
+#include "jpeg_encoder.hpp"
 #include "oscar/idl_texts.hpp"
 #include "oscar/topics.hpp"
 #include "raw_tap.hpp"
@@ -40,8 +43,15 @@ void check_listen_address(const std::string& address) {
   }
 }
 
-// Everything below runs on the one thread that runs io (Fast DDS threads and the configuration
-// worker only post to it).
+void check_jpeg_quality(int quality) {
+  if (quality < kMinJpegQuality || quality > kMaxJpegQuality) {
+    throw std::invalid_argument(fmt::format("--jpeg-quality {}: must be {} (smallest) to {} (best)",
+                                            quality, kMinJpegQuality, kMaxJpegQuality));
+  }
+}
+
+// Everything below runs on the one thread that runs io (Fast DDS threads and the conversion and
+// configuration workers only post to it).
 struct FoxgloveBridge::Impl final : SessionHost {
   // What the bridge knows of a channel it advertised, live or not.
   struct Known {
@@ -57,7 +67,8 @@ struct FoxgloveBridge::Impl final : SessionHost {
   std::string started_ns = std::to_string(inspect::now_ns());  // the session id
   net::io_context io{1};
   tcp::acceptor acceptor{io};
-  ChannelDirectory directory{idl_texts(), side_channel_for};
+  ChannelDirectory directory{idl_texts(), side_channels_for};
+  ConversionSettings conversion{.jpeg_quality = options.jpeg_quality};
   std::set<std::shared_ptr<Session>> sessions;
   std::map<std::uint32_t, int> wanted;   // channel -> subscribers
   std::map<std::string, int> readers;    // DDS topic -> channels wanting it; read while > 0
@@ -67,6 +78,16 @@ struct FoxgloveBridge::Impl final : SessionHost {
   Payload last_system_state;  // while oscar/system/state is read
   Clock::time_point last_graph_sent{};
   std::unique_ptr<ConfigWorker> config;  // with allow_config
+  // Side channel messages are made on the worker's thread; results come back through `io`.
+  ConversionWorker converter{
+      [settings = conversion,
+       delay = options.test_conversion_delay](const ConversionWorker::Job& job) {
+        if (delay.count() > 0) std::this_thread::sleep_for(delay);
+        return convert_sample(job.source_type, job.schema_name, *job.cdr, settings);
+      },
+      [this](ConversionWorker::Result r) {
+        net::post(io, [this, r = std::move(r)] { on_converted(r); });
+      }};
   // Last: deleted first, so no Fast DDS thread posts to `io` once it is gone.
   inspect::RawTap tap{
       participant,
@@ -77,7 +98,13 @@ struct FoxgloveBridge::Impl final : SessionHost {
       }};
 
   Impl(DdsParticipant& p, BridgeOptions o) : options(std::move(o)), participant(p) {
+    check_jpeg_quality(options.jpeg_quality);
     listen();
+    if (!jpeg_available()) {
+      fmt::print(stderr,
+                 "oscar bridge: images get no foxglove.CompressedImage side channel: this bridge "
+                 "was built without libjpeg (install libjpeg-dev and rebuild)\n");
+    }
     if (!options.allow_config) return;
     config = std::make_unique<ConfigWorker>(participant, kConfigSender);
     if (!net::ip::make_address(options.address).is_loopback()) {
@@ -126,28 +153,44 @@ struct FoxgloveBridge::Impl final : SessionHost {
     if (const auto raw = directory.id_of(topic); raw && wanted[*raw] > 0) {
       deliver(*raw, payload, receive_ns);
     }
-    const auto side = directory.side_of(topic);
-    if (!side) return;
-    const auto& k = known[*side];
+    for (const auto side : directory.sides_of(topic)) convert(side, payload, receive_ns);
+  }
+
+  // One sample of `topic` for its side channel `side`, if some client subscribes to it: to the
+  // conversion worker, whose result comes back in on_converted().
+  void convert(std::uint32_t side, const Payload& payload, std::uint64_t receive_ns) {
+    const auto& k = known[side];
     if (k.schema_name == kSystemGraphSchema) {
       last_system_state = payload;
-      return send_graph(*side, receive_ns);
+      return send_graph(side, receive_ns);
     }
-    if (wanted[*side] == 0) return;  // the raw channel alone is read: nothing to convert
-    auto& a = activity[*side];
-    try {
-      if (auto message = convert_sample(k.source_type, *payload)) {
-        ++a.converted;
-        deliver(*side,
-                std::make_shared<const std::vector<std::uint8_t>>(message->begin(), message->end()),
-                receive_ns);
-      } else {
-        ++a.skipped;
+    if (wanted[side] == 0) return;  // the raw channel alone is read: nothing to convert
+    const bool replaced = converter.submit({.channel = side,
+                                            .source_type = k.source_type,
+                                            .schema_name = k.schema_name,
+                                            .cdr = payload,
+                                            .receive_ns = receive_ns});
+    if (replaced) ++activity[side].skipped;  // a newer sample came before it was converted
+  }
+
+  void on_converted(const ConversionWorker::Result& r) {
+    const auto a = activity.find(r.channel);
+    if (a == activity.end()) return;  // the side channel went meanwhile
+    if (!r.error.empty()) {
+      ++a->second.skipped;
+      if (reported_malformed.insert(a->second.topic).second) {
+        fmt::print(stderr, "oscar bridge: {} not converted for {}: {}\n", a->second.source,
+                   a->second.topic, r.error);
       }
-    } catch (const std::runtime_error& e) {
-      ++a.skipped;
-      if (reported_malformed.insert(topic).second) {
-        fmt::print(stderr, "oscar bridge: {} not converted for {}: {}\n", topic, k.topic, e.what());
+    } else if (!r.message) {
+      ++a->second.skipped;
+    } else {
+      ++a->second.converted;
+      if (wanted[r.channel] > 0) {
+        deliver(
+            r.channel,
+            std::make_shared<const std::vector<std::uint8_t>>(r.message->begin(), r.message->end()),
+            r.receive_ns);
       }
     }
   }

@@ -4,7 +4,8 @@
 // messages, OMG IDL schema); a topic is read only while some client subscribes to it, and its
 // raw CDR goes to each subscriber as it came, through a bounded per-client queue. Images, poses,
 // robot states and the system state have side channels in Foxglove's schemas (JSON), converted
-// only while subscribed; with `allow_config`, the service oscar/config configures modules.
+// only while subscribed, on a thread of their own (newest sample wins per side channel); with
+// `allow_config`, the service oscar/config configures modules.
 
 #include <atomic>
 #include <chrono>
@@ -22,16 +23,22 @@ struct BridgeOptions {
   std::uint16_t port = 8765;          ///< 0: any free port (see FoxgloveBridge::port())
   QueueLimits queue;                  ///< per client
   double image_rate = 0;              ///< images per second and channel to a client (0: all)
+  int jpeg_quality = 80;              ///< foxglove.CompressedImage side channels, 1..100
   std::chrono::milliseconds discovery_period{200};
   std::chrono::milliseconds report_period{1000};  ///< how often drops are reported
   /// Offer the service oscar/config (configuration commands with the coordinator's authority;
   /// the participant must be allowed to write them, see ToolAuthority::kActAsBoot).
   bool allow_config = false;
+  /// Test hook: each side channel conversion takes at least this long more (0: none), to show
+  /// that a slow encoder delays no raw channel.
+  std::chrono::milliseconds test_conversion_delay{0};
 };
 
 /// @throws std::invalid_argument if `address` is no IP address (checked before anything joins
 ///         the domain).
 void check_listen_address(const std::string& address);
+/// @throws std::invalid_argument naming --jpeg-quality and its range if `quality` is outside it.
+void check_jpeg_quality(int quality);
 
 class FoxgloveBridge {
  public:

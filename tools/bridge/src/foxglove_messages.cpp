@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "jpeg_encoder.hpp"
+
 namespace oscar::bridge {
 using json = nlohmann::ordered_json;
 
@@ -27,12 +29,14 @@ json yawed_pose(double x, double y, double z, double yaw) {
            {{"x", 0.0}, {"y", 0.0}, {"z", std::sin(yaw / 2)}, {"w", std::cos(yaw / 2)}}}};
 }
 
+bool fills(long width, long height, const std::vector<std::uint8_t>& pixels) {
+  return width > 0 && height > 0 && pixels.size() == static_cast<std::size_t>(width * height);
+}
+
 std::optional<std::string> mono8(const CueHeader& header, std::string frame_id, long width,
                                  long height, const std::string& encoding,
                                  const std::vector<std::uint8_t>& pixels) {
-  if (width <= 0 || height <= 0 || pixels.size() != static_cast<std::size_t>(width * height)) {
-    return std::nullopt;
-  }
+  if (!fills(width, height, pixels)) return std::nullopt;
   return json{{"timestamp", time_of(header)},
               {"frame_id", std::move(frame_id)},
               {"width", width},
@@ -41,6 +45,22 @@ std::optional<std::string> mono8(const CueHeader& header, std::string frame_id, 
               {"step", width},
               {"data", base64(pixels)}}
       .dump();
+}
+
+std::optional<std::string> jpeg(const CueHeader& header, std::string frame_id, long width,
+                                long height, const std::vector<std::uint8_t>& pixels, int quality) {
+  if (!fills(width, height, pixels)) return std::nullopt;
+  return json{{"timestamp", time_of(header)},
+              {"frame_id", std::move(frame_id)},
+              {"format", "jpeg"},
+              {"data", base64(encode_mono8_jpeg(pixels, width, height, quality))}}
+      .dump();
+}
+
+// The producing kernel of a cue: its header's source up to '/'.
+std::string kernel_of(const CueHeader& header) {
+  const auto& source = header.source();
+  return source.substr(0, source.find('/'));
 }
 }  // namespace
 
@@ -65,9 +85,19 @@ std::string base64(std::span<const std::uint8_t> bytes) {
 }
 
 std::optional<std::string> raw_image_json(const GvImage& image) {
-  const auto& source = image.header().source();
-  return mono8(image.header(), source.substr(0, source.find('/')), image.dx(), image.dy(), "mono8",
+  return mono8(image.header(), kernel_of(image.header()), image.dx(), image.dy(), "mono8",
                image.image());
+}
+
+std::optional<std::string> compressed_image_json(const GvImage& image, int quality) {
+  return jpeg(image.header(), kernel_of(image.header()), image.dx(), image.dy(), image.image(),
+              quality);
+}
+
+std::optional<std::string> compressed_image_json(const CameraImage& image, int quality) {
+  if (image.encoding() != "mono8") return std::nullopt;
+  return jpeg(image.header(), image.camera_id(), image.width(), image.height(), image.data(),
+              quality);
 }
 
 std::optional<std::string> raw_image_json(const CameraImage& image) {

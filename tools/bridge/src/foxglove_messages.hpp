@@ -23,6 +23,13 @@ std::optional<std::string> raw_image_json(const GvImage& image);
 /// The same of a camera image (frame_id: its camera_id; encoding as it says, mono8).
 std::optional<std::string> raw_image_json(const CameraImage& image);
 
+/// A foxglove.CompressedImage (format "jpeg", greyscale) of a grey-value image at JPEG
+/// `quality` (1..100); frame_id as its RawImage. nullopt if the pixels do not fill dx x dy.
+/// @throws std::runtime_error if this build has no JPEG encoder (jpeg_available()).
+std::optional<std::string> compressed_image_json(const GvImage& image, int quality);
+/// The same of a mono8 camera image (frame_id: its camera_id).
+std::optional<std::string> compressed_image_json(const CameraImage& image, int quality);
+
 /// A foxglove.PoseInFrame of the fused target pose, frame "world"; nullopt if it is not valid.
 std::optional<std::string> pose_in_frame_json(const LandmarkPose& pose);
 

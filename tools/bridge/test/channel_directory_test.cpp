@@ -1,5 +1,7 @@
 #include "channel_directory.hpp"
 
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
 namespace oscar::bridge {
@@ -54,38 +56,45 @@ TEST(ChannelDirectory, FollowsTopicsThatGoAndComeBack) {
   EXPECT_NE(change.added[0].id, id) << "another type: another channel";
 }
 
-// A side channel for images only, as side_channel_for() makes them.
-std::optional<ChannelInfo> image_side(const std::string& topic, const std::string& type) {
-  if (type != "oscar::GvImage") return std::nullopt;
-  return ChannelInfo{.id = 0,
-                     .topic = "foxglove/" + topic,
-                     .schema_name = "foxglove.RawImage",
-                     .schema = "{}",
-                     .encoding = "json",
-                     .schema_encoding = "jsonschema",
-                     .source = topic};
+// Two side channels for images only, as side_channels_for() makes them.
+std::vector<ChannelInfo> image_side(const std::string& topic, const std::string& type) {
+  if (type != "oscar::GvImage") return {};
+  std::vector<ChannelInfo> out;
+  for (const auto* schema : {"foxglove.RawImage", "foxglove.CompressedImage"}) {
+    out.push_back({.id = 0,
+                   .topic = "foxglove/" + topic + (out.empty() ? "" : "/compressed"),
+                   .schema_name = schema,
+                   .schema = "{}",
+                   .encoding = "json",
+                   .schema_encoding = "jsonschema",
+                   .source = topic});
+  }
+  return out;
 }
 
-TEST(ChannelDirectory, ASideChannelComesAndGoesWithItsSource) {
+TEST(ChannelDirectory, SideChannelsComeAndGoWithTheirSource) {
   ChannelDirectory d(kIdl, image_side);
   auto change = d.update({{"oscar/cue/cam/out", writer("oscar::GvImage")},
                           {"oscar/cue/sig/out", writer("oscar::Bool")}});
-  ASSERT_EQ(change.added.size(), 3u);
+  ASSERT_EQ(change.added.size(), 4u);
   const auto cam = *d.id_of("oscar/cue/cam/out");
-  const auto side = d.side_of("oscar/cue/cam/out");
-  ASSERT_TRUE(side);
-  EXPECT_NE(*side, cam);
-  EXPECT_EQ(d.find(*side)->topic, "foxglove/oscar/cue/cam/out");
-  EXPECT_EQ(d.find(*side)->encoding, "json");
-  EXPECT_FALSE(d.side_of("oscar/cue/sig/out"));
+  const auto sides = d.sides_of("oscar/cue/cam/out");
+  ASSERT_EQ(sides.size(), 2u);
+  EXPECT_NE(sides[0], cam);
+  EXPECT_NE(sides[1], sides[0]);
+  EXPECT_EQ(d.find(sides[0])->topic, "foxglove/oscar/cue/cam/out");
+  EXPECT_EQ(d.find(sides[1])->topic, "foxglove/oscar/cue/cam/out/compressed");
+  EXPECT_EQ(d.find(sides[0])->encoding, "json");
+  EXPECT_TRUE(d.sides_of("oscar/cue/sig/out").empty());
   change = d.update({{"oscar/cue/sig/out", writer("oscar::Bool")}});
-  EXPECT_EQ(change.removed, (std::vector<std::uint32_t>{cam, *side}));
-  EXPECT_FALSE(d.side_of("oscar/cue/cam/out"));
-  EXPECT_EQ(d.find(*side), nullptr);
+  std::sort(change.removed.begin(), change.removed.end());
+  EXPECT_EQ(change.removed, (std::vector<std::uint32_t>{cam, sides[0], sides[1]}));
+  EXPECT_TRUE(d.sides_of("oscar/cue/cam/out").empty());
+  EXPECT_EQ(d.find(sides[0]), nullptr);
   change = d.update({{"oscar/cue/cam/out", writer("oscar::GvImage")},
                      {"oscar/cue/sig/out", writer("oscar::Bool")}});
-  ASSERT_EQ(change.added.size(), 2u);
-  EXPECT_EQ(d.side_of("oscar/cue/cam/out"), side) << "back with its source, under its old id";
+  ASSERT_EQ(change.added.size(), 3u);
+  EXPECT_EQ(d.sides_of("oscar/cue/cam/out"), sides) << "back with their source, under old ids";
 }
 
 }  // namespace
