@@ -92,9 +92,7 @@ class Bench {
                                  const Row& r, bool multicore, int count = 0) {
     if (count == 0) count = count_;
     const auto report = file(name.c_str(), r, multicore);
-    auto common =
-        join({"--type", r.type, "--domain", dom(), "--period-us", std::to_string(r.period_us)},
-             args, {});
+    auto common = join(row_args(r), args, {});
     const std::vector<std::string> sub{"--report", report,
                                        "--expect", std::to_string(count + warmup_),
                                        "--warmup", std::to_string(warmup_)};
@@ -135,8 +133,7 @@ class Bench {
 
   std::optional<Latency> raw_remote(const Row& r, const oscar::bench::RemoteHosts& hosts) {
     const auto report = remote_file("raw", r);
-    const std::vector<std::string> common{"--type", r.type,        "--domain",
-                                          dom(),    "--period-us", std::to_string(r.period_us)};
+    const auto common = row_args(r);
     const std::vector<std::string> sub{"sub",
                                        "--report",
                                        report,
@@ -168,8 +165,7 @@ class Bench {
                                       "--udp-buffer-bytes",
                                       std::to_string(hosts.udp_buffer_bytes())};
     };
-    const std::vector<std::string> common{"--type", r.type,        "--domain",
-                                          dom(),    "--period-us", std::to_string(r.period_us)};
+    const auto common = row_args(r);
     const std::vector<std::string> sub{"sub",
                                        "--report",
                                        report,
@@ -184,6 +180,11 @@ class Bench {
   }
 
  private:
+  // What every program of a row is told: the type, the domain, the publishing period.
+  std::vector<std::string> row_args(const Row& r) {
+    return {"--type", r.type, "--domain", dom(), "--period-us", std::to_string(r.period_us)};
+  }
+
   std::optional<Latency> across(const Row& r, const oscar::bench::RemoteHosts& hosts,
                                 const std::string& report, const std::vector<std::string>& sink,
                                 const std::vector<std::string>& source) {
