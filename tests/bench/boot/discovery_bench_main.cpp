@@ -34,7 +34,8 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
 #include "oscar/raw_cdr_type.hpp"
-#include "process.hpp"  // tests/common: test_domain()
+#include "process.hpp"      // tests/common: test_domain()
+#include "process_cpu.hpp"  // tests/common
 
 namespace {
 namespace dds = eprosima::fastdds::dds;
@@ -148,25 +149,9 @@ class CountingListener final : public dds::DomainParticipantListener {
   _exit(0);
 }
 
-// User and system CPU time of a process so far.
-double cpu_seconds(pid_t pid) {
-  std::ifstream stat(fmt::format("/proc/{}/stat", pid));
-  std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
-  const auto after_name = text.rfind(')');
-  if (after_name == std::string::npos) return 0;
-  std::istringstream fields(text.substr(after_name + 2));
-  std::string field;
-  unsigned long long utime = 0, stime = 0;
-  for (int i = 3; i <= 15 && fields >> field; ++i) {
-    if (i == 14) utime = std::stoull(field);
-    if (i == 15) stime = std::stoull(field);
-  }
-  return static_cast<double>(utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
-}
-
 double cpu_seconds(const std::vector<pid_t>& pids) {
   double sum = 0;
-  for (const auto pid : pids) sum += cpu_seconds(pid);
+  for (const auto pid : pids) sum += oscar::test::cpu_seconds(pid);
   return sum;
 }
 

@@ -24,11 +24,13 @@
 #include <oscar/command_line.hpp>
 
 #include "bridge_clients.hpp"
-#include "percentile.hpp"  // tests/common
-#include "process.hpp"     // tests/common
+#include "percentile.hpp"   // tests/common
+#include "process.hpp"      // tests/common
+#include "process_cpu.hpp"  // tests/common
 
 namespace {
 using namespace std::chrono_literals;
+using oscar::test::cpu_seconds;
 using oscar::test::Process;
 using Clock = std::chrono::steady_clock;
 
@@ -39,18 +41,6 @@ struct Type {
 
 std::string sibling(const std::string& name) {
   return (std::filesystem::read_symlink("/proc/self/exe").parent_path() / name).string();
-}
-
-// User + system CPU seconds of process `pid` so far.
-double cpu_seconds(pid_t pid) {
-  std::ifstream in(fmt::format("/proc/{}/stat", pid));
-  std::string stat((std::istreambuf_iterator<char>(in)), {});
-  std::istringstream fields(stat.substr(stat.rfind(')') + 2));
-  std::string skip;
-  for (int i = 3; i < 14; ++i) fields >> skip;  // fields 3..13
-  double utime = 0, stime = 0;
-  fields >> utime >> stime;
-  return (utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
 }
 
 // "2026-11-26T14:47:55.426430520Z" as ns since the Unix epoch.

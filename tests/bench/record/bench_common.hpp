@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "oscar/cue_types.hpp"
+#include "process_cpu.hpp"  // tests/common
 
 namespace oscar::bench {
 
@@ -48,20 +49,7 @@ inline std::filesystem::path own_dir() {
   return std::filesystem::read_symlink("/proc/self/exe").parent_path();
 }
 
-/// utime + stime of a process in seconds (from /proc/<pid>/stat).
-inline double cpu_seconds(long pid) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
-  std::string line;
-  std::getline(in, line);
-  std::istringstream fields(line.substr(line.rfind(')') + 2));
-  std::string f;
-  unsigned long long utime = 0, stime = 0;
-  for (int i = 3; i <= 15 && fields >> f; ++i) {
-    if (i == 14) utime = std::stoull(f);
-    if (i == 15) stime = std::stoull(f);
-  }
-  return static_cast<double>(utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
-}
+using test::cpu_seconds;  // process_cpu.hpp (tests/common)
 
 inline std::uint64_t wall_ns() {
   return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
