@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include "source_tree.hpp"
 
 namespace {
 namespace fs = std::filesystem;
@@ -18,7 +19,7 @@ std::string read(const fs::path& p) {
 }
 
 TEST(DocSnippets, EveryMarkedCodeBlockMatchesItsSource) {
-  const fs::path root = OSCAR_SOURCE_DIR;
+  const fs::path root = oscar::testing::source_path();
   std::vector<fs::path> docs{root / "README.md"};
   for (const auto& e : fs::directory_iterator(root / "docs")) {
     if (e.path().extension() == ".md") docs.push_back(e.path());

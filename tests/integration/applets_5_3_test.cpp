@@ -14,6 +14,7 @@
 #include "booted_system.hpp"
 #include "oscar/config_client.hpp"
 #include "plan_watch.hpp"
+#include "source_tree.hpp"
 
 namespace oscar {
 namespace {
@@ -22,7 +23,7 @@ using ::testing::HasSubstr;
 using Holders = std::map<std::string, std::string>;  // service -> the plan's holder
 
 std::string system_5_3() {
-  std::ifstream in(std::string(OSCAR_SOURCE_DIR) + "/config/applets-5-3.yaml");
+  std::ifstream in(oscar::testing::source_path("config/applets-5-3.yaml"));
   std::stringstream text;
   text << in.rdbuf();
   return text.str();

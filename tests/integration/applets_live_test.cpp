@@ -13,6 +13,7 @@
 #include "booted_system.hpp"
 #include "oscar/testing/eventually.hpp"
 #include "process.hpp"
+#include "source_tree.hpp"
 
 namespace oscar {
 namespace {
@@ -20,7 +21,7 @@ namespace {
 using ::testing::HasSubstr;
 
 std::string scenario_file(const std::string& name) {
-  return std::string(OSCAR_SOURCE_DIR) + "/coordinator/applets/scenarios/" + name + ".yaml";
+  return oscar::testing::source_path("coordinator/applets/scenarios/") + name + ".yaml";
 }
 
 // The JSON of the runner's output: the progress lines on stderr (which share the log) all come

@@ -15,6 +15,7 @@
 #include "oscar/config_client.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
+#include "source_tree.hpp"
 
 namespace oscar {
 namespace {
@@ -24,7 +25,8 @@ using ::testing::HasSubstr;
 
 // `params`: what the impostor claims to be and tries (by default: the coordinator activating cam).
 std::string system_with_an_impostor(const std::string& params = "target: cam") {
-  return std::string("system: authority\nplugins: ") + OSCAR_TEST_PLUGIN_DIR + R"(
+  return std::string("system: authority\nplugins: ") +
+         oscar::testing::build_path("lib/oscar/test_plugins") + R"(
 modules:
   - name: cam
     kernels: [ { type: framegrabber, name: cam, params: { source: "synthetic:static" } } ]

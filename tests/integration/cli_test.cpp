@@ -6,11 +6,12 @@
 #include <gtest/gtest.h>
 
 #include "process.hpp"  // tests/common
+#include "source_tree.hpp"
 
 namespace oscar {
 namespace {
 using namespace std::chrono_literals;
-using testing::HasSubstr;
+using ::testing::HasSubstr;
 
 const char* const kTools[] = {"oscar-applet",     "oscar-applets",     "oscar-boot",
                               "oscar-config",     "oscar-coordinator", "oscar-discovery-server",
@@ -43,7 +44,7 @@ TEST(CommandLine, EveryToolExitsWith2OnAUsageErrorAndSaysWhatIsWrong) {
     const auto r = run(tool, {"--no-such-option"});
     EXPECT_EQ(r.exit_code, 2) << tool << ":\n" << r.output;
     // CLI11 names the first thing wrong: a missing argument, or else the unknown option.
-    EXPECT_THAT(r.output, testing::ContainsRegex("(is required|--no-such-option)")) << tool;
+    EXPECT_THAT(r.output, ::testing::ContainsRegex("(is required|--no-such-option)")) << tool;
     EXPECT_THAT(r.output, HasSubstr("Run with --help for more information")) << tool;
   }
 }
@@ -64,10 +65,10 @@ TEST(CommandLine, AppletsRunDrawsWithSvgAsWithDot) {
   const auto svg =
       (std::filesystem::temp_directory_path() / ("applets_" + std::to_string(getpid()) + ".svg"))
           .string();
-  const auto r = run(
-      "oscar-applets",
-      {"run", std::string(OSCAR_SOURCE_DIR) + "/coordinator/applets/scenarios/real_world_5_3.yaml",
-       "--svg", svg});
+  const auto r =
+      run("oscar-applets",
+          {"run", oscar::testing::source_path("coordinator/applets/scenarios/real_world_5_3.yaml"),
+           "--svg", svg});
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(std::filesystem::exists(svg + ".dot")) << r.output;
   std::filesystem::remove(svg);
@@ -82,8 +83,7 @@ TEST(CommandLine, AppletsPsSaysSoWhenNoCoordinatorPublishesAPlan) {
 }
 
 TEST(CommandLine, TheCoordinatorRefusesASystemFileWithoutACoordinatorSection) {
-  const auto r =
-      run("oscar-coordinator", {std::string(OSCAR_SOURCE_DIR) + "/config/demo-local.yaml"});
+  const auto r = run("oscar-coordinator", {oscar::testing::source_path("config/demo-local.yaml")});
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_THAT(r.output, HasSubstr("demo-local.yaml: no coordinator: section"));
 }

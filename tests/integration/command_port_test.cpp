@@ -11,12 +11,13 @@
 #include "oscar/dds_participant.hpp"
 #include "oscar/testing/eventually.hpp"
 #include "process.hpp"  // tests/common
+#include "source_tree.hpp"
 
 namespace oscar {
 namespace {
 using namespace std::chrono_literals;
 using test::Process;
-using testing::HasSubstr;
+using ::testing::HasSubstr;
 
 struct Run {
   int exit_code;
@@ -43,8 +44,10 @@ Bool flag(bool value) {
 
 TEST(CommandPortsAcrossProcesses, AModuleProcessAnswersOnItsProcessingThreadBetweenCycles) {
   auto arm = test::run_module(
-      "arm", {"--plugin", OSCAR_TEST_PLUGIN_DIR "/liboscar_kernel_test_commanded.so", "-k",
-              "test_commanded:arm", "-m", "continuous:2ms"});
+      "arm",
+      {"--plugin",
+       oscar::testing::build_path("lib/oscar/test_plugins/liboscar_kernel_test_commanded.so"), "-k",
+       "test_commanded:arm", "-m", "continuous:2ms"});
   DdsParticipant participant(test::test_domain(), "test:coordinator");
   ConfigClient client(participant, "coordinator");
   ASSERT_TRUE(eventually([&] { return client.module_state("arm", 5s).kernels()[0].cycles() > 3; }))

@@ -14,12 +14,13 @@
 #include "oscar/coordinator/plan_json.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
+#include "source_tree.hpp"
 
 namespace oscar::test {
 
 // The example of docs/coordinator.md.
 inline std::string camera_system() {
-  std::ifstream in(std::string(OSCAR_SOURCE_DIR) + "/config/coordinator-camera.yaml");
+  std::ifstream in(oscar::testing::source_path("config/coordinator-camera.yaml"));
   std::stringstream text;
   text << in.rdbuf();
   return text.str();

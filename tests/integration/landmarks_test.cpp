@@ -27,6 +27,7 @@
 #include "oscar/perception_types.hpp"
 #include "oscar/testing/eventually.hpp"
 #include "oscar/topic_io.hpp"
+#include "source_tree.hpp"
 
 namespace oscar {
 namespace {
@@ -35,7 +36,7 @@ namespace dds = eprosima::fastdds::dds;
 
 // The shipped file on the test's domain; `frame_modes` replaces CobraControl's if not empty.
 std::string landmark_system(const std::string& file, const std::string& frame_modes = "") {
-  auto root = YAML::LoadFile(std::string(OSCAR_SOURCE_DIR) + "/config/" + file);
+  auto root = YAML::LoadFile(oscar::testing::source_path("config/") + file);
   root.remove("domain");  // the test's own domain
   // As the other booted-system tests: with the default 300 ms lease this module was declared
   // lost when the test's first configuration command reached it on the loaded test machine.

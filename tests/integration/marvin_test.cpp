@@ -16,6 +16,7 @@
 #include "booted_system.hpp"
 #include "oscar/testing/eventually.hpp"
 #include "plan_watch.hpp"
+#include "source_tree.hpp"
 
 namespace oscar {
 namespace {
@@ -25,7 +26,7 @@ using ::testing::HasSubstr;
 // The shipped system file, ending after `doors` doors, reading each sign for 3 s (long enough
 // for the registry's state to show the phase).
 std::string marvin_system(int doors) {
-  std::ifstream in(std::string(OSCAR_SOURCE_DIR) + "/config/marvin-phases.yaml");
+  std::ifstream in(oscar::testing::source_path("config/marvin-phases.yaml"));
   std::stringstream text;
   text << in.rdbuf();
   auto yaml = text.str();

@@ -17,6 +17,7 @@
 #include "oscar/security_files.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
+#include "source_tree.hpp"
 
 // Fast DDS 2.9's PKI-DH plugin leaks what it allocated through OpenSSL for a handshake with a
 // participant of another CA. Its frames are in libcrypto, whose stacks the fast unwinder cannot
@@ -36,7 +37,8 @@ namespace fs = std::filesystem;
 // `rogue` tries, from inside its module's process and with that module's own credentials, to
 // activate `cam`, as the coordinator would.
 std::string secured_system() {
-  return std::string("system: secure\nlease: 1s\nplugins: ") + OSCAR_TEST_PLUGIN_DIR + R"(
+  return std::string("system: secure\nlease: 1s\nplugins: ") +
+         oscar::testing::build_path("lib/oscar/test_plugins") + R"(
 modules:
   - name: cam
     kernels: [ { type: bench_source, name: cam, params: { type: Bool } } ]
@@ -250,8 +252,8 @@ TEST_F(SecureSystem, AKilledModuleIsRestartedWithItsIdentity) {
 }
 
 TEST(UnsecuredSystem, BootSaysPlainlyThatItIsUnauthenticated) {
-  test::BootedSystem sys("unsecured",
-                         std::string("system: unsecured\nplugins: ") + OSCAR_TEST_PLUGIN_DIR + R"(
+  test::BootedSystem sys("unsecured", std::string("system: unsecured\nplugins: ") +
+                                          oscar::testing::build_path("lib/oscar/test_plugins") + R"(
 modules:
   - name: signal
     kernels: [ { type: bench_source, name: signal, params: { type: Bool } } ]

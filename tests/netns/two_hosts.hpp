@@ -11,6 +11,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "process.hpp"
+#include "source_tree.hpp"
 #include "test_hosts.hpp"
 
 namespace oscar::test {
@@ -23,7 +24,7 @@ struct TwoHostRun {
 
 inline TwoHostRun boot_on_two_hosts(TestHosts& hosts, const std::string& config,
                                     const std::string& name, int seconds) {
-  auto root = YAML::LoadFile(std::string(OSCAR_SOURCE_DIR) + "/config/" + config);
+  auto root = YAML::LoadFile(oscar::testing::source_path("config/") + config);
   root.remove("domain");
   root["lease"] = "1s";
   root["hosts"]["pc1"]["address"] = hosts.address(1);

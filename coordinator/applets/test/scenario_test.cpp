@@ -4,12 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include "source_tree.hpp"
 
 namespace oscar::applets {
 namespace {
 
 std::string scenario_path(const std::string& name) {
-  return std::string(OSCAR_APPLETS_SCENARIO_DIR) + "/" + name;
+  return oscar::testing::source_path("coordinator/applets/scenarios/") + name;
 }
 
 // Seed 000 Abb. 5.4, transcribed: UI service, Pilot, Docking-Controller per step

@@ -25,6 +25,7 @@
 #include "oscar/topic_io.hpp"
 #include "percentile.hpp"  // tests/common
 #include "process.hpp"     // tests/common
+#include "source_tree.hpp"
 #include "test_hosts.hpp"  // tests/netns
 
 namespace {
@@ -158,7 +159,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "oscar bench landmarks: the two-host run %s\n", why.c_str());
       return 2;
     }
-    const std::string dir = OSCAR_SOURCE_DIR "/config/";
+    const std::string dir = oscar::testing::source_path("config/");
     const auto one = run(dir + "landmarks-1host.yaml", width, height, seconds, false);
     const auto two = run(dir + "landmarks-2hosts.yaml", width, height, seconds, true);
     const double p50_1 = percentile(one.ms, 0.5), p50_2 = percentile(two.ms, 0.5);

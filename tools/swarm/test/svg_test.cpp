@@ -11,16 +11,16 @@
 
 #include "oscar/swarm/load.hpp"
 #include "oscar/swarm/problem_runner.hpp"
+#include "source_tree.hpp"
 
 namespace oscar::swarm::tools {
 namespace {
-using testing::HasSubstr;
+using ::testing::HasSubstr;
 
 // A problem planned as oscar swarm plan does (the runner refers to the problem: both live here).
 struct Planned {
   explicit Planned(const std::string& example)
-      : problem(
-            load_problem(std::string(OSCAR_SOURCE_DIR) + "/coordinator/swarm/examples/" + example)),
+      : problem(load_problem(oscar::testing::source_path("coordinator/swarm/examples/") + example)),
         runner(problem) {
     runner.run();
   }
