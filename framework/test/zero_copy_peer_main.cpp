@@ -1,6 +1,7 @@
 // oscar-zero-copy-peer: one end of a zero-copy channel for tests/zero_copy_test.cpp. Prints a
 // line per cue with the chunk's identity (segment, offset, sequence number), so the test can
-// show that the consumer read the producer's chunk and not a copy.
+// show that the consumer read the producer's chunk and not a copy, and the consumer the latency
+// from publish to take (the producer's steady-clock stamp in header.stamps[0]).
 //   oscar-zero-copy-peer pub TYPE TOPIC COUNT PERIOD_MS HOLD_LOANS LINGER(0|1) FIRST_SEQ
 //   oscar-zero-copy-peer sub TYPE TOPIC EXPECT(0 = forever) HOLD
 // TYPE: PlainBool, PlainLineSeg3DSeq or PlainGvImage. A publisher holds HOLD_LOANS chunks unused
@@ -44,12 +45,20 @@ bool check(const oscar::PlainGvImage& cue, std::uint64_t seq) {
          cue.image()[768 * 576 - 1] == static_cast<std::uint8_t>(seq * 7);
 }
 
-void print(const char* what, std::uint64_t seq, const void* payload, bool ok) {
+std::uint64_t steady_ns() {
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                        std::chrono::steady_clock::now().time_since_epoch())
+                                        .count());
+}
+
+void print(const char* what, std::uint64_t seq, const void* payload, bool ok,
+           std::uint64_t latency_ns = 0) {
   const auto id = identify_chunk(payload);
-  std::printf("%s seq=%llu segment=%lld offset=%llu chunk=%llu ok=%d\n", what,
+  std::printf("%s seq=%llu segment=%lld offset=%llu chunk=%llu ok=%d latency_us=%.1f\n", what,
               static_cast<unsigned long long>(seq), id ? static_cast<long long>(id->segment) : -1,
               id ? static_cast<unsigned long long>(id->offset) : 0ULL,
-              id ? static_cast<unsigned long long>(id->sequence) : 0ULL, ok ? 1 : 0);
+              id ? static_cast<unsigned long long>(id->sequence) : 0ULL, ok ? 1 : 0,
+              static_cast<double>(latency_ns) / 1000.0);
   std::fflush(stdout);
 }
 
@@ -81,6 +90,9 @@ int publish(const std::string& topic, long count, long period_ms, long hold_loan
     cue->header().seq(seq);
     fill(*cue, seq);
     print("published", seq, cue.get(), true);
+    // The latency a consumer prints runs from here (steady clock: same host).
+    cue->header().stamps()[0] = steady_ns();
+    cue->header().stamp_count(1);
     publisher.publish(std::move(cue));
     std::this_thread::sleep_for(std::chrono::milliseconds(period_ms));
   }
@@ -99,8 +111,9 @@ int subscribe(const std::string& topic, long expect, long hold) {
   for (long received = 0; expect == 0 || received < expect;) {
     auto cue = subscriber.take(std::chrono::seconds(1));
     if (!cue) continue;
+    const auto latency_ns = steady_ns() - cue->header().stamps()[0];
     const auto seq = cue->header().seq();
-    print("received", seq, cue.get(), check(*cue, seq));
+    print("received", seq, cue.get(), check(*cue, seq), latency_ns);
     ring.push_back(std::move(cue));
     if (static_cast<long>(ring.size()) > hold) ring.pop_front();
     ++received;
