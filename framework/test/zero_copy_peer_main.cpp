@@ -4,6 +4,7 @@
 // from publish to take (the producer's steady-clock stamp in header.stamps[0]).
 //   oscar-zero-copy-peer pub TYPE TOPIC COUNT PERIOD_MS HOLD_LOANS LINGER(0|1) FIRST_SEQ
 //   oscar-zero-copy-peer sub TYPE TOPIC EXPECT(0 = forever) HOLD
+//   oscar-zero-copy-peer config COUNT    (RouDi's configuration: COUNT chunks per plain type)
 // TYPE: PlainBool, PlainLineSeg3DSeq or PlainGvImage. A publisher holds HOLD_LOANS chunks unused
 // (to show they come back when it is killed) and with LINGER stays after its last cue; a
 // subscriber keeps its HOLD newest cues, as an input's ring buffer does.
@@ -18,6 +19,7 @@
 #include "zero_copy/chunk_identity.hpp"
 #include "zero_copy/chunk_publisher.hpp"
 #include "zero_copy/chunk_subscriber.hpp"
+#include "zero_copy/mempools.hpp"
 #include "zero_copy/roudi.hpp"
 
 namespace {
@@ -135,6 +137,12 @@ int run(const std::vector<std::string>& a) {
 
 int main(int argc, char** argv) {
   const std::vector<std::string> a(argv, argv + argc);
+  if (a.size() == 3 && a[1] == "config") {
+    std::printf(
+        "%s",
+        roudi_config(plain_cue_mempools(static_cast<std::uint32_t>(std::stoul(a[2])))).c_str());
+    return 0;
+  }
   if (a.size() < 4) return run<oscar::PlainBool>({"", ""});
   try {
     if (const auto why_not = join_roudi("oscar-zc-" + a[1] + "-" + std::to_string(getpid()))) {

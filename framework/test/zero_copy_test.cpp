@@ -24,6 +24,7 @@
 #include "oscar/cue_types.hpp"
 #include "process.hpp"
 #include "zero_copy/cue_path.hpp"
+#include "zero_copy/mempools.hpp"
 #include "zero_copy/plain_cue.hpp"
 #include "zero_copy/roudi.hpp"
 
@@ -55,13 +56,11 @@ bool eventually(Condition condition, std::chrono::seconds timeout = std::chrono:
 std::string peer() { return oscar::test::bin("oscar-zero-copy-peer"); }
 
 // RouDi in the private namespace, with mempools of `image_chunks` image-sized chunks and
-// plenty of small ones.
-std::unique_ptr<oscar::test::Process> start_roudi(int image_chunks) {
-  std::ofstream("/tmp/roudi.toml")
-      << "[general]\nversion = 1\n\n[[segment]]\n\n"
-      << "[[segment.mempool]]\nsize = 256\ncount = 200\n\n"
-      << "[[segment.mempool]]\nsize = 16384\ncount = 200\n\n"
-      << "[[segment.mempool]]\nsize = 450000\ncount = " << image_chunks << "\n";
+// plenty of the others.
+std::unique_ptr<oscar::test::Process> start_roudi(std::uint32_t image_chunks) {
+  std::ofstream("/tmp/roudi.toml") << roudi_config(
+      {mempool_for<oscar::PlainBool>(200), mempool_for<oscar::PlainLineSeg3DSeq>(200),
+       mempool_for<oscar::PlainGvImage>(image_chunks)});
   auto roudi = std::make_unique<oscar::test::Process>(
       std::vector<std::string>{"/usr/bin/iox-roudi", "-c", "/tmp/roudi.toml", "-l", "info"},
       "/tmp/roudi.log");
@@ -128,6 +127,31 @@ TEST(PlainCues, APlainImageHoldsTheSeedBenchmarksImageInItself) {
   const auto* pixels = reinterpret_cast<const char*>(image.image().data());
   EXPECT_GE(pixels, begin);
   EXPECT_LE(pixels + 442368, begin + sizeof image);
+}
+
+TEST(Mempools, AChunkHoldsTheCueAndIceoryxsHeaderInMultiplesOfEight) {
+  for (const auto& pool : plain_cue_mempools(3)) {
+    EXPECT_EQ(pool.count, 3u);
+    EXPECT_EQ(pool.chunk_bytes % 8, 0u);
+  }
+  const auto image = mempool_for<oscar::PlainGvImage>(1).chunk_bytes;
+  EXPECT_GE(image, sizeof(oscar::PlainGvImage) + 32);  // iceoryx's chunk header: 32 bytes or more
+  EXPECT_LT(image, sizeof(oscar::PlainGvImage) + 256);
+  EXPECT_THROW(chunk_bytes_for(std::size_t{1} << 33, 8), std::invalid_argument);
+}
+
+TEST(Mempools, TheConfigListsPoolsAscendingWithEqualSizesMerged) {
+  EXPECT_EQ(roudi_config({{1024, 2}, {128, 5}, {1024, 3}}),
+            "[general]\nversion = 1\n\n[[segment]]\n"
+            "\n[[segment.mempool]]\nsize = 128\ncount = 5\n"
+            "\n[[segment.mempool]]\nsize = 1024\ncount = 5\n");
+  try {
+    roudi_config({{128, 0}});
+    FAIL() << "a pool without chunks was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("at least one chunk"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(roudi_config({}), std::invalid_argument);
 }
 
 TEST(CuePath, AnUnplainTypeGoesSerializedWithOneLineSayingWhy) {
