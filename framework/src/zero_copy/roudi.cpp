@@ -4,9 +4,11 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <cstring>
-#include <filesystem>
 #include <mutex>
+#include <stdexcept>
 
 #include <fmt/format.h>
 #include <iceoryx_posh/runtime/posh_runtime.hpp>
@@ -52,27 +54,27 @@ bool roudi_running() {
 }
 
 std::optional<std::string> join_roudi(const std::string& name) {
-  static std::mutex mutex;
-  static std::optional<std::optional<std::string>> result;
-  std::lock_guard lock(mutex);
-  if (result) return *result;
-  if (!roudi_running()) {
-    if (!roudi_installed())
-      return fmt::format(
-          "iox-roudi is not installed (Debian package iceoryx) and no RouDi "
-          "listens on {}",
-          roudi_socket());
-    return fmt::format("no RouDi runs on this host (nothing listens on {}; start iox-roudi)",
-                       roudi_socket());
-  }
   if (name.empty() || name.size() > iox::RuntimeName_t::capacity() || name.find('/') != name.npos)
     throw std::invalid_argument(
         fmt::format("zero-copy runtime name '{}': 1 to {} characters without '/'", name,
                     iox::RuntimeName_t::capacity()));
+  static std::mutex mutex;
+  static bool joined = false;
+  std::lock_guard lock(mutex);
+  if (joined) return std::nullopt;
+  if (!roudi_running()) {
+    if (!roudi_installed())
+      return fmt::format(
+          "iox-roudi is not installed (Debian package iceoryx) and no RouDi listens "
+          "on {}",
+          roudi_socket());
+    return fmt::format("no RouDi runs on this host (nothing listens on {}; start iox-roudi)",
+                       roudi_socket());
+  }
   iox::runtime::PoshRuntime::initRuntime(
       iox::RuntimeName_t(iox::cxx::TruncateToCapacity, name.c_str()));
-  result.emplace();
-  return *result;
+  joined = true;
+  return std::nullopt;
 }
 
 }  // namespace oscar::zero_copy
