@@ -4,6 +4,7 @@
 // from publish to take (the producer's steady-clock stamp in header.stamps[0]).
 //   oscar-zero-copy-peer pub TYPE TOPIC COUNT PERIOD_MS HOLD_LOANS LINGER(0|1) FIRST_SEQ
 //   oscar-zero-copy-peer sub TYPE TOPIC EXPECT(0 = forever) HOLD
+//   oscar-zero-copy-peer ring TYPE TOPIC EXPECT DEPTH  (a sub keeping cues in oscar::RingBuffer)
 //   oscar-zero-copy-peer config COUNT    (RouDi's configuration: COUNT chunks per plain type)
 // TYPE: PlainBool, PlainLineSeg3DSeq or PlainGvImage. A publisher holds HOLD_LOANS chunks unused
 // (to show they come back when it is killed) and with LINGER stays after its last cue; a
@@ -16,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "oscar/ring_buffer.hpp"
 #include "zero_copy/chunk_identity.hpp"
 #include "zero_copy/chunk_publisher.hpp"
 #include "zero_copy/chunk_subscriber.hpp"
@@ -123,12 +125,48 @@ int subscribe(const std::string& topic, long expect, long hold) {
   return 0;
 }
 
+// Cues kept in the framework's RingBuffer (as an input keeps them): each entry is the chunk
+// itself; an evicted cue's chunk goes back to RouDi, and held cues stay readable after the
+// subscriber object is gone.
+template <class T>
+int keep_in_ring(const std::string& topic, long expect, long depth) {
+  oscar::RingBuffer ring(static_cast<std::size_t>(depth));
+  {
+    PlainSubscriber<T> subscriber(topic);
+    std::printf("subscribed\n");
+    std::fflush(stdout);
+    for (long received = 0; received < expect;) {
+      auto cue = subscriber.take(std::chrono::seconds(1));
+      if (!cue) continue;
+      const auto seq = cue->header().seq();
+      const void* where = cue.get();
+      ring.push(cue, static_cast<oscar::Stamp>(cue->header().stamps()[0]), 0);
+      const auto latest = ring.latest();
+      print("ringed", seq, latest->cue.get(), latest->cue.get() == where && check(*cue, seq));
+      ++received;
+    }
+  }  // the subscriber object ends here; the ring still holds its newest chunks
+  bool readable = true;
+  for (const auto& entry : ring.latest(ring.depth())) {
+    const auto& cue = *std::static_pointer_cast<const T>(entry.cue);
+    readable = readable && check(cue, cue.header().seq());
+  }
+  std::printf("after the subscriber: %zu cues held, readable=%d\n",
+              ring.latest(ring.depth()).size(), readable ? 1 : 0);
+  ring.clear();
+  std::printf("released\n");
+  std::fflush(stdout);
+  return readable ? 0 : 1;
+}
+
 template <class T>
 int run(const std::vector<std::string>& a) {
   if (a[1] == "pub" && a.size() == 9)
     return publish<T>(a[3], std::stol(a[4]), std::stol(a[5]), std::stol(a[6]), a[7] == "1",
                       std::stol(a[8]));
   if (a[1] == "sub" && a.size() == 6) return subscribe<T>(a[3], std::stol(a[4]), std::stol(a[5]));
+  if (a[1] == "ring" && a.size() == 6)
+    return keep_in_ring<T>(a[3], std::stol(a[4]), std::stol(a[5]));
   std::fprintf(stderr, "usage: see the head of zero_copy_peer_main.cpp\n");
   return 2;
 }

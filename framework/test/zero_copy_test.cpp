@@ -218,6 +218,25 @@ TEST_P(ZeroCopyType, TheConsumerReadsTheProducersChunkInPlace) {
 INSTANTIATE_TEST_SUITE_P(BenchTypes, ZeroCopyType,
                          ::testing::Values("PlainBool", "PlainLineSeg3DSeq", "PlainGvImage"));
 
+TEST_F(ZeroCopy, ARingBufferHoldsTheChunksAndEvictionGivesThemBack) {
+  // 6 image chunks and a ring of 4: without eviction giving chunks back the producer would run
+  // out after a few cues.
+  auto roudi = start_roudi(6);
+  Peer ring({"ring", "PlainGvImage", "cam/image", "40", "4"}, "ring");
+  ASSERT_TRUE(eventually([&] { return ring.printed("subscribed"); })) << ring.process.output();
+  Peer pub({"pub", "PlainGvImage", "cam/image", "40", "10", "0", "0", "1"}, "pub");
+  ASSERT_EQ(pub.process.wait(std::chrono::seconds(60)), 0) << pub.process.output();
+  ASSERT_EQ(ring.process.wait(std::chrono::seconds(60)), 0) << ring.process.output();
+  const auto published = by_seq(pub.lines("published"));
+  const auto ringed = by_seq(ring.lines("ringed"));
+  EXPECT_EQ(ringed.size(), 40u);
+  for (const auto& [seq, where] : ringed) EXPECT_EQ(where, published.at(seq)) << seq;
+  for (const auto& line : ring.lines("ringed")) EXPECT_NE(line.find(" ok=1"), std::string::npos);
+  EXPECT_TRUE(ring.printed("after the subscriber: 4 cues held, readable=1"))
+      << ring.process.output();
+  EXPECT_TRUE(ring.printed("released")) << ring.process.output();
+}
+
 // RouDi frees a killed process's chunks once it stops answering (~1.5 s); its log names it.
 bool roudi_removed(const oscar::test::Process& roudi, pid_t pid) {
   std::istringstream in(roudi.output());
