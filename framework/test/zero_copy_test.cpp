@@ -194,6 +194,16 @@ TEST_F(ZeroCopy, WithoutRouDiAPeerSaysSoInsteadOfWaiting) {
   EXPECT_TRUE(sub.printed("no zero-copy: no RouDi runs on this host")) << sub.process.output();
 }
 
+TEST_F(ZeroCopy, WithoutIoxRoudiInstalledAPeerNamesThePackage) {
+  const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+  ::setenv("PATH", "/nonexistent", 1);  // the peer's search finds no iox-roudi
+  Peer sub({"sub", "PlainBool", "t", "1", "1"}, "sub");
+  ::setenv("PATH", path.c_str(), 1);
+  ASSERT_EQ(sub.process.wait(std::chrono::seconds(30)), 5) << sub.process.output();
+  EXPECT_TRUE(sub.printed("no zero-copy: iox-roudi is not installed (Debian package iceoryx)"))
+      << sub.process.output();
+}
+
 // The consumer's cue is the producer's chunk: the same segment, offset and chunk sequence number
 // in both processes, and its content as written.
 class ZeroCopyType : public ZeroCopy, public ::testing::WithParamInterface<std::string> {};
