@@ -1,0 +1,19 @@
+#include "zero_copy/chunk_identity.hpp"
+
+#include <iceoryx_hoofs/internal/relocatable_pointer/base_relative_pointer.hpp>
+#include <iceoryx_posh/mepoo/chunk_header.hpp>
+
+namespace oscar::zero_copy {
+
+std::optional<ChunkIdentity> identify_chunk(const void* payload) {
+  using iox::rp::BaseRelativePointer;
+  const auto segment = BaseRelativePointer::searchId(const_cast<void*>(payload));
+  if (segment == BaseRelativePointer::NULL_POINTER_ID) return std::nullopt;
+  ChunkIdentity identity;
+  identity.segment = segment;
+  identity.offset = BaseRelativePointer::getOffset(segment, payload);
+  identity.sequence = iox::mepoo::ChunkHeader::fromUserPayload(payload)->sequenceNumber();
+  return identity;
+}
+
+}  // namespace oscar::zero_copy

@@ -1,0 +1,31 @@
+#include "zero_copy/chunk_publisher.hpp"
+
+#include <iceoryx_posh/popo/untyped_publisher.hpp>
+
+#include "zero_copy/service.hpp"
+
+namespace oscar::zero_copy {
+
+struct ChunkPublisher::Impl {
+  explicit Impl(const iox::capro::ServiceDescription& service) : publisher(service) {}
+  iox::popo::UntypedPublisher publisher;
+};
+
+ChunkPublisher::ChunkPublisher(const std::string& topic, const std::string& type_name)
+    : impl_(std::make_unique<Impl>(internal::service_for(topic, type_name))) {}
+
+ChunkPublisher::~ChunkPublisher() = default;
+
+void* ChunkPublisher::loan(std::size_t bytes, std::size_t alignment) {
+  auto chunk = impl_->publisher.loan(static_cast<std::uint32_t>(bytes),
+                                     static_cast<std::uint32_t>(alignment));
+  return chunk.has_error() ? nullptr : chunk.value();
+}
+
+void ChunkPublisher::publish(void* payload) { impl_->publisher.publish(payload); }
+
+void ChunkPublisher::release(void* payload) { impl_->publisher.release(payload); }
+
+bool ChunkPublisher::has_subscribers() const { return impl_->publisher.hasSubscribers(); }
+
+}  // namespace oscar::zero_copy

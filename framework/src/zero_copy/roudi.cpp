@@ -1,0 +1,80 @@
+#include "zero_copy/roudi.hpp"
+
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <iceoryx_posh/runtime/posh_runtime.hpp>
+
+namespace oscar::zero_copy {
+namespace {
+
+// iceoryx 2.0 on Linux: unix datagram sockets under IOX_UDS_SOCKET_PATH_PREFIX, RouDi's named
+// IPC_CHANNEL_ROUDI_NAME.
+std::string roudi_socket() {
+  return std::string(iox::platform::IOX_UDS_SOCKET_PATH_PREFIX) +
+         iox::roudi::IPC_CHANNEL_ROUDI_NAME;
+}
+
+bool roudi_installed() {
+  const char* path = std::getenv("PATH");
+  std::string dirs = path ? path : "/usr/bin:/bin";
+  for (std::size_t start = 0; start <= dirs.size();) {
+    const auto end = std::min(dirs.find(':', start), dirs.size());
+    if (end > start &&
+        ::access((dirs.substr(start, end - start) + "/iox-roudi").c_str(), X_OK) == 0)
+      return true;
+    start = end + 1;
+  }
+  return false;
+}
+
+}  // namespace
+
+bool roudi_running() {
+  const auto path = roudi_socket();
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  if (path.size() >= sizeof(address.sun_path)) return false;
+  std::memcpy(address.sun_path, path.c_str(), path.size() + 1);
+  const int fd = ::socket(AF_UNIX, SOCK_DGRAM, 0);
+  if (fd < 0) return false;
+  // A datagram socket connects only to a bound one: a socket file left by a dead RouDi refuses.
+  const bool listening =
+      ::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) == 0;
+  ::close(fd);
+  return listening;
+}
+
+std::optional<std::string> join_roudi(const std::string& name) {
+  if (name.empty() || name.size() > iox::RuntimeName_t::capacity() || name.find('/') != name.npos)
+    throw std::invalid_argument(
+        fmt::format("zero-copy runtime name '{}': 1 to {} characters without '/'", name,
+                    iox::RuntimeName_t::capacity()));
+  static std::mutex mutex;
+  static bool joined = false;
+  std::lock_guard lock(mutex);
+  if (joined) return std::nullopt;
+  if (!roudi_running()) {
+    if (!roudi_installed())
+      return fmt::format(
+          "iox-roudi is not installed (Debian package iceoryx) and no RouDi listens "
+          "on {}",
+          roudi_socket());
+    return fmt::format("no RouDi runs on this host (nothing listens on {}; start iox-roudi)",
+                       roudi_socket());
+  }
+  iox::runtime::PoshRuntime::initRuntime(
+      iox::RuntimeName_t(iox::cxx::TruncateToCapacity, name.c_str()));
+  joined = true;
+  return std::nullopt;
+}
+
+}  // namespace oscar::zero_copy

@@ -1,0 +1,304 @@
+// The zero-copy path (docs/zero_copy.md): plain types, the path choice with its reasons, and
+// cues across processes through a RouDi of the test's own. Every test process runs in a private
+// mount namespace with its own /dev/shm and /tmp (iceoryx 2.0's names there are fixed:
+// /dev/shm/iceoryx_mgmt, /tmp/roudi), so tests run in parallel and leave no files behind.
+#include <sched.h>
+#include <signal.h>
+#include <sys/mount.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <thread>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
+
+#include "oscar/cue_types.hpp"
+#include "process.hpp"
+#include "zero_copy/cue_path.hpp"
+#include "zero_copy/mempools.hpp"
+#include "zero_copy/plain_cue.hpp"
+#include "zero_copy/roudi.hpp"
+
+namespace oscar::zero_copy {
+namespace {
+
+// Enters the private namespace before main() (and before any thread): empty if that worked,
+// else why not.
+const std::string kNoPrivateShm = [] {
+  if (::unshare(CLONE_NEWNS) != 0) return std::string("unshare(CLONE_NEWNS): ") + strerror(errno);
+  if (::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) != 0)
+    return std::string("making / private: ") + strerror(errno);
+  for (const char* dir : {"/dev/shm", "/tmp"})
+    if (::mount("tmpfs", dir, "tmpfs", 0, "size=256m") != 0)
+      return std::string("tmpfs on ") + dir + ": " + strerror(errno);
+  return std::string();
+}();
+
+template <class Condition>
+bool eventually(Condition condition, std::chrono::seconds timeout = std::chrono::seconds(60)) {
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  while (!condition()) {
+    if (std::chrono::steady_clock::now() > until) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return true;
+}
+
+std::string peer() { return oscar::test::bin("oscar-zero-copy-peer"); }
+
+// RouDi in the private namespace, with mempools of `image_chunks` image-sized chunks and
+// plenty of the others.
+std::unique_ptr<oscar::test::Process> start_roudi(std::uint32_t image_chunks) {
+  std::ofstream("/tmp/roudi.toml") << roudi_config(
+      {mempool_for<oscar::PlainBool>(200), mempool_for<oscar::PlainLineSeg3DSeq>(200),
+       mempool_for<oscar::PlainGvImage>(image_chunks)});
+  auto roudi = std::make_unique<oscar::test::Process>(
+      std::vector<std::string>{"/usr/bin/iox-roudi", "-c", "/tmp/roudi.toml", "-l", "info"},
+      "/tmp/roudi.log");
+  if (!eventually([] { return roudi_running(); }) || roudi->wait(std::chrono::milliseconds(0)))
+    ADD_FAILURE() << "iox-roudi did not come up: " << roudi->output();
+  return roudi;
+}
+
+struct Peer {
+  explicit Peer(std::vector<std::string> args, const std::string& name)
+      : process(
+            [&] {
+              args.insert(args.begin(), peer());
+              return args;
+            }(),
+            "/tmp/" + name + ".log") {}
+  // Lines of the peer's output that start with `what` ("published", "received").
+  std::vector<std::string> lines(const std::string& what) const {
+    std::vector<std::string> out;
+    std::istringstream in(process.output());
+    for (std::string line; std::getline(in, line);)
+      if (line.rfind(what + " ", 0) == 0) out.push_back(line);
+    return out;
+  }
+  bool printed(const std::string& text) const {
+    return process.output().find(text) != std::string::npos;
+  }
+  oscar::test::Process process;
+};
+
+// seq -> "segment=S offset=O": where the cue lay in shared memory (a chunk's sequence number is
+// set when it is published, so the producer cannot print it beforehand).
+std::map<std::string, std::string> by_seq(const std::vector<std::string>& lines) {
+  static const std::regex pattern(R"(^\w+ seq=(\d+) (segment=\d+ offset=\d+) .*$)");
+  std::map<std::string, std::string> out;
+  for (const auto& line : lines) {
+    std::smatch m;
+    if (std::regex_match(line, m, pattern)) out[m[1]] = m[2];
+  }
+  return out;
+}
+
+class ZeroCopy : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!kNoPrivateShm.empty())
+      GTEST_SKIP() << "needs a private mount namespace (root): " << kNoPrivateShm;
+    ASSERT_TRUE(std::filesystem::exists(peer())) << peer() << " is missing (OSCAR_BUILD_DIR?)";
+  }
+};
+
+TEST(PlainCues, FastDdsCallsThePlainTypesPlainAndTheSequenceTypesNot) {
+  EXPECT_TRUE(PlainCueTraits<oscar::PlainBool>::PubSubType().is_plain());
+  EXPECT_TRUE(PlainCueTraits<oscar::PlainLineSeg3DSeq>::PubSubType().is_plain());
+  EXPECT_TRUE(PlainCueTraits<oscar::PlainGvImage>::PubSubType().is_plain());
+  EXPECT_FALSE(oscar::GvImagePubSubType().is_plain());
+  EXPECT_FALSE(oscar::LineSeg3DSeqPubSubType().is_plain());
+  EXPECT_FALSE(oscar::BoolPubSubType().is_plain());  // its header's stamps and source
+}
+
+TEST(PlainCues, APlainImageHoldsTheSeedBenchmarksImageInItself) {
+  oscar::PlainGvImage image;
+  const auto* begin = reinterpret_cast<const char*>(&image);
+  const auto* pixels = reinterpret_cast<const char*>(image.image().data());
+  EXPECT_GE(pixels, begin);
+  EXPECT_LE(pixels + 442368, begin + sizeof image);
+}
+
+TEST(Mempools, AChunkHoldsTheCueAndIceoryxsHeaderInMultiplesOfEight) {
+  for (const auto& pool : plain_cue_mempools(3)) {
+    EXPECT_EQ(pool.count, 3u);
+    EXPECT_EQ(pool.chunk_bytes % 8, 0u);
+  }
+  const auto image = mempool_for<oscar::PlainGvImage>(1).chunk_bytes;
+  EXPECT_GE(image, sizeof(oscar::PlainGvImage) + 32);  // iceoryx's chunk header: 32 bytes or more
+  EXPECT_LT(image, sizeof(oscar::PlainGvImage) + 256);
+  EXPECT_THROW(chunk_bytes_for(std::size_t{1} << 33, 8), std::invalid_argument);
+}
+
+TEST(Mempools, TheConfigListsPoolsAscendingWithEqualSizesMerged) {
+  EXPECT_EQ(roudi_config({{1024, 2}, {128, 5}, {1024, 3}}),
+            "[general]\nversion = 1\n\n[[segment]]\n"
+            "\n[[segment.mempool]]\nsize = 128\ncount = 5\n"
+            "\n[[segment.mempool]]\nsize = 1024\ncount = 5\n");
+  try {
+    roudi_config({{128, 0}});
+    FAIL() << "a pool without chunks was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("at least one chunk"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(roudi_config({}), std::invalid_argument);
+}
+
+TEST(CuePath, AnUnplainTypeGoesSerializedWithOneLineSayingWhy) {
+  register_standard_cue_types();
+  std::ostringstream log;
+  auto previous = spdlog::default_logger();
+  spdlog::set_default_logger(std::make_shared<spdlog::logger>(
+      "zc", std::make_shared<spdlog::sinks::ostream_sink_st>(log)));
+  const auto* image = find_cue_type("oscar::GvImage");
+  ASSERT_NE(image, nullptr);
+  const auto choice = choose_cue_path(connection_facts("cam/image", *image, true));
+  spdlog::set_default_logger(previous);
+  const auto lines = log.str();
+  EXPECT_EQ(choice.path, CuePath::kSerialized);
+  EXPECT_NE(choice.reason.find("oscar::GvImage is not plain"), std::string::npos) << choice.reason;
+  EXPECT_NE(lines.find("cues of cam/image go serialized, not zero-copy: cue type "
+                       "oscar::GvImage is not plain"),
+            std::string::npos)
+      << lines;
+  EXPECT_EQ(std::count(lines.begin(), lines.end(), '\n'), 1) << lines;
+}
+
+TEST(CuePath, EachFactRulesZeroCopyOutWithItsOwnReason) {
+  const ConnectionFacts all{"cam/image", "oscar::PlainGvImage", true, true, true};
+  EXPECT_EQ(choose_cue_path(all).path, CuePath::kZeroCopy);
+  EXPECT_TRUE(choose_cue_path(all).reason.empty());
+  auto remote = all;
+  remote.producer_on_this_host = false;
+  EXPECT_NE(choose_cue_path(remote).reason.find("another host"), std::string::npos);
+  auto no_roudi = all;
+  no_roudi.roudi_running = false;
+  EXPECT_NE(choose_cue_path(no_roudi).reason.find("no RouDi"), std::string::npos);
+  EXPECT_EQ(choose_cue_path(no_roudi).path, CuePath::kSerialized);
+}
+
+TEST_F(ZeroCopy, WithoutRouDiAPeerSaysSoInsteadOfWaiting) {
+  EXPECT_FALSE(roudi_running());
+  Peer sub({"sub", "PlainBool", "t", "1", "1"}, "sub");
+  ASSERT_EQ(sub.process.wait(std::chrono::seconds(30)), 5) << sub.process.output();
+  EXPECT_TRUE(sub.printed("no zero-copy: no RouDi runs on this host")) << sub.process.output();
+}
+
+TEST_F(ZeroCopy, WithoutIoxRoudiInstalledAPeerNamesThePackage) {
+  const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+  ::setenv("PATH", "/nonexistent", 1);  // the peer's search finds no iox-roudi
+  Peer sub({"sub", "PlainBool", "t", "1", "1"}, "sub");
+  ::setenv("PATH", path.c_str(), 1);
+  ASSERT_EQ(sub.process.wait(std::chrono::seconds(30)), 5) << sub.process.output();
+  EXPECT_TRUE(sub.printed("no zero-copy: iox-roudi is not installed (Debian package iceoryx)"))
+      << sub.process.output();
+}
+
+// The consumer's cue is the producer's chunk: the same segment, offset and chunk sequence number
+// in both processes, and its content as written.
+class ZeroCopyType : public ZeroCopy, public ::testing::WithParamInterface<std::string> {};
+
+TEST_P(ZeroCopyType, TheConsumerReadsTheProducersChunkInPlace) {
+  auto roudi = start_roudi(40);
+  Peer sub({"sub", GetParam(), "bench/cue", "20", "16"}, "sub");
+  ASSERT_TRUE(eventually([&] { return sub.printed("subscribed"); })) << sub.process.output();
+  Peer pub({"pub", GetParam(), "bench/cue", "20", "10", "0", "0", "1"}, "pub");
+  ASSERT_EQ(sub.process.wait(std::chrono::seconds(60)), 0) << sub.process.output();
+  ASSERT_EQ(pub.process.wait(std::chrono::seconds(60)), 0) << pub.process.output();
+  const auto published = by_seq(pub.lines("published"));
+  const auto received = by_seq(sub.lines("received"));
+  ASSERT_EQ(received.size(), 20u) << sub.process.output();
+  for (const auto& [seq, where] : received) {
+    ASSERT_TRUE(published.count(seq)) << seq;
+    EXPECT_EQ(where, published.at(seq)) << "cue " << seq << " is not the producer's chunk";
+  }
+  for (const auto& line : sub.lines("received")) EXPECT_NE(line.find(" ok=1"), std::string::npos);
+}
+
+INSTANTIATE_TEST_SUITE_P(BenchTypes, ZeroCopyType,
+                         ::testing::Values("PlainBool", "PlainLineSeg3DSeq", "PlainGvImage"));
+
+TEST_F(ZeroCopy, ARingBufferHoldsTheChunksAndEvictionGivesThemBack) {
+  // 6 image chunks and a ring of 4: without eviction giving chunks back the producer would run
+  // out after a few cues.
+  auto roudi = start_roudi(6);
+  Peer ring({"ring", "PlainGvImage", "cam/image", "40", "4"}, "ring");
+  ASSERT_TRUE(eventually([&] { return ring.printed("subscribed"); })) << ring.process.output();
+  Peer pub({"pub", "PlainGvImage", "cam/image", "40", "10", "0", "0", "1"}, "pub");
+  ASSERT_EQ(pub.process.wait(std::chrono::seconds(60)), 0) << pub.process.output();
+  ASSERT_EQ(ring.process.wait(std::chrono::seconds(60)), 0) << ring.process.output();
+  const auto published = by_seq(pub.lines("published"));
+  const auto ringed = by_seq(ring.lines("ringed"));
+  EXPECT_EQ(ringed.size(), 40u);
+  for (const auto& [seq, where] : ringed) EXPECT_EQ(where, published.at(seq)) << seq;
+  for (const auto& line : ring.lines("ringed")) EXPECT_NE(line.find(" ok=1"), std::string::npos);
+  EXPECT_TRUE(ring.printed("after the subscriber: 4 cues held, readable=1"))
+      << ring.process.output();
+  EXPECT_TRUE(ring.printed("released")) << ring.process.output();
+}
+
+// RouDi frees a killed process's chunks once it stops answering (~1.5 s); its log names it.
+bool roudi_removed(const oscar::test::Process& roudi, pid_t pid) {
+  std::istringstream in(roudi.output());
+  for (std::string line; std::getline(in, line);)
+    if (line.find(fmt::format("-{} ", pid)) != std::string::npos &&
+        line.find("removing") != std::string::npos)
+      return true;
+  return false;
+}
+
+TEST_F(ZeroCopy, AKilledProducersChunksComeBackAndTheConsumerGoesOn) {
+  // 18 image chunks: the killed producer holds 7 loans (iceoryx allows 8 per publisher) and the
+  // consumer 4 of its cues; a second producer could not loan 7 and publish if they never came
+  // back.
+  auto roudi = start_roudi(18);
+  Peer sub({"sub", "PlainGvImage", "cam/image", "0", "4"}, "sub");
+  ASSERT_TRUE(eventually([&] { return sub.printed("subscribed"); })) << sub.process.output();
+  Peer first({"pub", "PlainGvImage", "cam/image", "5", "10", "7", "1", "1"}, "first");
+  ASSERT_TRUE(eventually([&] { return first.printed("done"); })) << first.process.output();
+  ASSERT_TRUE(eventually([&] { return sub.printed("received seq=5 "); })) << sub.process.output();
+  ::kill(first.process.pid(), SIGKILL);
+  first.process.wait(std::chrono::seconds(10));
+  ASSERT_TRUE(eventually([&] { return roudi_removed(*roudi, first.process.pid()); }))
+      << roudi->output();
+  Peer second({"pub", "PlainGvImage", "cam/image", "30", "10", "7", "0", "101"}, "second");
+  ASSERT_EQ(second.process.wait(std::chrono::seconds(60)), 0) << second.process.output();
+  EXPECT_TRUE(eventually([&] { return sub.printed("received seq=130 "); })) << sub.process.output();
+  EXPECT_FALSE(sub.process.wait(std::chrono::milliseconds(0))) << "the consumer ended";
+  for (const auto& line : sub.lines("received"))
+    EXPECT_NE(line.find("ok=1"), std::string::npos) << line;
+}
+
+TEST_F(ZeroCopy, AKilledConsumersChunksComeBackAndTheProducerGoesOn) {
+  // 40 image chunks: the killed consumer holds 16 and had up to 16 queued; a second consumer
+  // holding 16 more would leave the producer none if they never came back.
+  auto roudi = start_roudi(40);
+  Peer first({"sub", "PlainGvImage", "cam/image", "0", "16"}, "first");
+  ASSERT_TRUE(eventually([&] { return first.printed("subscribed"); })) << first.process.output();
+  Peer pub({"pub", "PlainGvImage", "cam/image", "100000", "10", "0", "0", "1"}, "pub");
+  ASSERT_TRUE(eventually([&] { return first.lines("received").size() >= 30; }))
+      << first.process.output();
+  ::kill(first.process.pid(), SIGKILL);
+  first.process.wait(std::chrono::seconds(10));
+  ASSERT_TRUE(eventually([&] { return roudi_removed(*roudi, first.process.pid()); }))
+      << roudi->output();
+  Peer second({"sub", "PlainGvImage", "cam/image", "80", "16"}, "second");
+  ASSERT_EQ(second.process.wait(std::chrono::seconds(60)), 0) << second.process.output();
+  EXPECT_FALSE(pub.process.wait(std::chrono::milliseconds(0))) << pub.process.output();
+  EXPECT_FALSE(pub.printed("loan failed")) << pub.process.output();
+  for (const auto& line : second.lines("received"))
+    EXPECT_NE(line.find("ok=1"), std::string::npos) << line;
+}
+
+}  // namespace
+}  // namespace oscar::zero_copy
