@@ -9,7 +9,14 @@
 
 #include <fastrtps/utils/IPLocator.h>
 
+#include <oscar/configPubSubTypes.h>
 #include "dds/participant_identity.hpp"
+#include "oscar/dds_participant.hpp"
+#include "oscar/discovery_server.hpp"
+#include "oscar/testing/booted_system.hpp"
+#include "oscar/testing/eventually.hpp"
+#include "oscar/topic_io.hpp"
+#include "oscar/topics.hpp"
 
 namespace oscar {
 namespace {
@@ -138,6 +145,61 @@ hosts:
   const auto static_net = NetworkConfig::for_host(YAML::Load("{hosts: {}}"), "");
   EXPECT_EQ(static_net.discovery, Discovery::kStaticPeers);
   EXPECT_TRUE(static_net.discovery_servers.empty());
+}
+
+TEST(DiscoveryServers, AModulesParticipantIsAPlainClientAndOnlyIt) {
+  const auto net = NetworkConfig::from_yaml(YAML::Load("{discovery: server}"));
+  BuiltinAttributes builtin;
+  internal::configure_discovery(builtin, net, 3, internal::ServerClient::kPlain);
+  EXPECT_EQ(builtin.discovery_config.discoveryProtocol, DiscoveryProtocol::CLIENT);
+  EXPECT_EQ(builtin.discovery_config.m_DiscoveryServers.size(), 1u);
+  // Said for the next participant of this thread, taken by it, and gone for the one after.
+  EXPECT_EQ(&internal::next_participant_is(internal::ServerClient::kPlain, net), &net);
+  EXPECT_EQ(internal::take_next_participant_kind(), internal::ServerClient::kPlain);
+  EXPECT_EQ(internal::take_next_participant_kind(), internal::ServerClient::kSuper);
+}
+
+bool sees(const DdsParticipant& p, const std::string& name) {
+  const auto all = p.discovered_participants();
+  return std::find(all.begin(), all.end(), name) != all.end();
+}
+
+// A plain client is told of the participants whose endpoints share a topic with its own, and of
+// no other; a super client (boot, the registry, the tools) of all.
+TEST(DiscoveryServerPlainClients, LearnOnlyOfTheParticipantsTheyShareATopicWith) {
+  using namespace std::chrono_literals;
+  // Two free domains, the lower one used: a discovery server's port (id 119) does not fit in
+  // domain 232's, the first FreeDomain tries.
+  oscar::testing::FreeDomain higher, free;
+  const int domain = free.domain();
+  const auto net = NetworkConfig::from_yaml(YAML::Load("{discovery: server}"));
+  DiscoveryServer server(domain, net, 0);
+  const auto plain = [&](const std::string& name) {
+    return std::make_unique<DdsParticipant>(
+        domain, name, internal::next_participant_is(internal::ServerClient::kPlain, net));
+  };
+  auto producer = plain("producer");
+  auto consumer = plain("consumer");
+  auto stranger = plain("stranger");
+  DdsParticipant tool(domain, "tool", net);
+  TopicWriter<ConfigCommand, ConfigCommandPubSubType> shared_writer(*producer, topics::config("a"));
+  TopicReader<ConfigCommand, ConfigCommandPubSubType> shared_reader(
+      *consumer, topics::config("a"), [](const ConfigCommand&, const auto&) {});
+  TopicWriter<ConfigCommand, ConfigCommandPubSubType> other(*stranger, topics::config("b"));
+  ASSERT_TRUE(eventually(
+      [&] {
+        return sees(tool, "producer") && sees(tool, "consumer") && sees(tool, "stranger") &&
+               shared_reader.matched() > 0;
+      },
+      30s))
+      << "the super client sees everyone, the consumer matches the producer";
+  EXPECT_TRUE(sees(*consumer, "producer"));
+  EXPECT_TRUE(sees(*producer, "consumer"));
+  // The server has gone through what it learned many times over (every 50 ms) by now.
+  std::this_thread::sleep_for(1s);
+  EXPECT_FALSE(sees(*consumer, "stranger")) << "shares no topic with it";
+  EXPECT_FALSE(sees(*stranger, "producer"));
+  EXPECT_FALSE(sees(*stranger, "consumer"));
 }
 
 void expect_refused(const char* yaml, const char* message) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <utility>
 
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
@@ -30,6 +31,9 @@ namespace {
 // How often clients ping their servers until they are matched, and servers go through what
 // they learned (Fast DDS's default: 450 ms).
 const eprosima::fastrtps::Duration_t kServerSyncPeriod(0, 50'000'000);
+
+// next_participant_is(): per thread, so that no other thread's participant takes it.
+thread_local ServerClient next_participant_kind = ServerClient::kSuper;
 
 Locator_t udp_locator(const std::string& address, std::uint32_t port) {
   Locator_t l;
@@ -68,8 +72,17 @@ RemoteServerAttributes remote_server(const std::string& address, int domain, int
   return server;
 }
 
+const NetworkConfig& next_participant_is(ServerClient client, const NetworkConfig& net) {
+  next_participant_kind = client;
+  return net;
+}
+
+ServerClient take_next_participant_kind() {
+  return std::exchange(next_participant_kind, ServerClient::kSuper);
+}
+
 void configure_discovery(eprosima::fastrtps::rtps::BuiltinAttributes& builtin,
-                         const NetworkConfig& net, int domain) {
+                         const NetworkConfig& net, int domain, ServerClient client) {
   auto& discovery = builtin.discovery_config;
   builtin.initialPeersList.clear();
   discovery.m_DiscoveryServers.clear();
@@ -78,10 +91,13 @@ void configure_discovery(eprosima::fastrtps::rtps::BuiltinAttributes& builtin,
       throw std::invalid_argument("network: discovery: server, but no discovery server address");
     }
     // A super client learns of every participant and endpoint, as with static peers (boot, the
-    // registry and the tools need the whole graph; a plain client would only learn of the
-    // participants it shares a topic with), but from the servers alone: nobody announces
-    // itself to every participant id of every host any more.
-    discovery.discoveryProtocol = DiscoveryProtocol::SUPER_CLIENT;
+    // registry and the tools need the whole graph), but from the servers alone: nobody
+    // announces itself to every participant id of every host any more. A plain client learns
+    // only of the participants it shares a topic with, and of their endpoints on those topics:
+    // a module's participant does not parse, match or answer the rest of the system
+    // (docs/network.md, "Discovery: static peers or a discovery server").
+    discovery.discoveryProtocol = client == ServerClient::kPlain ? DiscoveryProtocol::CLIENT
+                                                                 : DiscoveryProtocol::SUPER_CLIENT;
     discovery.discoveryServer_client_syncperiod = kServerSyncPeriod;
     for (std::size_t i = 0; i < net.discovery_servers.size(); ++i) {
       discovery.m_DiscoveryServers.push_back(

@@ -172,8 +172,24 @@ class Module::Dds::CueReader final : public dds::DataReaderListener {
   }
 };
 
+// A plain client, unless an input takes any type: such an input is subscribed once discovery
+// shows a writer of its source, which a plain client learns of only through a reader of the
+// topic, and that needs the type.
+internal::ServerClient Module::Dds::server_client_of(const Module& module) {
+  for (const auto& s : module.slots_) {
+    for (const auto& input : s->instance->ports().inputs) {
+      if (input->takes_any_type()) return internal::ServerClient::kSuper;
+    }
+  }
+  return internal::ServerClient::kPlain;
+}
+
 Module::Dds::Dds(Module& module, int domain)
-    : module_(module), participant_(domain, "oscar:" + module.spec_.name, module.spec_.network) {
+    : module_(module),
+      participant_(domain, "oscar:" + module.spec_.name,
+                   internal::next_participant_is(server_client_of(module), module.spec_.network)),
+      learns_only_shared_topics_(module.spec_.network.discovery == Discovery::kServer &&
+                                 server_client_of(module) == internal::ServerClient::kPlain) {
   // Samples dropped as malformed are reported where the module's other lines go: its console
   // and oscar/log. The logger outlives this (shared), and its DDS sink is detached below.
   set_malformed_sample_log(module.log_);
@@ -249,11 +265,16 @@ std::string Module::Dds::connect_input(InputPort& input, const std::string& sour
   // The reader follows the class the producer declared, which its writer offers: discovery shows
   // it, usually within milliseconds. A producer not seen within the bound gets a reliable,
   // volatile reader, which every reliable writer matches; a best-effort one makes the reader
-  // report an incompatible writer, and follow_producer() replaces it.
+  // report an incompatible writer, and follow_producer() replaces it. A plain client of the
+  // discovery servers learns of the writer only once it reads the topic.
   std::optional<DdsParticipant::DiscoveredWriter> seen;
-  while (!(seen = participant_.discovered_writer(topics::cue(source))) &&
-         std::chrono::steady_clock::now() < until) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  if (learns_only_shared_topics_) {
+    seen = ask_servers_for_producer(input, source, until);
+  } else {
+    while (!(seen = participant_.discovered_writer(topics::cue(source))) &&
+           std::chrono::steady_clock::now() < until) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
   }
   OutputOptions producer;
   if (seen) {
@@ -277,6 +298,25 @@ std::string Module::Dds::connect_input(InputPort& input, const std::string& sour
   }
   return subscribe(input, source, producer, seen ? seen->type : input.type().name, switch_wait,
                    until);
+}
+
+std::optional<DdsParticipant::DiscoveredWriter> Module::Dds::ask_servers_for_producer(
+    InputPort& input, const std::string& source, std::chrono::steady_clock::time_point until) {
+  const auto name = topics::cue(source);
+  if (auto seen = participant_.discovered_writer(name)) return seen;  // e.g. another input's
+  auto& topic = participant_.topic(name, input.type().new_topic_type());
+  // Best effort and volatile: every writer matches it, whatever its class.
+  const auto probe = participant_.subscriber().create_datareader(
+      &topic, qos::cue_reader({.depth = 1, .reliable = false, .transient_local = false}, 1,
+                              Reliability::kBestEffort));
+  if (!probe) throw std::runtime_error("cannot create a reader for " + source);
+  std::optional<DdsParticipant::DiscoveredWriter> seen;
+  while (!(seen = participant_.discovered_writer(name)) &&
+         std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  participant_.subscriber().delete_datareader(probe);
+  return seen;
 }
 
 std::string Module::Dds::subscribe(InputPort& input, const std::string& source,

@@ -19,6 +19,7 @@
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 
 #include "command_rate_limit.hpp"
+#include "dds/discovery.hpp"
 #include "dds/module_wishes.hpp"
 #include "dds/pull.hpp"
 #include "dds/writer_identity.hpp"
@@ -70,6 +71,15 @@ class Module::Dds {
     std::string source;
     OutputOptions offered;
   };
+  /// What the module's participant is to the discovery servers, if it uses them: a plain
+  /// client (docs/network.md), which learns only of what shares a topic with it.
+  static internal::ServerClient server_client_of(const Module& module);
+  /// A plain client of the discovery servers learns of a writer only once it reads the topic:
+  /// makes a reader every writer matches, which makes the servers tell this participant of the
+  /// source's writer, waits for it (at most until `until`) and deletes the reader, which
+  /// delivers nothing. The producer's writer as discovery then shows it, if it does.
+  std::optional<DdsParticipant::DiscoveredWriter> ask_servers_for_producer(
+      InputPort& input, const std::string& source, std::chrono::steady_clock::time_point until);
   std::string subscribe(InputPort& input, const std::string& source, const OutputOptions& producer,
                         const std::string& type,
                         std::optional<std::chrono::milliseconds> switch_wait,
@@ -82,6 +92,9 @@ class Module::Dds {
 
   Module& module_;
   DdsParticipant participant_;
+  /// A plain client of discovery servers: it learns of a producer's writer only by reading the
+  /// producer's topic (ask_servers_for_producer).
+  bool learns_only_shared_topics_ = false;
   std::vector<std::unique_ptr<OutputWriter>> writers_;
   std::vector<std::unique_ptr<internal::DdsPullServer>> pull_servers_;
   std::map<InputPort*, std::shared_ptr<internal::DdsPullSource>> pull_sources_;

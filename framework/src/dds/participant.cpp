@@ -64,7 +64,8 @@ std::vector<std::string> hosted() {
 }
 
 dds::DomainParticipantQos participant_qos(const std::string& name, const NetworkConfig& net,
-                                          int domain, int participant_id) {
+                                          int domain, int participant_id,
+                                          internal::ServerClient client) {
   dds::DomainParticipantQos qos;
   qos.name(name);
   if (const auto modules = hosted(); !modules.empty()) {
@@ -120,7 +121,7 @@ dds::DomainParticipantQos participant_qos(const std::string& name, const Network
     user.push_back(l);
   }
   if (net.shared_memory) user.push_back(internal::unique_shared_memory_locator());
-  internal::configure_discovery(builtin, net, domain);  // static peers or discovery servers
+  internal::configure_discovery(builtin, net, domain, client);  // static peers or servers
   // Leave quickly: a vanished participant must not linger for 20 s. Announced every second, not
   // every 200 ms: each announcement goes to every participant, and booting a hundred modules on
   // two cores, UDP sends were most of their CPU time (perf; docs/network.md).
@@ -377,6 +378,7 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
 
 DdsParticipant::DdsParticipant(int domain, const std::string& name, const NetworkConfig& network)
     : domain_(domain), security_(network.security), listener_(std::make_unique<Listener>()) {
+  const auto client = internal::take_next_participant_kind();  // first: this one takes it
   if (network.interfaces.empty()) throw std::invalid_argument("network: no interface given");
   auto* factory = dds::DomainParticipantFactory::get_instance();
   dds_log_level_from_env();
@@ -388,8 +390,8 @@ DdsParticipant::DdsParticipant(int domain, const std::string& name, const Networ
   for (int id = 0; id < ids && !participant_; ++id) {
     auto claim = std::make_unique<internal::ParticipantIdClaim>(domain, address, id);
     if (!*claim || !udp_port_free(address, metatraffic_unicast_port(domain, id))) continue;
-    participant_ = factory->create_participant(domain, participant_qos(name, network, domain, id),
-                                               listener_.get(), mask);
+    participant_ = factory->create_participant(
+        domain, participant_qos(name, network, domain, id, client), listener_.get(), mask);
     if (participant_) {
       claim->record(participant_->guid().guidPrefix);
       id_claim_ = std::move(claim);
