@@ -11,6 +11,7 @@
 #include "oscar/time.hpp"
 #include "registry_io.hpp"
 #include "registry_tracked.hpp"
+#include "start_order.hpp"
 
 namespace oscar {
 namespace {
@@ -35,6 +36,10 @@ Registry::Registry(const SystemSpec& system, DdsParticipant& participant, std::s
     t->spec = &m;
     t->status = m.standby ? "standby" : "waiting";
     modules_.push_back(std::move(t));
+  }
+  const auto first = internal::producers_launched_first(system_);
+  for (std::size_t i = 0; i < modules_.size(); ++i) {
+    for (auto p : first[i]) modules_[i]->launched_after.push_back(modules_[p].get());
   }
   if (recovering_) read_journal();
   io_ = std::make_unique<Io>(*this);

@@ -40,8 +40,9 @@ void Registry::launch(Tracked& m, unsigned incarnation) {
                incarnation);
 }
 
-// Launches what is due: at boot every module whose monitor is up, later the restarts whose
-// backoff has passed (once the failed process is gone and its host's monitor answers).
+// Launches what is due: at boot every module whose monitor is up, producers before their
+// consumers, later the restarts whose backoff has passed (once the failed process is gone and
+// its host's monitor answers).
 void Registry::tick() {
   const auto now = Clock::now();
   std::map<std::string, int> starting;  // per host
@@ -52,7 +53,9 @@ void Registry::tick() {
     const auto& mon = monitors_[m->spec->spec.host];
     if (!mon.alive) continue;
     if (m->status == "waiting") {
-      if (starting[m->spec->spec.host] >= kStartingPerHost || !may_start_on(m->spec->spec.host)) {
+      if (starting[m->spec->spec.host] >= kStartingPerHost || !may_start_on(m->spec->spec.host) ||
+          std::any_of(m->launched_after.begin(), m->launched_after.end(),
+                      [](const Tracked* p) { return p->status == "waiting"; })) {
         continue;
       }
       ++starting[m->spec->spec.host];

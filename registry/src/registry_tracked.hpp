@@ -2,6 +2,7 @@
 // The registry's record of one module (internal to Registry).
 
 #include <string>
+#include <vector>
 
 #include "oscar/registry/registry.hpp"
 #include "registry_journal.hpp"
@@ -12,6 +13,8 @@ namespace oscar {
 
 struct Registry::Tracked {
   const SystemModule* spec = nullptr;
+  // At boot it is launched only once these (the producers of its inputs) were: see start_order.hpp.
+  std::vector<const Tracked*> launched_after;
   // waiting | starting | running | failed | restarting | replaced | standby | stopped
   std::string status;
   unsigned incarnation = 0;  // 0: never started

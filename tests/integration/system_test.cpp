@@ -2,6 +2,9 @@
 #include <signal.h>
 
 #include <algorithm>
+#include <fstream>
+#include <iterator>
+#include <string>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -88,6 +91,28 @@ modules:
     mode: single_step
     restart: { policy: auto, max: 3, backoff: 50ms }
 )";
+
+// A consumer started with or before its producer waits in connect_input for the producer's
+// writer (up to 2 s per input): the registry launches producers first, whatever the file's order.
+TEST(Boot, AConsumerListedBeforeItsProducerIsLaunchedAfterIt) {
+  BootedSystem sys("consumer_first", R"(
+system: consumer_first
+modules:
+  - name: sink
+    kernels: [ { type: bench_sink, name: sink, params: { type: Bool }, inputs: { in: src/out } } ]
+    mode: single_step
+  - name: src
+    kernels: [ { type: bench_source, name: src, params: { type: Bool } } ]
+    mode: { continuous: 20ms }
+)");
+  sys.running();
+  std::ifstream in(sys.log_dir() + "/registry.log");
+  const std::string log((std::istreambuf_iterator<char>(in)), {});
+  const auto src = log.find("starting 'src'"), sink = log.find("starting 'sink'");
+  ASSERT_NE(src, std::string::npos) << log;
+  ASSERT_NE(sink, std::string::npos) << log;
+  EXPECT_LT(src, sink) << "the sink was launched before its producer:\n" << log;
+}
 
 TEST(Registry, KillNineRestartsTheModuleWithItsConfigurationAndWiring) {
   BootedSystem sys("kill9", kRestartable);
