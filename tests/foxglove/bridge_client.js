@@ -64,6 +64,9 @@ class Client {
     this.errors = [];
     this.services = new Map();  // name -> service
     this.client.on("advertiseServices", (services) => { for (const s of services) this.services.set(s.name, s); });
+    this.client.on("unadvertiseServices", (ids) => {
+      for (const [name, s] of this.services) if (ids.includes(s.id)) this.services.delete(name);
+    });
     this.client.on("serverInfo", (info) => { this.serverInfo = info; });
     this.client.on("advertise", (channels) => {
       for (const c of channels) { this.channels.set(c.topic, c); this.unadvertised.delete(c.id); }

@@ -123,7 +123,74 @@ async function checkServices(a, configUrl, { check, until, sleep, Client, figure
         `the module publishes its new cycle: r7 ${cycleBefore} ms before, ${cycleAfter} ms after`);
   check(robotAfter > 1.6 * robotBefore,
         `and behaves so: r7's states ${robotBefore.toFixed(1)} Hz before, ${robotAfter.toFixed(1)} Hz after`);
+  await checkCommandServices(c, { check, until, robotSub, callId: 2000, figures });
   c.close();
+}
+
+const parse = (r) => { try { return JSON.parse(Buffer.from(r.response.data).toString("utf8")); } catch (e) { return { error: String(e) }; } };
+const said = (r) => (r.failure ? r.failure.message : r.response ? Buffer.from(r.response.data).toString("utf8") : JSON.stringify(r));
+
+// Kernel command ports as services: robot r7 (robot_sim) declares propose, commit, abort and
+// committed; the other kernels of the system declare none. A proposal and its commit, sent from
+// Foxglove's client, make r7 drive half a metre (seen in its published state); wrong arguments
+// and a commit the kernel refuses fail with the reason.
+async function checkCommandServices(c, { check, until, robotSub, callId, figures }) {
+  const R7 = ["abort", "commit", "committed", "propose"].map((n) => `oscar/robot/r7/${n}`);
+  await until(() => R7.every((n) => c.services.has(n)), 10000);
+  const offered = [...c.services.keys()].filter((n) => n !== "oscar/config").sort();
+  check(JSON.stringify(offered) === JSON.stringify(R7),
+        `the command ports of r7 are services, no other kernel declares any: ${offered.join(", ")}`);
+  const propose = c.services.get(R7[3]), commit = c.services.get(R7[1]);
+  if (!propose || !commit) return;
+  const schema = JSON.parse(propose.request.schema);
+  const waypoint = (((schema.properties || {}).sections || {}).items || {}).properties;
+  check(propose.type === "oscar::Trajectory" && propose.request.encoding === "json" &&
+        propose.request.schemaEncoding === "jsonschema" && schema.title === "oscar::Trajectory" &&
+        waypoint && waypoint.waypoints.items.properties.t_ns.pattern === "^-?[0-9]+$" &&
+        JSON.parse(commit.response.schema).title === "oscar.CommandResponse",
+        `propose is advertised with a JSON schema of oscar::Trajectory's members, commit answers oscar.CommandResponse`);
+
+  // Errors, each a call failure with the reason and an error status.
+  const wrong = [
+    ["a value of the wrong type", commit, { robot: "r7", transaction: "seven" }, /oscar\/robot\/r7\/commit: wrong arguments: transaction: 'seven' is no unsigned long long/],
+    ["a member the request type lacks", commit, { robot: "r7", tx: 7 }, /wrong arguments: oscar::TransactionDecision has no member 'tx'/],
+    ["a commit the kernel refuses", commit, { robot: "r7", transaction: 9 }, /robot command r7 commit: .*refused by kernel 'r7': no proposal of transaction 9 is pending/],
+  ];
+  for (const [what, service, payload, expected] of wrong) {
+    const n = c.statuses.length;
+    const r = await call(c, service.id, ++callId, payload);
+    const s = await errorStatusSince(c, n, until);
+    check(r.failure && expected.test(r.failure.message) && s, `${what}: ${said(r)}`);
+  }
+
+  // From 1.5 s on, half a metre along x in 1 s, then stand there.
+  const states = c.received.get(robotSub);
+  const last = states[states.length - 1].msg;
+  const x0 = last.x, y0 = last.y;
+  const from = BigInt(Date.now()) * 1000000n + 1500000000n, to = from + 1000000000n;
+  const proposal = {
+    robot: "r7", transaction: "7",
+    sections: [{ from_ns: from.toString(), open_end: true,
+                 waypoints: [{ x: x0, y: y0, t_ns: from.toString() }, { x: x0 + 0.5, y: y0, t_ns: to.toString() }] }],
+  };
+  const proposed = await call(c, propose.id, ++callId, proposal);
+  const ack = proposed.response ? parse(proposed) : {};
+  check(proposed.response && ack.module === "robot" && ack.kernel === "r7" && ack.command === "propose" &&
+        /^transaction 7 pending: 1 section\(s\)/.test(ack.answer), `propose is acknowledged: ${said(proposed)}`);
+  const committed = await call(c, commit.id, ++callId, { robot: "r7", transaction: 7 });
+  check(committed.response && /^transaction 7 committed/.test(parse(committed).answer), `commit is accepted: ${said(committed)}`);
+  const sent = states.length;
+  const arrived = () => {
+    const m = states[states.length - 1].msg;
+    return Math.abs(m.x - (x0 + 0.5)) < 1e-3 && Math.abs(m.y - y0) < 1e-3;
+  };
+  await until(arrived, 8000);
+  const end = states[states.length - 1].msg;
+  // While it drives, its state names the transaction (standing at the end, none).
+  const driving = states.slice(sent).filter((m) => Number(m.msg.transaction) === 7 && m.msg.speed > 0);
+  figures.r7_driven = { from: [x0, y0], to: [end.x, end.y], states_in_transaction_7: driving.length };
+  check(arrived() && driving.length > 0,
+        `and r7 drives there: from (${x0}, ${y0}) to (${end.x}, ${end.y}), ${driving.length} states moving in transaction 7`);
 }
 
 module.exports = { checkServices };

@@ -263,6 +263,34 @@ modules:
   EXPECT_GT(slowed["skipped"]["foxglove/cam/out"].get<double>(), 10.0) << slowed;
   slow.stop();
 
+  // The command services follow their module: killed, its services go; restarted by the
+  // registry, they come back under the same ids.
+  const auto logged = [&](const std::string& text, int times) {
+    for (int i = 0; i < 600; ++i) {
+      const auto out = config_bridge.output();
+      int n = 0;
+      for (auto at = out.find(text); at != std::string::npos; at = out.find(text, at + 1)) ++n;
+      if (n >= times) return true;
+      std::this_thread::sleep_for(50ms);
+    }
+    return false;
+  };
+  const auto robot_running = system.wait_for([](const SystemState& s) {
+    const auto* m = test::entry(s, "robot");
+    return m && m->status() == "running";
+  });
+  const auto* robot = test::entry(robot_running, "robot");
+  ASSERT_NE(robot, nullptr);
+  const auto incarnation = robot->incarnation();
+  ASSERT_EQ(::kill(static_cast<pid_t>(robot->pid()), SIGKILL), 0);
+  EXPECT_TRUE(logged("service 2 oscar/robot/r7/propose is gone", 1)) << config_bridge.output();
+  system.wait_for([&](const SystemState& s) {
+    const auto* m = test::entry(s, "robot");
+    return m && m->incarnation() > incarnation && m->status() == "running";
+  });
+  EXPECT_TRUE(logged("service 2 oscar/robot/r7/propose (oscar::Trajectory)", 2))
+      << config_bridge.output();
+
   // The bridge read the topics only while subscribed, and said whom it dropped what for.
   const auto log = bridge.output();
   EXPECT_THAT(log, HasSubstr("subscribes to oscar/cue/sig/out"));
@@ -285,6 +313,7 @@ modules:
   // Malformed calls did not stop the bridge that takes them; the valid one was carried out.
   const auto config_log = config_bridge.output();
   EXPECT_THAT(config_log, HasSubstr("oscar/config robot set-cycle r7 50ms: accepted"));
+  EXPECT_THAT(config_log, HasSubstr("oscar/robot/r7/commit robot command r7 commit: accepted"));
   bridge.stop();
   config_bridge.stop();
   EXPECT_THAT(bridge.output(), HasSubstr("oscar bridge: stopped"));

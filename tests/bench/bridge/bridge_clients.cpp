@@ -96,6 +96,9 @@ ClientResult run_client(int port, const std::vector<std::string>& topics,
           std::chrono::duration_cast<std::chrono::nanoseconds>(now.time_since_epoch()).count();
       result.delays_us.push_back(static_cast<double>(arrival - static_cast<long long>(stamp)) /
                                  1e3);
+      const auto received = little_endian<std::uint64_t>(data + 5);
+      result.after_dds_us.push_back(
+          static_cast<double>(arrival - static_cast<long long>(received)) / 1e3);
     }
     ws.close(websocket::close_code::normal);
   } catch (const std::exception& e) {

@@ -19,8 +19,11 @@ std::uint64_t first_stamp(const std::uint8_t* cdr, std::size_t size);
 
 struct ClientResult {
   std::vector<double> delays_us;  ///< one per CDR message, arrival minus the cue's first stamp
-  std::size_t messages = 0;       ///< every message after the warm-up (JSON side channels too)
-  std::string error;              ///< why the client stopped early, or ""
+  /// The same messages' arrival minus their receive time in the frame header (when the bridge
+  /// took them from DDS): the part of the delay after DDS, in the bridge and the socket.
+  std::vector<double> after_dds_us;
+  std::size_t messages = 0;  ///< every message after the warm-up (JSON side channels too)
+  std::string error;         ///< why the client stopped early, or ""
 };
 
 /// Connects to ws://127.0.0.1:`port`, subscribes to each of `topics` once advertised and

@@ -17,8 +17,8 @@ using json = nlohmann::ordered_json;
 
 namespace {
 // The command kinds offered, in `oscar config`'s words. Not shutdown (stopping a module is the
-// registry's: `oscar shutdown`/`restart`) and not kernel commands (their requests are IDL types
-// the service's JSON schema cannot describe; `oscar config ... command` sends them).
+// registry's: `oscar shutdown`/`restart`) and not kernel commands (each command port is a
+// service of its own, with its request's JSON schema: command_services.hpp).
 constexpr std::pair<const char*, CommandKind> kOffered[] = {
     {"activate", CMD_ACTIVATE},   {"deactivate", CMD_DEACTIVATE}, {"trigger", CMD_TRIGGER},
     {"set-cycle", CMD_SET_CYCLE}, {"set-param", CMD_SET_PARAM},   {"rewire", CMD_REWIRE},
@@ -36,6 +36,9 @@ std::string offered_list() {
 }  // namespace
 
 std::string ConfigRequest::text() const {
+  if (kind == CMD_COMMAND) {
+    return fmt::format("{} command {} {}", command.module, command.kernel, command.name);
+  }
   for (const auto& [name, k] : kOffered) {
     if (k == kind)
       return fmt::format("{} {}{}{}", module, name, args.empty() ? "" : " ", fmt::join(args, " "));
@@ -165,9 +168,17 @@ void ConfigWorker::run() {
                                       parse_duration(request.args[3])))
                        : kRewireWait;
       }
-      const auto reply = client.send(request.module, request.kind, request.args, timeout);
-      outcome.ok = reply.ok();
-      outcome.text = reply.ok() ? config_response_json(reply) : reply.error();
+      if (request.kind == CMD_COMMAND) {
+        const auto& c = request.command;
+        const auto reply = client.send_command(c.module, c.kernel, c.name, c.request_type,
+                                               std::move(request.request_cdr), timeout);
+        outcome.ok = reply.ok();
+        outcome.text = reply.ok() ? command_response_json(c, reply.answer()) : reply.error();
+      } else {
+        const auto reply = client.send(request.module, request.kind, request.args, timeout);
+        outcome.ok = reply.ok();
+        outcome.text = reply.ok() ? config_response_json(reply) : reply.error();
+      }
     } catch (const std::exception& e) {
       outcome.text = e.what();
     }

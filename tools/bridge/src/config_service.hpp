@@ -18,17 +18,22 @@
 
 #include <oscar/config.h>
 
+#include "command_services.hpp"
 #include "foxglove_protocol.hpp"
 #include "oscar/dds_participant.hpp"
 
 namespace oscar::bridge {
 
-/// One configuration command as a service call asks for it.
+/// One configuration command as a service call asks for it: oscar/config's kinds, or
+/// CMD_COMMAND for a kernel's command port (a command service).
 struct ConfigRequest {
   std::string module;
   CommandKind kind = CMD_ACTIVATE;
   std::vector<std::string> args;
-  /// "set-cycle sig 10ms": the command in `oscar config`'s words, for logs and errors.
+  KernelCommand command{};                  ///< CMD_COMMAND: the command port called
+  std::vector<std::uint8_t> request_cdr{};  ///< CMD_COMMAND: its request, CDR encoded
+  /// "sources set-cycle sig 10ms" or "robot command r7 commit": the command in `oscar config`'s
+  /// words, for logs and errors.
   std::string text() const;
 };
 

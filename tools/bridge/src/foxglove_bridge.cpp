@@ -12,6 +12,7 @@
 #include <boost/asio/steady_timer.hpp>
 
 #include "channel_directory.hpp"
+#include "command_services.hpp"
 #include "config_service.hpp"
 #include "conversion_worker.hpp"
 #include "jpeg_encoder.hpp"
@@ -30,6 +31,7 @@ using Payload = std::shared_ptr<const std::vector<std::uint8_t>>;
 
 namespace {
 constexpr std::uint32_t kConfigServiceId = 1;
+constexpr std::uint32_t kFirstCommandServiceId = 2;  // kernel command ports, as they appear
 // The authority configuration commands from Foxglove carry (as `oscar config --as coordinator`).
 constexpr const char* kConfigSender = "coordinator";
 }  // namespace
@@ -78,6 +80,11 @@ struct FoxgloveBridge::Impl final : SessionHost {
   Payload last_system_state;  // while oscar/system/state is read
   Clock::time_point last_graph_sent{};
   std::unique_ptr<ConfigWorker> config;  // with allow_config
+  // With allow_config: the running modules' kernel command ports as services, from the system
+  // state (read for them as long as the bridge runs), their requests encoded with these types.
+  inspect::IdlTypes request_types;
+  std::unique_ptr<CommandServices> commands;
+  bool reading_state_for_commands = false;
   // Side channel messages are made on the worker's thread; results come back through `io`.
   ConversionWorker converter{
       [settings = conversion,
@@ -107,6 +114,8 @@ struct FoxgloveBridge::Impl final : SessionHost {
     }
     if (!options.allow_config) return;
     config = std::make_unique<ConfigWorker>(participant, kConfigSender);
+    for (const auto& [type, text] : idl_texts()) request_types.add(text);
+    commands = std::make_unique<CommandServices>(request_types, kFirstCommandServiceId);
     if (!net::ip::make_address(options.address).is_loopback()) {
       fmt::print(stderr,
                  "oscar bridge: warning: --allow-config on {}: anyone who reaches port {} there "
@@ -150,6 +159,7 @@ struct FoxgloveBridge::Impl final : SessionHost {
   }
 
   void on_sample(const std::string& topic, const Payload& payload, std::uint64_t receive_ns) {
+    if (commands && topic == topics::system_state().name) update_commands(*payload);
     if (const auto raw = directory.id_of(topic); raw && wanted[*raw] > 0) {
       deliver(*raw, payload, receive_ns);
     }
@@ -267,6 +277,47 @@ struct FoxgloveBridge::Impl final : SessionHost {
       const auto text = advertise_json(change.added);
       for (const auto& s : sessions) s->send_text(text);
     }
+    // The command services follow the system state: read from its first writer on, for good.
+    const auto& state_topic = topics::system_state().name;
+    if (commands && !reading_state_for_commands && directory.id_of(state_topic)) {
+      reading_state_for_commands = true;
+      read(state_topic);
+    }
+  }
+
+  // The running modules' command ports in `state_cdr` (a system state) become the command
+  // services: new ones are advertised, those of modules that stopped unadvertised.
+  void update_commands(const std::vector<std::uint8_t>& state_cdr) {
+    std::vector<KernelCommand> running;
+    try {
+      running = running_commands(system_state_from_cdr(state_cdr));
+    } catch (const std::runtime_error& e) {
+      fmt::print(stderr, "oscar bridge: no command services from this system state: {}\n",
+                 e.what());
+      return;
+    }
+    const auto change = commands->update(running);
+    for (const auto& c : change.unknown_types) {
+      fmt::print(stderr,
+                 "oscar bridge: {} is not offered: its request type {} has no IDL text here\n",
+                 c.service_name(), c.request_type);
+    }
+    for (const auto id : change.removed) {
+      fmt::print(stderr, "oscar bridge: service {} {} is gone\n", id,
+                 commands->ever(id)->service_name());
+    }
+    for (const auto& service : change.added) {
+      fmt::print(stderr, "oscar bridge: service {} {} ({})\n", service.id, service.name,
+                 service.type);
+    }
+    if (!change.removed.empty()) {
+      const auto text = unadvertise_services_json(change.removed);
+      for (const auto& s : sessions) s->send_text(text);
+    }
+    if (!change.added.empty()) {
+      const auto text = advertise_services_json(change.added);
+      for (const auto& s : sessions) s->send_text(text);
+    }
   }
 
   void report() {
@@ -293,11 +344,11 @@ struct FoxgloveBridge::Impl final : SessionHost {
   }
 
   void on_config_done(const std::weak_ptr<Session>& caller, const ServiceCall& call,
-                      const std::string& command, const ConfigWorker::Outcome& outcome) {
+                      const std::string& service, const std::string& command,
+                      const ConfigWorker::Outcome& outcome) {
     const auto session = caller.lock();
-    fmt::print(stderr, "oscar bridge: client {}: oscar/config {}: {}\n",
-               session ? session->peer() : "(gone)", command,
-               outcome.ok ? "accepted" : outcome.text);
+    fmt::print(stderr, "oscar bridge: client {}: {} {}: {}\n", session ? session->peer() : "(gone)",
+               service, command, outcome.ok ? "accepted" : outcome.text);
     if (!session) return;
     if (outcome.ok) {
       session->answer_call(call, outcome.text);
@@ -333,7 +384,9 @@ struct FoxgloveBridge::Impl final : SessionHost {
   const std::string& session_id() const override { return started_ns; }
   std::vector<ServiceInfo> services() const override {
     if (!config) return {};
-    return {config_service_info(kConfigServiceId)};
+    auto offered = commands->services();
+    offered.insert(offered.begin(), config_service_info(kConfigServiceId));
+    return offered;
   }
   void call_service(const std::shared_ptr<Session>& caller, ServiceCall call) override {
     if (!config) {
@@ -342,28 +395,51 @@ struct FoxgloveBridge::Impl final : SessionHost {
           "this bridge offers no services: it was started without --allow-config, so "
           "Foxglove may not configure modules");
     }
+    std::string service = "oscar/config";
     if (call.service != kConfigServiceId) {
-      return caller->fail_call(call, fmt::format("no service {} is advertised (oscar/config is {})",
-                                                 call.service, kConfigServiceId));
+      const auto* c = commands->offered(call.service);
+      if (!c) {
+        if (const auto* gone = commands->ever(call.service)) {
+          return caller->fail_call(
+              call, fmt::format("service {} ({}) is gone: module '{}' does not run now",
+                                call.service, gone->service_name(), gone->module));
+        }
+        return caller->fail_call(
+            call, fmt::format("no service {} is advertised (oscar/config is {}; kernel commands "
+                              "are oscar/<module>/<kernel>/<command>)",
+                              call.service, kConfigServiceId));
+      }
+      service = c->service_name();
     }
     if (call.encoding != "json") {
       return caller->fail_call(
-          call,
-          fmt::format("encoding '{}' is not offered: oscar/config takes json", call.encoding));
+          call, fmt::format("encoding '{}' is not offered: {} takes json", call.encoding, service));
     }
     ConfigRequest request;
     try {
-      request = parse_config_request(call.payload);
+      if (call.service == kConfigServiceId) {
+        request = parse_config_request(call.payload);
+      } else {
+        const auto& c = *commands->offered(call.service);
+        request = {.module = c.module,
+                   .kind = CMD_COMMAND,
+                   .args = {c.kernel, c.name},
+                   .command = c,
+                   .request_cdr = request_cdr(request_types, c.request_type, call.payload)};
+      }
     } catch (const std::invalid_argument& e) {
-      return caller->fail_call(call, e.what());
+      return caller->fail_call(call,
+                               call.service == kConfigServiceId
+                                   ? std::string(e.what())
+                                   : fmt::format("{}: wrong arguments: {}", service, e.what()));
     }
     const auto command = request.text();
-    fmt::print(stderr, "oscar bridge: client {} calls oscar/config {}\n", caller->peer(), command);
+    fmt::print(stderr, "oscar bridge: client {} calls {} {}\n", caller->peer(), service, command);
     std::weak_ptr<Session> weak = caller;
-    const bool queued =
-        config->submit(std::move(request), [this, weak, call, command](ConfigWorker::Outcome o) {
-          net::post(io, [this, weak, call, command, o = std::move(o)] {
-            on_config_done(weak, call, command, o);
+    const bool queued = config->submit(
+        std::move(request), [this, weak, call, service, command](ConfigWorker::Outcome o) {
+          net::post(io, [this, weak, call, service, command, o = std::move(o)] {
+            on_config_done(weak, call, service, command, o);
           });
         });
     if (!queued) {

@@ -5,7 +5,8 @@
 // raw CDR goes to each subscriber as it came, through a bounded per-client queue. Images, poses,
 // robot states and the system state have side channels in Foxglove's schemas (JSON), converted
 // only while subscribed, on a thread of their own (newest sample wins per side channel); with
-// `allow_config`, the service oscar/config configures modules.
+// `allow_config`, the service oscar/config configures modules and each running kernel's command
+// ports are services oscar/<module>/<kernel>/<command> (command_services.hpp).
 
 #include <atomic>
 #include <chrono>
@@ -26,7 +27,8 @@ struct BridgeOptions {
   int jpeg_quality = 80;              ///< foxglove.CompressedImage side channels, 1..100
   std::chrono::milliseconds discovery_period{200};
   std::chrono::milliseconds report_period{1000};  ///< how often drops are reported
-  /// Offer the service oscar/config (configuration commands with the coordinator's authority;
+  /// Offer the service oscar/config and the kernels' command ports as services (configuration
+  /// commands with the coordinator's authority;
   /// the participant must be allowed to write them, see ToolAuthority::kActAsBoot).
   bool allow_config = false;
   /// Test hook: each side channel conversion takes at least this long more (0: none), to show

@@ -61,6 +61,10 @@ std::string advertise_services_json(const std::vector<ServiceInfo>& services) {
   return json{{"op", "advertiseServices"}, {"services", list}}.dump();
 }
 
+std::string unadvertise_services_json(const std::vector<std::uint32_t>& service_ids) {
+  return json{{"op", "unadvertiseServices"}, {"serviceIds", service_ids}}.dump();
+}
+
 std::string service_call_failure_json(std::uint32_t service, std::uint32_t call,
                                       const std::string& message) {
   return json{

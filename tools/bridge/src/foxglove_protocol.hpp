@@ -49,6 +49,7 @@ std::string advertise_json(const std::vector<ChannelInfo>& channels);
 std::string unadvertise_json(const std::vector<std::uint32_t>& channel_ids);
 std::string status_json(StatusLevel level, const std::string& message);
 std::string advertise_services_json(const std::vector<ServiceInfo>& services);
+std::string unadvertise_services_json(const std::vector<std::uint32_t>& service_ids);
 std::string service_call_failure_json(std::uint32_t service, std::uint32_t call,
                                       const std::string& message);
 

@@ -192,6 +192,16 @@ void IdlTypes::add(const std::string& idl_text) {
 
 bool IdlTypes::has(const std::string& name) const { return structs_.count(name) > 0; }
 
+const std::vector<IdlMember>* IdlTypes::members(const std::string& name) const {
+  const auto it = structs_.find(name);
+  return it == structs_.end() ? nullptr : &it->second;
+}
+
+const std::vector<std::string>* IdlTypes::enumerators(const std::string& name) const {
+  const auto it = enums_.find(name);
+  return it == enums_.end() ? nullptr : &it->second;
+}
+
 // Reads XCDR1/XCDR2 plain (final) data as Fast DDS 2.9 writes it.
 class Decoder {
  public:

@@ -36,6 +36,12 @@ class IdlTypes {
   /// @throws std::invalid_argument naming the token it did not understand.
   void add(const std::string& idl_text);
   bool has(const std::string& scoped_name) const;
+  /// The members of the struct `scoped_name` in declaration order; nullptr if it is no struct
+  /// known here.
+  const std::vector<IdlMember>* members(const std::string& scoped_name) const;
+  /// The enumerators of the enum `scoped_name` in declaration order; nullptr if it is no enum
+  /// known here.
+  const std::vector<std::string>* enumerators(const std::string& scoped_name) const;
 
   struct Options {
     std::size_t max_items = 16;  ///< longer sequences and arrays show their first items and size
