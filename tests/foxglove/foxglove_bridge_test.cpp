@@ -19,6 +19,7 @@
 #include "foxglove_messages.hpp"
 #include "jpeg_encoder.hpp"
 #include "json_schemas.hpp"
+#include "source_tree.hpp"
 
 namespace oscar {
 namespace {
@@ -39,6 +40,12 @@ std::string on_path(const std::string& program) {
   return "";
 }
 
+// This folder's Node scripts, and the npm packages installed for them in the build tree.
+std::string script(const std::string& name) {
+  return oscar::testing::source_path("tests/foxglove/") + name;
+}
+fs::path npm_dir() { return oscar::testing::build_path("tests/foxglove/npm"); }
+
 std::string read(const fs::path& file) {
   std::ifstream in(file);
   std::stringstream s;
@@ -49,7 +56,7 @@ std::string read(const fs::path& file) {
 // Installs the locked npm packages into the build tree with `npm ci`, unless the lock file
 // installed there last time is this one. Returns npm's output on failure, "" on success.
 std::string install_client_packages(const std::string& npm) {
-  const fs::path source(OSCAR_FOXGLOVE_TEST_DIR), target(OSCAR_FOXGLOVE_NPM_DIR);
+  const fs::path source = oscar::testing::source_path("tests/foxglove"), target = npm_dir();
   const auto lock = read(source / "package-lock.json");
   if (fs::exists(target / "node_modules" / ".package-lock.json") &&
       read(target / "package-lock.json") == lock) {
@@ -150,10 +157,10 @@ TEST(FoxgloveBridge, ItsSchemasForFoxglovesTypesFollowThePublishedOnes) {
   std::ofstream(schemas_file) << schemas.dump(2);
   std::ofstream(messages_file) << messages.dump(2);
 
-  ::setenv("NODE_PATH", (fs::path(OSCAR_FOXGLOVE_NPM_DIR) / "node_modules").c_str(), 1);
-  Process check({node, std::string(OSCAR_FOXGLOVE_TEST_DIR) + "/schema_checks.js", "--schemas",
-                 schemas_file, "--messages", messages_file},
-                test::temp_path("schema_checks") + ".log");
+  ::setenv("NODE_PATH", (npm_dir() / "node_modules").c_str(), 1);
+  Process check(
+      {node, script("schema_checks.js"), "--schemas", schemas_file, "--messages", messages_file},
+      test::temp_path("schema_checks") + ".log");
   EXPECT_EQ(check.wait(60s), 0) << check.output();
   std::cout << check.output();
 }
@@ -200,15 +207,15 @@ modules:
   const auto config_port = served_port(config_bridge);
   ASSERT_NE(config_port, 0) << config_bridge.output();
 
-  ::setenv("NODE_PATH", (fs::path(OSCAR_FOXGLOVE_NPM_DIR) / "node_modules").c_str(), 1);
+  ::setenv("NODE_PATH", (npm_dir() / "node_modules").c_str(), 1);
   // After --late: the command of a module the client starts later (its topic appears then).
-  Process client({node, std::string(OSCAR_FOXGLOVE_TEST_DIR) + "/bridge_client.js", "--url",
-                  "ws://127.0.0.1:" + std::to_string(port), "--config-url",
-                  "ws://127.0.0.1:" + std::to_string(config_port),
-                  bridge::jpeg_available() ? "--expect-jpeg" : "--no-jpeg", "--late",
-                  test::bin("oscar-run"), "--name", "late", "--domain", domain, "-k",
-                  "bench_source:late", "-p", "late.type=Bool", "-m", "continuous:50ms"},
-                 test::temp_path("bridge_client") + ".log");
+  Process client(
+      {node, script("bridge_client.js"), "--url", "ws://127.0.0.1:" + std::to_string(port),
+       "--config-url", "ws://127.0.0.1:" + std::to_string(config_port),
+       bridge::jpeg_available() ? "--expect-jpeg" : "--no-jpeg", "--late", test::bin("oscar-run"),
+       "--name", "late", "--domain", domain, "-k", "bench_source:late", "-p", "late.type=Bool",
+       "-m", "continuous:50ms"},
+      test::temp_path("bridge_client") + ".log");
   const auto rc = client.wait(240s);
   std::cout << client.output();
   EXPECT_EQ(rc, 0) << client.output() << "\nbridge:\n"
@@ -223,10 +230,10 @@ modules:
       test::temp_path("throttled_bridge") + ".log");
   const auto throttled_port = served_port(throttled);
   ASSERT_NE(throttled_port, 0) << throttled.output();
-  Process rate_client({node, std::string(OSCAR_FOXGLOVE_TEST_DIR) + "/image_rate.js", "--url",
-                       "ws://127.0.0.1:" + std::to_string(throttled_port), "--image",
-                       "oscar/cue/cam/out", "--bool", "oscar/cue/sig/out"},
-                      test::temp_path("image_rate_client") + ".log");
+  Process rate_client(
+      {node, script("image_rate.js"), "--url", "ws://127.0.0.1:" + std::to_string(throttled_port),
+       "--image", "oscar/cue/cam/out", "--bool", "oscar/cue/sig/out"},
+      test::temp_path("image_rate_client") + ".log");
   ASSERT_EQ(rate_client.wait(60s), 0) << rate_client.output();
   const auto rates = nlohmann::json::parse(rate_client.output());
   EXPECT_GE(rates["images_per_s"].get<double>(), 3.5) << rates;
@@ -244,11 +251,10 @@ modules:
                test::temp_path("slow_conversion_bridge") + ".log");
   const auto slow_port = served_port(slow);
   ASSERT_NE(slow_port, 0) << slow.output();
-  std::vector<std::string> slow_args{
-      node,     std::string(OSCAR_FOXGLOVE_TEST_DIR) + "/slow_conversion.js",
-      "--url",  "ws://127.0.0.1:" + std::to_string(slow_port),
-      "--bool", "oscar/cue/sig/out",
-      "--side", "foxglove/cam/out"};
+  std::vector<std::string> slow_args{node,     script("slow_conversion.js"),
+                                     "--url",  "ws://127.0.0.1:" + std::to_string(slow_port),
+                                     "--bool", "oscar/cue/sig/out",
+                                     "--side", "foxglove/cam/out"};
   if (bridge::jpeg_available()) {
     slow_args.insert(slow_args.end(), {"--side", "foxglove/cam/out/compressed"});
   }
@@ -351,11 +357,11 @@ modules:
         test::temp_path("secured_bridge") + ".log");
     const auto port = served_port(bridge);
     ASSERT_NE(port, 0) << bridge.output();
-    ::setenv("NODE_PATH", (fs::path(OSCAR_FOXGLOVE_NPM_DIR) / "node_modules").c_str(), 1);
-    Process call({node, std::string(OSCAR_FOXGLOVE_TEST_DIR) + "/config_call.js", "--url",
-                  "ws://127.0.0.1:" + std::to_string(port), "--request",
-                  R"({"module": "sources", "command": "set-cycle", "args": ["sig", "50ms"]})"},
-                 test::temp_path("secured_call") + ".log");
+    ::setenv("NODE_PATH", (npm_dir() / "node_modules").c_str(), 1);
+    Process call(
+        {node, script("config_call.js"), "--url", "ws://127.0.0.1:" + std::to_string(port),
+         "--request", R"({"module": "sources", "command": "set-cycle", "args": ["sig", "50ms"]})"},
+        test::temp_path("secured_call") + ".log");
     EXPECT_EQ(call.wait(30s), 0) << call.output() << "\nbridge:\n" << bridge.output();
     EXPECT_THAT(call.output(), HasSubstr(R"("cycle_ms":50.0)"));
     system.wait_for([](const SystemState& s) {
