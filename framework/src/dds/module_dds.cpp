@@ -305,10 +305,13 @@ std::optional<DdsParticipant::DiscoveredWriter> Module::Dds::ask_servers_for_pro
   const auto name = topics::cue(source);
   if (auto seen = participant_.discovered_writer(name)) return seen;  // e.g. another input's
   auto& topic = participant_.topic(name, input.type().new_topic_type());
-  // Best effort and volatile: every writer matches it, whatever its class.
-  const auto probe = participant_.subscriber().create_datareader(
-      &topic, qos::cue_reader({.depth = 1, .reliable = false, .transient_local = false}, 1,
-                              Reliability::kBestEffort));
+  // The servers tell a plain client of the writers of a topic it reads, whatever their QoS. The
+  // probe matches none of them (exclusive ownership; every OSCAR writer is shared), so it only
+  // asks: no writer sends it a cue.
+  auto probe_qos = qos::cue_reader({.depth = 1, .reliable = false, .transient_local = false}, 1,
+                                   Reliability::kBestEffort);
+  probe_qos.ownership().kind = dds::EXCLUSIVE_OWNERSHIP_QOS;
+  const auto probe = participant_.subscriber().create_datareader(&topic, probe_qos);
   if (!probe) throw std::runtime_error("cannot create a reader for " + source);
   std::optional<DdsParticipant::DiscoveredWriter> seen;
   while (!(seen = participant_.discovered_writer(name)) &&

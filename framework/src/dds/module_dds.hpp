@@ -75,9 +75,9 @@ class Module::Dds {
   /// client (docs/network.md), which learns only of what shares a topic with it.
   static internal::ServerClient server_client_of(const Module& module);
   /// A plain client of the discovery servers learns of a writer only once it reads the topic:
-  /// makes a reader every writer matches, which makes the servers tell this participant of the
-  /// source's writer, waits for it (at most until `until`) and deletes the reader, which
-  /// delivers nothing. The producer's writer as discovery then shows it, if it does.
+  /// makes a reader of the topic that matches no writer (exclusive ownership), which makes the
+  /// servers tell this participant of the source's writer, waits for it (at most until `until`)
+  /// and deletes the reader, which never received anything. The producer's writer as discovery then shows it, if it does.
   std::optional<DdsParticipant::DiscoveredWriter> ask_servers_for_producer(
       InputPort& input, const std::string& source, std::chrono::steady_clock::time_point until);
   std::string subscribe(InputPort& input, const std::string& source, const OutputOptions& producer,
