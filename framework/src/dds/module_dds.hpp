@@ -77,7 +77,8 @@ class Module::Dds {
   /// A plain client of the discovery servers learns of a writer only once it reads the topic:
   /// makes a reader of the topic that matches no writer (exclusive ownership), which makes the
   /// servers tell this participant of the source's writer, waits for it (at most until `until`)
-  /// and deletes the reader, which never received anything. The producer's writer as discovery then shows it, if it does.
+  /// and deletes the reader, which never received anything. Returns the producer's writer as
+  /// discovery then shows it, if it does.
   std::optional<DdsParticipant::DiscoveredWriter> ask_servers_for_producer(
       InputPort& input, const std::string& source, std::chrono::steady_clock::time_point until);
   std::string subscribe(InputPort& input, const std::string& source, const OutputOptions& producer,
