@@ -434,7 +434,9 @@ struct FoxgloveBridge::Impl final : SessionHost {
                                    : fmt::format("{}: wrong arguments: {}", service, e.what()));
     }
     const auto command = request.text();
-    fmt::print(stderr, "oscar bridge: client {} calls {} {}\n", caller->peer(), service, command);
+    // A kernel command's service name already says module, kernel and command.
+    fmt::print(stderr, "oscar bridge: client {} calls {}\n", caller->peer(),
+               call.service == kConfigServiceId ? service + " " + command : service);
     std::weak_ptr<Session> weak = caller;
     const bool queued = config->submit(
         std::move(request), [this, weak, call, service, command](ConfigWorker::Outcome o) {
