@@ -72,6 +72,9 @@ struct FoxgloveBridge::Impl final : SessionHost {
   ChannelDirectory directory{idl_texts(), side_channels_for};
   ConversionSettings conversion{.jpeg_quality = options.jpeg_quality};
   std::set<std::shared_ptr<Session>> sessions;
+  void send_to_every_client(const std::string& text) const {
+    for (const auto& s : sessions) s->send_text(text);
+  }
   std::map<std::uint32_t, int> wanted;   // channel -> subscribers
   std::map<std::string, int> readers;    // DDS topic -> channels wanting it; read while > 0
   std::map<std::uint32_t, Known> known;  // every channel id ever made
@@ -270,12 +273,10 @@ struct FoxgloveBridge::Impl final : SessionHost {
                  side ? ", from " + c.source : "");
     }
     if (!change.removed.empty()) {
-      const auto text = unadvertise_json(change.removed);
-      for (const auto& s : sessions) s->send_text(text);
+      send_to_every_client(unadvertise_json(change.removed));
     }
     if (!change.added.empty()) {
-      const auto text = advertise_json(change.added);
-      for (const auto& s : sessions) s->send_text(text);
+      send_to_every_client(advertise_json(change.added));
     }
     // The command services follow the system state: read from its first writer on, for good.
     const auto& state_topic = topics::system_state().name;
@@ -311,12 +312,10 @@ struct FoxgloveBridge::Impl final : SessionHost {
                  service.type);
     }
     if (!change.removed.empty()) {
-      const auto text = unadvertise_services_json(change.removed);
-      for (const auto& s : sessions) s->send_text(text);
+      send_to_every_client(unadvertise_services_json(change.removed));
     }
     if (!change.added.empty()) {
-      const auto text = advertise_services_json(change.added);
-      for (const auto& s : sessions) s->send_text(text);
+      send_to_every_client(advertise_services_json(change.added));
     }
   }
 
