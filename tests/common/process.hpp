@@ -3,6 +3,7 @@
 // (SIGTERM, then SIGKILL) when the object goes away, so a failed test leaves nothing behind.
 
 #include <fcntl.h>
+#include <linux/close_range.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -30,17 +31,24 @@ inline std::string bin(const std::string& program) { return build_dir() + "/bin/
 class Process {
  public:
   Process(std::vector<std::string> argv, std::string log) : log_(std::move(log)) {
+    // Everything that allocates happens before fork: the test runs other threads (DDS's), and a
+    // child that needs a lock one of them held when it forked (the allocator's under TSan) waits
+    // forever. The child only redirects, lets go of the test's sockets and files, and execs.
+    std::vector<char*> args;
+    for (auto& a : argv) args.push_back(a.data());
+    args.push_back(nullptr);
+    const int fd = ::open(log_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     pid_ = fork();
     if (pid_ == 0) {
-      const int fd = ::open(log_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      dup2(fd, 1);
-      dup2(fd, 2);
-      std::vector<char*> args;
-      for (auto& a : argv) args.push_back(a.data());
-      args.push_back(nullptr);
+      if (fd >= 0) {
+        dup2(fd, 1);
+        dup2(fd, 2);
+      }
+      close_range(3, ~0U, CLOSE_RANGE_CLOEXEC);
       execv(args[0], args.data());
       _exit(127);
     }
+    if (fd >= 0) ::close(fd);
   }
   ~Process() { stop(); }
   Process(const Process&) = delete;
