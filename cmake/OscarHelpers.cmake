@@ -16,6 +16,13 @@ elseif(NOT OSCAR_SANITIZE STREQUAL "")
   message(FATAL_ERROR "OSCAR_SANITIZE='${OSCAR_SANITIZE}': use '', 'address' or 'thread'")
 endif()
 
+# With debug information ccache keys every object on the compiler's working directory too, unless
+# the debug information names paths relative to the checkout: then a clone at another path (CI's)
+# reuses the objects of this one.
+if(NOT OSCAR_SANITIZE STREQUAL "" OR CMAKE_BUILD_TYPE MATCHES "Deb")
+  add_compile_options(-fdebug-prefix-map=${PROJECT_SOURCE_DIR}=.)
+endif()
+
 # Warnings for OSCAR's own code (generated and third-party code is compiled without them).
 function(oscar_warnings target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow)
