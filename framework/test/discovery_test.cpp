@@ -150,13 +150,12 @@ hosts:
 TEST(DiscoveryServers, AModulesParticipantIsAPlainClientAndOnlyIt) {
   const auto net = NetworkConfig::from_yaml(YAML::Load("{discovery: server}"));
   BuiltinAttributes builtin;
-  internal::configure_discovery(builtin, net, 3, internal::ServerClient::kPlain);
+  internal::configure_discovery(builtin, net, 3, DiscoveryScope::kSharedTopics);
   EXPECT_EQ(builtin.discovery_config.discoveryProtocol, DiscoveryProtocol::CLIENT);
   EXPECT_EQ(builtin.discovery_config.m_DiscoveryServers.size(), 1u);
-  // Said for the next participant of this thread, taken by it, and gone for the one after.
-  EXPECT_EQ(&internal::next_participant_is(internal::ServerClient::kPlain, net), &net);
-  EXPECT_EQ(internal::take_next_participant_kind(), internal::ServerClient::kPlain);
-  EXPECT_EQ(internal::take_next_participant_kind(), internal::ServerClient::kSuper);
+  BuiltinAttributes whole;
+  internal::configure_discovery(whole, net, 3);
+  EXPECT_EQ(whole.discovery_config.discoveryProtocol, DiscoveryProtocol::SUPER_CLIENT);
 }
 
 bool sees(const DdsParticipant& p, const std::string& name) {
@@ -175,8 +174,7 @@ TEST(DiscoveryServerPlainClients, LearnOnlyOfTheParticipantsTheyShareATopicWith)
   const auto net = NetworkConfig::from_yaml(YAML::Load("{discovery: server}"));
   DiscoveryServer server(domain, net, 0);
   const auto plain = [&](const std::string& name) {
-    return std::make_unique<DdsParticipant>(
-        domain, name, internal::next_participant_is(internal::ServerClient::kPlain, net));
+    return std::make_unique<DdsParticipant>(domain, name, net, DiscoveryScope::kSharedTopics);
   };
   auto producer = plain("producer");
   auto consumer = plain("consumer");

@@ -32,8 +32,11 @@ void note_hosted_module(const std::string& module);
 
 class DdsParticipant {
  public:
+  /// `scope`: what it learns of where `network` uses discovery servers (a module's
+  /// participant: only what shares a topic with it).
   /// @throws std::runtime_error if no participant can be created (e.g. all ports taken).
-  DdsParticipant(int domain, const std::string& name, const NetworkConfig& network = {});
+  DdsParticipant(int domain, const std::string& name, const NetworkConfig& network = {},
+                 DiscoveryScope scope = DiscoveryScope::kWholeSystem);
   ~DdsParticipant();
   DdsParticipant(const DdsParticipant&) = delete;
   DdsParticipant& operator=(const DdsParticipant&) = delete;

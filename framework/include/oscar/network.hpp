@@ -29,6 +29,12 @@ enum class Discovery {
   kServer,       ///< each is a client of the discovery servers `oscar boot` starts
 };
 
+/// What a participant learns of from the discovery servers (docs/network.md): the whole system
+/// (boot, the registry, the monitors, the tools: Fast DDS's SUPER_CLIENT) or only the
+/// participants and endpoints that share a topic with its own (a module: a plain CLIENT, which
+/// does not parse, match or answer the rest). With static peers every participant learns of all.
+enum class DiscoveryScope { kWholeSystem, kSharedTopics };
+
 /// The transport profile of a DDS participant. The default confines it to the loopback
 /// interface: UDP on 127.0.0.1 with unicast discovery to localhost, plus shared memory; no
 /// multicast, no other interface. A system file may name other interfaces and peers, or use

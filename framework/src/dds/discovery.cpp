@@ -32,9 +32,6 @@ namespace {
 // they learned (Fast DDS's default: 450 ms).
 const eprosima::fastrtps::Duration_t kServerSyncPeriod(0, 50'000'000);
 
-// next_participant_is(): per thread, so that no other thread's participant takes it.
-thread_local ServerClient next_participant_kind = ServerClient::kSuper;
-
 Locator_t udp_locator(const std::string& address, std::uint32_t port) {
   Locator_t l;
   IPLocator::setIPv4(l, address);
@@ -72,17 +69,8 @@ RemoteServerAttributes remote_server(const std::string& address, int domain, int
   return server;
 }
 
-const NetworkConfig& next_participant_is(ServerClient client, const NetworkConfig& net) {
-  next_participant_kind = client;
-  return net;
-}
-
-ServerClient take_next_participant_kind() {
-  return std::exchange(next_participant_kind, ServerClient::kSuper);
-}
-
 void configure_discovery(eprosima::fastrtps::rtps::BuiltinAttributes& builtin,
-                         const NetworkConfig& net, int domain, ServerClient client) {
+                         const NetworkConfig& net, int domain, DiscoveryScope scope) {
   auto& discovery = builtin.discovery_config;
   builtin.initialPeersList.clear();
   discovery.m_DiscoveryServers.clear();
@@ -96,8 +84,9 @@ void configure_discovery(eprosima::fastrtps::rtps::BuiltinAttributes& builtin,
     // only of the participants it shares a topic with, and of their endpoints on those topics:
     // a module's participant does not parse, match or answer the rest of the system
     // (docs/network.md, "Discovery: static peers or a discovery server").
-    discovery.discoveryProtocol = client == ServerClient::kPlain ? DiscoveryProtocol::CLIENT
-                                                                 : DiscoveryProtocol::SUPER_CLIENT;
+    discovery.discoveryProtocol = scope == DiscoveryScope::kSharedTopics
+                                      ? DiscoveryProtocol::CLIENT
+                                      : DiscoveryProtocol::SUPER_CLIENT;
     discovery.discoveryServer_client_syncperiod = kServerSyncPeriod;
     for (std::size_t i = 0; i < net.discovery_servers.size(); ++i) {
       discovery.m_DiscoveryServers.push_back(

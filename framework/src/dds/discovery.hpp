@@ -15,26 +15,11 @@ namespace oscar::internal {
 /// ids discovery servers take, less ids whose ports would not fit in 16 bits.
 int participant_ids(const NetworkConfig& net, int domain);
 
-/// What a client of the discovery servers learns from them.
-enum class ServerClient {
-  kSuper,  ///< every participant and endpoint (boot, the registry, the monitors, the tools)
-  kPlain,  ///< only the participants and endpoints that share a topic with its own (modules)
-};
-
 /// Sets `builtin`'s discovery for `net`: initial peers (every usable participant id of every
-/// peer) or the discovery servers this participant is a `client` of.
+/// peer) or the discovery servers, learning of what `scope` says.
 void configure_discovery(eprosima::fastrtps::rtps::BuiltinAttributes& builtin,
                          const NetworkConfig& net, int domain,
-                         ServerClient client = ServerClient::kSuper);
-
-/// Makes the next DdsParticipant this thread creates a `client` of the discovery servers, if
-/// its network uses them; every later one is a super client again. Returns `net`, so that the
-/// initializer that makes the participant says it: `participant_(domain, name,
-/// next_participant_is(ServerClient::kPlain, net))`.
-const NetworkConfig& next_participant_is(ServerClient client, const NetworkConfig& net);
-/// What the participant being made is (DdsParticipant's constructor): what
-/// next_participant_is() said, or kSuper; resets it to kSuper.
-ServerClient take_next_participant_kind();
+                         DiscoveryScope scope = DiscoveryScope::kWholeSystem);
 
 /// The remote-server entry for discovery server `index` of `domain` on `address`: its GUID
 /// prefix (Fast DDS's default for server `index`) and its discovery locator.

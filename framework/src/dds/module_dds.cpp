@@ -172,24 +172,24 @@ class Module::Dds::CueReader final : public dds::DataReaderListener {
   }
 };
 
-// A plain client, unless an input takes any type: such an input is subscribed once discovery
-// shows a writer of its source, which a plain client learns of only through a reader of the
-// topic, and that needs the type.
-internal::ServerClient Module::Dds::server_client_of(const Module& module) {
+// Only the topics it shares, unless an input takes any type: such an input is subscribed once
+// discovery shows a writer of its source, which a plain client learns of only through a reader
+// of the topic, and that needs the type.
+DiscoveryScope Module::Dds::discovery_scope_of(const Module& module) {
   for (const auto& s : module.slots_) {
     for (const auto& input : s->instance->ports().inputs) {
-      if (input->takes_any_type()) return internal::ServerClient::kSuper;
+      if (input->takes_any_type()) return DiscoveryScope::kWholeSystem;
     }
   }
-  return internal::ServerClient::kPlain;
+  return DiscoveryScope::kSharedTopics;
 }
 
 Module::Dds::Dds(Module& module, int domain)
     : module_(module),
-      participant_(domain, "oscar:" + module.spec_.name,
-                   internal::next_participant_is(server_client_of(module), module.spec_.network)),
+      participant_(domain, "oscar:" + module.spec_.name, module.spec_.network,
+                   discovery_scope_of(module)),
       learns_only_shared_topics_(module.spec_.network.discovery == Discovery::kServer &&
-                                 server_client_of(module) == internal::ServerClient::kPlain) {
+                                 discovery_scope_of(module) == DiscoveryScope::kSharedTopics) {
   // Samples dropped as malformed are reported where the module's other lines go: its console
   // and oscar/log. The logger outlives this (shared), and its DDS sink is detached below.
   set_malformed_sample_log(module.log_);

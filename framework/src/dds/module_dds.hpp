@@ -71,9 +71,9 @@ class Module::Dds {
     std::string source;
     OutputOptions offered;
   };
-  /// What the module's participant is to the discovery servers, if it uses them: a plain
-  /// client (docs/network.md), which learns only of what shares a topic with it.
-  static internal::ServerClient server_client_of(const Module& module);
+  /// What the module's participant learns of from the discovery servers, if it uses them:
+  /// only what shares a topic with it (docs/network.md), unless an input takes any type.
+  static DiscoveryScope discovery_scope_of(const Module& module);
   /// A plain client of the discovery servers learns of a writer only once it reads the topic:
   /// makes a reader of the topic that matches no writer (exclusive ownership), which makes the
   /// servers tell this participant of the source's writer, waits for it (at most until `until`)

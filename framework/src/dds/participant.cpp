@@ -64,8 +64,7 @@ std::vector<std::string> hosted() {
 }
 
 dds::DomainParticipantQos participant_qos(const std::string& name, const NetworkConfig& net,
-                                          int domain, int participant_id,
-                                          internal::ServerClient client) {
+                                          int domain, int participant_id, DiscoveryScope scope) {
   dds::DomainParticipantQos qos;
   qos.name(name);
   if (const auto modules = hosted(); !modules.empty()) {
@@ -121,7 +120,7 @@ dds::DomainParticipantQos participant_qos(const std::string& name, const Network
     user.push_back(l);
   }
   if (net.shared_memory) user.push_back(internal::unique_shared_memory_locator());
-  internal::configure_discovery(builtin, net, domain, client);  // static peers or servers
+  internal::configure_discovery(builtin, net, domain, scope);  // static peers or servers
   // Leave quickly: a vanished participant must not linger for 20 s. Announced every second, not
   // every 200 ms: each announcement goes to every participant, and booting a hundred modules on
   // two cores, UDP sends were most of their CPU time (perf; docs/network.md).
@@ -376,9 +375,9 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
   std::map<eprosima::fastrtps::rtps::GuidPrefix_t, Participant> participants_;
 };
 
-DdsParticipant::DdsParticipant(int domain, const std::string& name, const NetworkConfig& network)
+DdsParticipant::DdsParticipant(int domain, const std::string& name, const NetworkConfig& network,
+                               DiscoveryScope scope)
     : domain_(domain), security_(network.security), listener_(std::make_unique<Listener>()) {
-  const auto client = internal::take_next_participant_kind();  // first: this one takes it
   if (network.interfaces.empty()) throw std::invalid_argument("network: no interface given");
   auto* factory = dds::DomainParticipantFactory::get_instance();
   dds_log_level_from_env();
@@ -391,7 +390,7 @@ DdsParticipant::DdsParticipant(int domain, const std::string& name, const Networ
     auto claim = std::make_unique<internal::ParticipantIdClaim>(domain, address, id);
     if (!*claim || !udp_port_free(address, metatraffic_unicast_port(domain, id))) continue;
     participant_ = factory->create_participant(
-        domain, participant_qos(name, network, domain, id, client), listener_.get(), mask);
+        domain, participant_qos(name, network, domain, id, scope), listener_.get(), mask);
     if (participant_) {
       claim->record(participant_->guid().guidPrefix);
       id_claim_ = std::move(claim);
