@@ -3,6 +3,7 @@
 #include <cstdlib>
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include "dds/udp_tuning.hpp"  // framework/src
 
@@ -28,7 +29,7 @@ TEST(NetworkBadInput, UdpSettingsOutOfRangeNameTheVariableAndTheRange) {
     setenv(name, value, 1);
     std::string what;
     try {
-      internal::udp_tuning_from_env();
+      internal::udp_tuning(NetworkConfig{});
     } catch (const std::invalid_argument& e) {
       what = e.what();
     }
@@ -52,18 +53,46 @@ TEST(NetworkBadInput, UdpSettingsOutOfRangeNameTheVariableAndTheRange) {
             "number of bytes from 1024 to 65500");
 }
 
-TEST(Network, UdpSettingsComeFromTheEnvironmentAndBuffersDefaultTo4MiB) {
+TEST(NetworkBadInput, UdpKeysOutOfRangeNameTheKeyAndTheRange) {
+  const auto refused = [](const char* yaml) {
+    try {
+      NetworkConfig::from_yaml(YAML::Load(yaml));
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(refused("{udp_buffer_bytes: 4MiB}"),
+            "network.udp_buffer_bytes='4MiB': expected 0 (the default) or a number of bytes from "
+            "65536 to 1073741824");
+  EXPECT_EQ(refused("{udp_buffer_bytes: -4194304}"),
+            "network.udp_buffer_bytes='-4194304': expected 0 (the default) or a number of bytes "
+            "from 65536 to 1073741824");
+  EXPECT_EQ(refused("{udp_max_message_bytes: 100}"),
+            "network.udp_max_message_bytes='100': expected 0 (the default) or a number of bytes "
+            "from 1024 to 65500");
+}
+
+// The system file's (or module file's) `network:` map sets them; the environment, where set,
+// overrides that for the participants a process makes (benchmarks, experiments).
+TEST(Network, UdpSettingsComeFromTheNetworkMapAndTheEnvironmentOverridesThem) {
   unsetenv("OSCAR_UDP_BUFFER_BYTES");
   unsetenv("OSCAR_UDP_MAX_MESSAGE_BYTES");
-  EXPECT_EQ(internal::udp_tuning_from_env().buffer_bytes, 4u << 20);
-  EXPECT_EQ(internal::udp_tuning_from_env().max_message_bytes, 0u);
+  const NetworkConfig loopback;
+  EXPECT_EQ(internal::udp_tuning(loopback).buffer_bytes, 4u << 20) << "room for a 442 KB image";
+  EXPECT_EQ(internal::udp_tuning(loopback).max_message_bytes, 0u) << "0: Fast DDS's 65500";
+  const auto tuned =
+      NetworkConfig::from_yaml(YAML::Load("{udp_buffer_bytes: 8388608, udp_max_message_bytes: "
+                                          "8972}"));
+  EXPECT_EQ(internal::udp_tuning(tuned).buffer_bytes, 8u << 20);
+  EXPECT_EQ(internal::udp_tuning(tuned).max_message_bytes, 8972u);
+  const auto system_default = NetworkConfig::from_yaml(YAML::Load("{udp_buffer_bytes: 0}"));
+  EXPECT_EQ(internal::udp_tuning(system_default).buffer_bytes, 0u) << "0: the system's default";
   setenv("OSCAR_UDP_BUFFER_BYTES", "0", 1);
-  EXPECT_EQ(internal::udp_tuning_from_env().buffer_bytes, 0u) << "0: the system's default";
-  setenv("OSCAR_UDP_BUFFER_BYTES", "4194304", 1);
-  setenv("OSCAR_UDP_MAX_MESSAGE_BYTES", "8972", 1);
-  const auto t = internal::udp_tuning_from_env();
-  EXPECT_EQ(t.buffer_bytes, 4194304u);
-  EXPECT_EQ(t.max_message_bytes, 8972u);
+  setenv("OSCAR_UDP_MAX_MESSAGE_BYTES", "1400", 1);
+  const auto t = internal::udp_tuning(tuned);
+  EXPECT_EQ(t.buffer_bytes, 0u);
+  EXPECT_EQ(t.max_message_bytes, 1400u);
   unsetenv("OSCAR_UDP_BUFFER_BYTES");
   unsetenv("OSCAR_UDP_MAX_MESSAGE_BYTES");
 }

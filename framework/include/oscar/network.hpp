@@ -44,6 +44,11 @@ struct NetworkConfig {
   std::vector<std::string> peers{"127.0.0.1"};       ///< hosts discovery announces itself to
   bool shared_memory = true;
   std::uint32_t shm_segment_bytes = 8u << 20;  ///< must hold the largest cues in flight
+  /// UDP send and receive socket buffers: room for a 442 KB image in one burst (the kernel caps
+  /// them at net.core.{w,r}mem_max); 0: the system's default.
+  std::uint32_t udp_buffer_bytes = 4u << 20;
+  /// The largest UDP datagram; larger samples go in fragments of it. 0: Fast DDS's 65500.
+  std::uint32_t udp_max_message_bytes = 0;
   /// Participant ids taken and probed per address (at most kParticipantIdsPerDomain).
   int max_participants_per_host = kParticipantIdsPerDomain;
   Discovery discovery = Discovery::kStaticPeers;
@@ -54,7 +59,8 @@ struct NetworkConfig {
   std::optional<ParticipantSecurity> security;
 
   /// Reads a `network:` map (interfaces, peers, shared_memory, shm_segment_bytes,
-  /// max_participants_per_host, discovery, discovery_servers) over `base`.
+  /// udp_buffer_bytes, udp_max_message_bytes, max_participants_per_host, discovery,
+  /// discovery_servers) over `base`.
   /// @throws std::invalid_argument on unknown keys, bad values or non-IPv4 addresses.
   static NetworkConfig from_yaml(const YAML::Node& node, NetworkConfig base);
   /// ... over the loopback default.

@@ -81,7 +81,7 @@ dds::DomainParticipantQos participant_qos(const std::string& name, const Network
   transport.use_builtin_transports = false;
   auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
   udp->interfaceWhiteList = net.interfaces;
-  const auto tuning = internal::udp_tuning_from_env();
+  const auto tuning = internal::udp_tuning(net);
   if (tuning.buffer_bytes != 0) {
     // Room for a 442 KB image in one burst (udp_tuning.hpp); the kernel caps it at
     // net.core.{w,r}mem_max, which is read-only inside a network namespace.
@@ -160,6 +160,12 @@ NetworkConfig NetworkConfig::from_yaml(const YAML::Node& node, NetworkConfig bas
       net.shared_memory = kv.second.as<bool>();
     } else if (key == "shm_segment_bytes") {
       net.shm_segment_bytes = kv.second.as<std::uint32_t>();
+    } else if (key == "udp_buffer_bytes") {
+      net.udp_buffer_bytes =
+          internal::udp_buffer_bytes("network.udp_buffer_bytes", kv.second.as<std::string>());
+    } else if (key == "udp_max_message_bytes") {
+      net.udp_max_message_bytes = internal::udp_max_message_bytes("network.udp_max_message_bytes",
+                                                                  kv.second.as<std::string>());
     } else if (key == "max_participants_per_host") {
       net.max_participants_per_host = kv.second.as<int>();
       if (net.max_participants_per_host < 1 ||
@@ -190,8 +196,8 @@ NetworkConfig NetworkConfig::from_yaml(const YAML::Node& node, NetworkConfig bas
     } else {
       throw std::invalid_argument(
           fmt::format("network: unknown key '{}' (allowed: interfaces, peers, shared_memory, "
-                      "shm_segment_bytes, max_participants_per_host, discovery, "
-                      "discovery_servers)",
+                      "shm_segment_bytes, udp_buffer_bytes, udp_max_message_bytes, "
+                      "max_participants_per_host, discovery, discovery_servers)",
                       key));
     }
   }
