@@ -259,6 +259,7 @@ void Registry::started(Tracked& m, const ModuleState& now) {
     }
   }
   resume_if_whole();
+  say_whom_the_system_runs_without();
   publish();
 }
 
@@ -290,6 +291,7 @@ void Registry::fail(Tracked& m, const std::string& reason, bool process_gone) {
     if (!go_on) return set_system("suspended", why);
     spdlog::warn("registry: {}; the rest runs on (host '{}' lost, on_lost: continue)", why,
                  m.spec->spec.host);
+    say_whom_the_system_runs_without();
   };
   const auto& policy = m.spec->restart;
   switch (policy.kind) {

@@ -164,21 +164,54 @@ bool Registry::left_behind(const Tracked& m) const {
   return false;
 }
 
+bool Registry::on_its_way_back(const Tracked& m) {
+  if (m.status != "starting" && m.status != "restarting" && m.status != "failed") return false;
+  const bool given_up = m.status == "failed" &&
+                        m.spec->restart.kind == RestartPolicy::Kind::kAuto &&
+                        m.spec->restart.continue_on_limit;
+  return !given_up;
+}
+
+std::vector<std::string> Registry::hosts_run_on_without() const {
+  std::vector<std::string> hosts;
+  for (const auto& m : modules_) {
+    const auto& host = m->spec->spec.host;
+    if (on_its_way_back(*m) && left_behind(*m) &&
+        std::find(hosts.begin(), hosts.end(), host) == hosts.end()) {
+      hosts.push_back(host);
+    }
+  }
+  return hosts;
+}
+
+namespace {
+std::string without_message(const char* verb, const std::vector<std::string>& hosts) {
+  return fmt::format("{} without the modules of lost host '{}' (on_lost: continue)", verb,
+                     fmt::join(hosts, "', '"));
+}
+}  // namespace
+
+// Whichever lapses first, a lost host's monitor or its modules' heartbeats, a running system
+// says that it runs on without them (and no longer "all modules announced").
+void Registry::say_whom_the_system_runs_without() {
+  if (state_ != "running") return;
+  const auto without = hosts_run_on_without();
+  if (!without.empty()) {
+    if (const auto message = without_message("running", without); message != message_) {
+      set_system("running", message);
+    }
+  } else if (running_without_) {
+    set_system("running", "all modules running again");
+  }
+  running_without_ = !without.empty();
+}
+
 // Resumes once no module is on its way back; a module given up (or replaced) no longer counts,
 // nor one left behind on a lost host that the system goes on without.
 void Registry::resume_if_whole() {
   if (state_ != "suspended") return;
-  std::vector<std::string> without;  // lost hosts the rest runs on without
   for (const auto& m : modules_) {
-    if (m->status != "starting" && m->status != "restarting" && m->status != "failed") continue;
-    const bool given_up = m->status == "failed" &&
-                          m->spec->restart.kind == RestartPolicy::Kind::kAuto &&
-                          m->spec->restart.continue_on_limit;
-    if (given_up) continue;
-    if (!left_behind(*m)) return;
-    if (std::find(without.begin(), without.end(), m->spec->spec.host) == without.end()) {
-      without.push_back(m->spec->spec.host);
-    }
+    if (on_its_way_back(*m) && !left_behind(*m)) return;
   }
   // A restarted module starts running (configured by --restore): only the others wait.
   std::vector<Tracked*> targets;
@@ -187,10 +220,10 @@ void Registry::resume_if_whole() {
   }
   const auto ok = configure_all(targets, CMD_RESUME);
   for (std::size_t i = 0; i < targets.size(); ++i) targets[i]->suspended = !ok[i];
-  set_system("running", without.empty() ? std::string("resumed")
-                                        : fmt::format("resumed without the modules of lost host "
-                                                      "'{}' (on_lost: continue)",
-                                                      fmt::join(without, "', '")));
+  const auto without = hosts_run_on_without();
+  set_system("running",
+             without.empty() ? std::string("resumed") : without_message("resumed", without));
+  running_without_ = !without.empty();
 }
 
 bool Registry::configure(const std::string& module, CommandKind kind,

@@ -83,6 +83,15 @@ class Registry {
   /// Whether `m` is on a lost host whose system file says `on_lost: continue`: the rest does not
   /// wait for it (it is restarted when the host is back).
   bool left_behind(const Tracked& m) const;
+  /// Whether `m` is not running but still counts: starting, restarting, or failed and not given
+  /// up under `continue_on_limit`.
+  static bool on_its_way_back(const Tracked& m);
+  /// The lost hosts the system runs on without (on_lost: continue): those of the modules left
+  /// behind that are on their way back.
+  std::vector<std::string> hosts_run_on_without() const;
+  /// While running: the message names the lost hosts the system runs on without, and says so
+  /// once their modules run again.
+  void say_whom_the_system_runs_without();
   void resume_if_whole();
   void recovered();
   bool configure(const std::string& module, CommandKind kind, std::vector<std::string> args);
@@ -103,7 +112,8 @@ class Registry {
   std::map<std::string, Monitor> monitors_;        // by host
   std::string state_ = "booting";
   std::string message_;
-  bool recovering_ = false;                   // until every module is back after a crash
+  bool running_without_ = false;  // the message names lost hosts (say_whom_the_system_runs_without)
+  bool recovering_ = false;       // until every module is back after a crash
   Clock::time_point recovery_since_{};        // when this registry started (recovering or not)
   std::map<std::string, long> reported_;      // by host: the monitor pid whose report came
   std::map<std::string, ModuleState> early_;  // recovering: states that came before adoption
