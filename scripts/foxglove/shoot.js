@@ -123,10 +123,11 @@ async function main() {
     ["/studio/", args.studio],
   ]);
   const origin = `http://127.0.0.1:${server.address().port}`;
+  const profile = fs.mkdtempSync(path.join(require("os").tmpdir(), "oscar-foxglove-shot-"));
   const browser = await puppeteer.launch({
     executablePath: args.chromium,
     headless: true,
-    userDataDir: fs.mkdtempSync(path.join(require("os").tmpdir(), "oscar-foxglove-shot-")),
+    userDataDir: profile,
     defaultViewport: { width: args.width, height: args.height },
     args: [
       "--no-sandbox", // runs as root in a container
@@ -193,6 +194,7 @@ async function main() {
     await sleep(args.settleS * 1000);
     await page.screenshot({ path: args.out });
     await page.click('[data-sidebar-key="connection"]'); // open again to read its problems
+    await sleep(1000);
     const foxglove = await foxgloveProblems(page);
     console.log(JSON.stringify({
       out: args.out,
@@ -205,6 +207,7 @@ async function main() {
   } finally {
     await browser.close();
     server.close();
+    fs.rmSync(profile, { recursive: true, force: true });
   }
 }
 
