@@ -7,7 +7,7 @@
 // bridge_client.js with its helpers.
 "use strict";
 const published = require("@foxglove/schemas/jsonschema");
-const { mismatch, undeclared, publishedDrift } = require("./schema_checks");
+const { mismatch, undeclared, publishedDrift, foxgloveParserRefuses } = require("./schema_checks");
 
 const CAM = "oscar/cue/cam/out", CAM_SIDE = "foxglove/cam/out", CAM_JPEG = "foxglove/cam/out/compressed";
 const ROBOT_SIDE = "foxglove/r7/state", GRAPH = "foxglove/system/graph";
@@ -71,9 +71,10 @@ async function checkCompressedImages(a, { check, until, sleep, figures, lastGrap
   const c = a.channels.get(CAM_JPEG);
   if (!check(c, `${CAM_JPEG} is advertised beside its source`)) return;
   const drift = publishedDrift(JSON.parse(c.schema), published.CompressedImage);
+  const refused = foxgloveParserRefuses(JSON.parse(c.schema));
   check(c.encoding === "json" && c.schemaEncoding === "jsonschema" && c.schemaName === "foxglove.CompressedImage" &&
-        drift.length === 0,
-        `${CAM_JPEG}: json, a jsonschema foxglove.CompressedImage that follows the published one (${c.encoding}, ${c.schemaEncoding}, ${c.schemaName}) ${drift.join("; ")}`);
+        drift.length === 0 && refused.length === 0,
+        `${CAM_JPEG}: json, a jsonschema foxglove.CompressedImage that follows the published one and Foxglove's parser takes (${c.encoding}, ${c.schemaEncoding}, ${c.schemaName}) ${drift.concat(refused).join("; ")}`);
   check(sideCounter(lastGraph(), CAM_JPEG) === 0, `before anyone subscribes, no JPEG is made (${sideCounter(lastGraph(), CAM_JPEG)})`);
   const sub = subscribeJson(a, CAM_JPEG);
   await until(() => a.received.get(sub).length >= 20, 10000);
@@ -109,13 +110,16 @@ async function checkSideChannels(a, { check, until, sleep, figures, imageComplet
     const c = a.channels.get(topic);
     if (!check(c, `${topic} is advertised beside its source`)) return;
     const drift = publishedDrift(JSON.parse(c.schema), published[name]);
+    const refused = foxgloveParserRefuses(JSON.parse(c.schema));
     check(c.encoding === "json" && c.schemaEncoding === "jsonschema" && c.schemaName === `foxglove.${name}` &&
-          drift.length === 0,
-          `${topic}: json, a jsonschema foxglove.${name} that follows the published one (${c.encoding}, ${c.schemaEncoding}, ${c.schemaName}) ${drift.join("; ")}`);
+          drift.length === 0 && refused.length === 0,
+          `${topic}: json, a jsonschema foxglove.${name} that follows the published one and Foxglove's parser takes (${c.encoding}, ${c.schemaEncoding}, ${c.schemaName}) ${drift.concat(refused).join("; ")}`);
   }
   const g = a.channels.get(GRAPH);
   if (!check(g && g.encoding === "json" && g.schemaEncoding === "jsonschema" && g.schemaName === "oscar.SystemGraph",
              `${GRAPH} is advertised: json, jsonschema oscar.SystemGraph`)) return;
+  const graphRefused = foxgloveParserRefuses(JSON.parse(g.schema));
+  check(graphRefused.length === 0, `Foxglove's parser takes the schema oscar.SystemGraph ${graphRefused.join("; ")}`);
 
   // The graph: every booted module with its state, kernels and wiring.
   const graphSub = subscribeJson(a, GRAPH);

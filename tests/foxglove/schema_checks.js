@@ -55,7 +55,8 @@ function undeclared(schema, value, path = "$") {
 // Where `ours` departs from Foxglove's `published` schema, one line each: a property ours
 // declares that the published one lacks at that path, a different type or content encoding, a
 // property the published one requires of an object ours declares that ours leaves out, another
-// title at the top. Empty if ours follows it.
+// title at the top. Empty if ours follows it. A list ours never fills (maxItems 0) declares only
+// its items' type, which must be the published one.
 function publishedDrift(ours, published, path = "$") {
   const problems = [];
   if (path === "$" && ours.title !== published.title) problems.push(`$: title ${ours.title}, published ${published.title}`);
@@ -75,12 +76,48 @@ function publishedDrift(ours, published, path = "$") {
   }
   if (ours.items) {
     if (!published.items) problems.push(`${path}[]: items, none in the published schema`);
-    else problems.push(...publishedDrift(ours.items, published.items, `${path}[]`));
+    else if (ours.maxItems === 0) {
+      // always empty: its items declare their type (Foxglove's parser needs it), no fields
+      if (ours.items.type !== published.items.type) {
+        problems.push(`${path}[]: type ${ours.items.type}, published ${published.items.type}`);
+      }
+      if (Object.keys(ours.items.properties || {}).length > 0) {
+        problems.push(`${path}[]: declares fields of items it never sends (maxItems 0)`);
+      }
+    } else problems.push(...publishedDrift(ours.items, published.items, `${path}[]`));
   }
   return problems;
 }
 
-module.exports = { mismatch, undeclared, publishedDrift };
+// What Foxglove's parser of a channel's JSON schema (its jsonschema message definitions) cannot
+// take, one line each: it reads only objects with "properties" whose fields are booleans,
+// strings, numbers, objects, lists of those (each list naming its item type) or number
+// alternatives (oneOf of consts), and refuses the whole channel ("Failed to parse channel schema")
+// otherwise. Empty if it can parse `schema`.
+function foxgloveParserRefuses(schema, path = "$") {
+  if (schema.type !== "object") return [`${path}: type ${schema.type}, not object`];
+  if (!schema.properties) return [`${path}: an object without properties`];
+  const problems = [];
+  for (const [k, sub] of Object.entries(schema.properties)) {
+    const at = `${path}.${k}`;
+    if (Array.isArray(sub.oneOf)) {
+      if (!sub.oneOf.every((a) => typeof a.const === "number")) problems.push(`${at}: oneOf of other than numbers`);
+    } else if (sub.type === "object") {
+      problems.push(...foxgloveParserRefuses(sub, at));
+    } else if (sub.type === "array") {
+      const t = sub.items && sub.items.type;
+      if (t === "object") problems.push(...foxgloveParserRefuses(sub.items, `${at}[]`));
+      else if (!["boolean", "string", "number", "integer"].includes(t)) problems.push(`${at}[]: item type ${t}`);
+    } else if (sub.type === "string") {
+      if (![undefined, "base64"].includes(sub.contentEncoding)) problems.push(`${at}: content encoding ${sub.contentEncoding}`);
+    } else if (!["boolean", "number", "integer"].includes(sub.type)) {
+      problems.push(`${at}: type ${sub.type}`);
+    }
+  }
+  return problems;
+}
+
+module.exports = { mismatch, undeclared, publishedDrift, foxgloveParserRefuses };
 
 if (require.main === module) {
   const fs = require("fs");
@@ -107,6 +144,12 @@ if (require.main === module) {
     retyped.properties[first].type = retyped.properties[first].type === "string" ? "integer" : "string";
     check(publishedDrift(renamed, theirs).length > 0 && publishedDrift(retyped, theirs).length > 0,
           `${name}: a renamed field or a changed type would be found`);
+    const refused = foxgloveParserRefuses(ours);
+    check(refused.length === 0, `${name}: Foxglove's parser of JSON schemas takes it` +
+          (refused.length ? `:\n       ${refused.join("\n       ")}` : ""));
+    const itemless = structuredClone(ours);
+    itemless.properties.a_list_ = { type: "array", maxItems: 0 };
+    check(foxgloveParserRefuses(itemless).length > 0, `${name}: a list without its item type would be found`);
     const list = messages[name] || [];
     check(list.length > 0, `${name}: ${list.length} messages from the bridge's encoders`);
     list.forEach((m, i) => {
