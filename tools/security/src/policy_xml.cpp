@@ -82,6 +82,13 @@ std::string topic_list(const char* element, const std::vector<std::string>& topi
 std::string governance_xml(SecuritySpec::CueProtection cue) {
   // The first rule whose expression matches a topic applies (Fast DDS and the spec): cue and pull
   // topics (which carry cues too) first, then every other topic.
+  //
+  // Discovery and liveliness messages are not transformed (kind NONE): every topic rule keeps
+  // enable_discovery_protection, so endpoints are still announced only on the secure discovery
+  // endpoints, which match authenticated participants alone. Signing or encrypting those
+  // announcements, once per receiver, was half the CPU of a secured 20-module boot (docs/
+  // benchmarks.md) and kept only topic names and QoS from whoever captures the network; the
+  // samples of every control topic stay signed and encrypted (docs/security.md, "Governance").
   return fmt::format(
       "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
       "<!-- Written by `oscar security init` from the system file: do not edit (it is signed). "
@@ -93,8 +100,8 @@ std::string governance_xml(SecuritySpec::CueProtection cue) {
       "      {}\n"
       "      <allow_unauthenticated_participants>false</allow_unauthenticated_participants>\n"
       "      <enable_join_access_control>true</enable_join_access_control>\n"
-      "      <discovery_protection_kind>ENCRYPT</discovery_protection_kind>\n"
-      "      <liveliness_protection_kind>ENCRYPT</liveliness_protection_kind>\n"
+      "      <discovery_protection_kind>NONE</discovery_protection_kind>\n"
+      "      <liveliness_protection_kind>NONE</liveliness_protection_kind>\n"
       "      <rtps_protection_kind>NONE</rtps_protection_kind>\n"
       "      <topic_access_rules>\n"
       "{}{}{}{}"

@@ -7,6 +7,13 @@ namespace oscar::security {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
+
+std::size_t count_of(const std::string& text, const std::string& part) {
+  std::size_t n = 0;
+  for (auto at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++n;
+  return n;
+}
 
 // The rule for `expression`, from its expression to its end.
 std::string rule_of(const std::string& governance, const std::string& expression) {
@@ -38,8 +45,16 @@ TEST(Governance, CueProtectionSetsTheCueAndPullRulesAndControlTopicsStayProtecte
                                                     "protection_kind>\n          <data_protection_"
                                                     "kind>ENCRYPT</"));
     EXPECT_THAT(governance, HasSubstr("<allow_unauthenticated_participants>false</"));
-    EXPECT_THAT(governance, HasSubstr("<discovery_protection_kind>ENCRYPT</"));
-    EXPECT_THAT(governance, HasSubstr("<liveliness_protection_kind>ENCRYPT</"));
+    EXPECT_THAT(governance, HasSubstr("<enable_join_access_control>true</"));
+    // Announcements are not transformed (half a secured boot's CPU), but every topic is still
+    // announced only on the secure discovery endpoints, to authenticated participants alone.
+    EXPECT_THAT(governance, HasSubstr("<discovery_protection_kind>NONE</"));
+    EXPECT_THAT(governance, HasSubstr("<liveliness_protection_kind>NONE</"));
+    EXPECT_THAT(governance, Not(HasSubstr("<enable_discovery_protection>false</")));
+    EXPECT_EQ(count_of(governance, "<enable_discovery_protection>true</"),
+              count_of(governance, "<topic_rule>"));
+    EXPECT_EQ(count_of(governance, "<enable_write_access_control>true</"),
+              count_of(governance, "<topic_rule>"));
     // The catch-all comes last: the first matching rule applies.
     EXPECT_GT(governance.find("<topic_expression>*</"), governance.find("oscar/pull/*/reply"));
   }
