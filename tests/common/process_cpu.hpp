@@ -4,16 +4,15 @@
 
 #include <unistd.h>
 
-#include <fstream>
-#include <iterator>
 #include <sstream>
 #include <string>
+
+#include "proc.hpp"
 
 namespace oscar::test {
 
 inline double cpu_seconds(long pid) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
-  const std::string stat((std::istreambuf_iterator<char>(in)), {});
+  const auto stat = proc_file(pid, "stat");
   const auto after_name = stat.rfind(')');  // the name may hold spaces and parentheses
   if (after_name == std::string::npos) return 0;
   std::istringstream fields(stat.substr(after_name + 2));

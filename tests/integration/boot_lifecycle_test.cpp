@@ -182,9 +182,9 @@ TEST(Boot, ASecondCtrlCAbortsAShutdownThatHangs) {
   // A registry that does not react: the orderly shutdown would wait for it.
   std::vector<long> registry;
   for (const auto pid : test::processes_mentioning(sys.file())) {
-    std::ifstream in("/proc/" + std::to_string(pid) + "/cmdline");
-    const std::string cmd((std::istreambuf_iterator<char>(in)), {});
-    if (cmd.find("oscar-registry") != std::string::npos) registry.push_back(pid);
+    if (test::proc_file(pid, "cmdline").find("oscar-registry") != std::string::npos) {
+      registry.push_back(pid);
+    }
   }
   ASSERT_EQ(registry.size(), 1u);
   ASSERT_EQ(kill(static_cast<pid_t>(registry[0]), SIGSTOP), 0);

@@ -11,6 +11,7 @@
 
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/testing/booted_system.hpp"
+#include "proc.hpp"     // tests/common
 #include "process.hpp"  // tests/common
 
 namespace oscar::test {
@@ -99,13 +100,8 @@ inline bool alive(long pid) {
 /// Pids of processes whose command line mentions `text`.
 inline std::vector<long> processes_mentioning(const std::string& text) {
   std::vector<long> out;
-  for (const auto& e : std::filesystem::directory_iterator("/proc")) {
-    const auto name = e.path().filename().string();
-    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
-    std::ifstream in(e.path() / "cmdline");
-    std::string cmd((std::istreambuf_iterator<char>(in)), {});
-    if (cmd.find(text) != std::string::npos && alive(std::stol(name)))
-      out.push_back(std::stol(name));
+  for (const long pid : listed_pids()) {
+    if (proc_file(pid, "cmdline").find(text) != std::string::npos && alive(pid)) out.push_back(pid);
   }
   return out;
 }

@@ -38,8 +38,7 @@ std::uint64_t sink_cycles(const SystemState& s) {
 // The pid of the system's discovery server `index` (its command line names the system file).
 long server_pid(const std::string& file, int index) {
   for (const auto pid : test::processes_mentioning(file)) {
-    std::ifstream in("/proc/" + std::to_string(pid) + "/cmdline");
-    std::string cmd((std::istreambuf_iterator<char>(in)), {});
+    const auto cmd = test::proc_file(pid, "cmdline");
     if (cmd.find("oscar-discovery-server") != std::string::npos &&
         cmd.find(std::string("--index") + '\0' + std::to_string(index) + '\0') !=
             std::string::npos) {

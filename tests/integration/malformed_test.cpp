@@ -111,9 +111,9 @@ TEST(MalformedSamples, AModuleDropsABoolWhoseValueByteIs2AndTakesTheNextCues) {
 std::vector<long> registries_of(const test::BootedSystem& system) {
   std::vector<long> out;
   for (const long pid : test::processes_mentioning(system.file())) {
-    std::ifstream in("/proc/" + std::to_string(pid) + "/cmdline");
-    std::string cmd((std::istreambuf_iterator<char>(in)), {});
-    if (cmd.find("oscar-registry") != std::string::npos) out.push_back(pid);
+    if (test::proc_file(pid, "cmdline").find("oscar-registry") != std::string::npos) {
+      out.push_back(pid);
+    }
   }
   return out;
 }

@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "proc.hpp"     // tests/common
 #include "process.hpp"  // tests/common
 #include "test_hosts.hpp"
 
@@ -109,14 +110,13 @@ modules:
   // The pids of processes of this system whose command line has all of `words`.
   std::vector<long> processes_with(const std::vector<std::string>& words) const {
     std::vector<long> pids;
-    for (const auto& e : std::filesystem::directory_iterator("/proc")) {
-      std::ifstream in(e.path() / "cmdline");
-      const std::string cmd((std::istreambuf_iterator<char>(in)), {});
+    for (const long pid : test::listed_pids()) {
+      const auto cmd = test::proc_file(pid, "cmdline");
       if (cmd.find(file_) == std::string::npos) continue;
       if (std::all_of(words.begin(), words.end(), [&](const std::string& w) {
             return cmd.find(w + '\0') != std::string::npos;
           })) {
-        pids.push_back(std::stol(e.path().filename()));
+        pids.push_back(pid);
       }
     }
     return pids;
@@ -125,13 +125,12 @@ modules:
   // The pids of the monitors of `host` (not the `ip netns exec` that started one).
   std::vector<long> monitors_of(const std::string& host) const {
     std::vector<long> pids;
-    for (const auto& e : std::filesystem::directory_iterator("/proc")) {
-      std::ifstream in(e.path() / "cmdline");
-      const std::string cmd((std::istreambuf_iterator<char>(in)), {});
+    for (const long pid : test::listed_pids()) {
+      const auto cmd = test::proc_file(pid, "cmdline");
       if (cmd.find("oscar-monitor") != std::string::npos && cmd.find(file_) != std::string::npos &&
           cmd.find(host + '\0') != std::string::npos &&
           cmd.find("ip\0netns", 0, 8) == std::string::npos) {
-        pids.push_back(std::stol(e.path().filename()));
+        pids.push_back(pid);
       }
     }
     return pids;

@@ -14,6 +14,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "proc.hpp"     // tests/common
 #include "process.hpp"  // tests/common
 #include "ssh_hosts.hpp"
 #include "test_hosts.hpp"
@@ -31,18 +32,14 @@ std::string read(const std::string& path) {
 // Live processes whose command line holds every one of `parts` (separated by NULs there).
 std::vector<pid_t> processes_with(const std::vector<std::string>& parts) {
   std::vector<pid_t> out;
-  for (const auto& e : std::filesystem::directory_iterator("/proc")) {
-    const auto name = e.path().filename().string();
-    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
-    std::ifstream in(e.path() / "cmdline");
-    const std::string cmd((std::istreambuf_iterator<char>(in)), {});
-    std::ifstream stat(e.path() / "stat");
-    std::string line;
-    std::getline(stat, line);
-    if (line.empty() || line[line.rfind(')') + 2] == 'Z') continue;
+  for (const long pid : test::listed_pids()) {
+    const auto cmd = test::proc_file(pid, "cmdline");
+    const auto stat = test::proc_file(pid, "stat");
+    const auto close = stat.rfind(')');
+    if (close == std::string::npos || close + 2 >= stat.size() || stat[close + 2] == 'Z') continue;
     bool all = !cmd.empty();
     for (const auto& p : parts) all = all && cmd.find(p) != std::string::npos;
-    if (all) out.push_back(static_cast<pid_t>(std::stol(name)));
+    if (all) out.push_back(static_cast<pid_t>(pid));
   }
   return out;
 }
@@ -51,8 +48,7 @@ std::vector<pid_t> processes_with(const std::vector<std::string>& parts) {
 std::string command_lines(const std::vector<pid_t>& pids) {
   std::string out;
   for (const auto pid : pids) {
-    std::ifstream in("/proc/" + std::to_string(pid) + "/cmdline");
-    std::string cmd((std::istreambuf_iterator<char>(in)), {});
+    auto cmd = test::proc_file(pid, "cmdline");
     std::replace(cmd.begin(), cmd.end(), '\0', ' ');
     out += std::to_string(pid) + ": " + cmd + "\n";
   }
