@@ -85,7 +85,13 @@ Module::Module(ModuleSpec spec, const std::vector<std::string>& plugin_path)
   wire_in_process();
 }
 
-Module::~Module() { stop(); }
+Module::~Module() {
+  stop();
+  // A pull source in this process watches its producer's output: it goes before any output.
+  for (auto& s : slots_) {
+    for (auto& input : s->instance->ports().inputs) input->set_pull_source(nullptr);
+  }
+}
 
 KernelInstance& Module::kernel(const std::string& name) {
   for (auto& s : slots_) {
@@ -182,7 +188,8 @@ std::string Module::connect(InputPort& input, const std::string& source,
     if (input.transfer() == Transfer::kPush) {
       output->connect(&input);  // also checks the reliability the input declares
     } else {
-      input.set_pull_source(std::make_shared<internal::RingPullSource>(output->buffer(), input));
+      input.set_pull_source(
+          std::make_shared<internal::RingPullSource>(output->buffer(), input, output));
     }
     for (auto& s : slots_) {
       for (auto& out : s->instance->ports().outputs) {

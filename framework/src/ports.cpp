@@ -78,8 +78,14 @@ std::shared_ptr<PullSource> InputPort::pull_source() {
   return source;
 }
 
-std::shared_future<std::shared_ptr<const void>> InputPort::request(PullQuery query, Stamp t) {
-  return pull_source()->request(query, t);
+std::shared_future<std::shared_ptr<const void>> InputPort::request(PullQuery query, Stamp t,
+                                                                   std::chrono::nanoseconds wait) {
+  if (wait < std::chrono::nanoseconds::zero() || wait > kMaxPullWait) {
+    throw std::invalid_argument(fmt::format(
+        "input '{}/{}': a pull may ask the producer to wait 0 to {} s, not {} ms", kernel_, name_,
+        kMaxPullWait.count(), std::chrono::duration<double, std::milli>(wait).count()));
+  }
+  return pull_source()->request(query, t, wait);
 }
 
 std::shared_future<CueBlock> InputPort::request(const PullBlock& block) {

@@ -2,56 +2,40 @@
 // Pulls answered from a ring buffer in this process: the producer's output ring buffer in a
 // multi-core module, or what a harness fed. The answer also lands in the consumer's ring.
 
+#include <mutex>
+
+#include "held_pulls.hpp"
 #include "oscar/input.hpp"
+#include "oscar/output.hpp"
 
 namespace oscar::internal {
 
 class RingPullSource final : public PullSource {
  public:
-  RingPullSource(const RingBuffer& producer, InputPort& consumer)
-      : producer_(producer), consumer_(consumer) {}
+  /// Answers from `producer`. A pull for a cue not there yet (PullQuery::kAtOrAfter) is held
+  /// until `output` takes one: `output` owns `producer` and must outlive this source. Without an
+  /// output (a harness's ring) such a pull is answered at the end of its wait, from the ring.
+  RingPullSource(const RingBuffer& producer, InputPort& consumer, OutputPort* output = nullptr);
+  /// Stops watching the output; held pulls are answered with nothing.
+  ~RingPullSource() override;
 
-  std::shared_future<std::shared_ptr<const void>> request(PullQuery query, Stamp t) override {
-    std::optional<RingEntry> e;
-    switch (query) {
-      case PullQuery::kLatest:
-        e = producer_.latest();
-        break;
-      case PullQuery::kAtOrBefore:
-        e = producer_.at_or_before(t);
-        break;
-      case PullQuery::kNearest:
-        e = producer_.nearest(t);
-        break;
-    }
-    std::promise<std::shared_ptr<const void>> answer;
-    if (e) {
-      consumer_.buffer().push(e->cue, e->t, wall_now());
-      answer.set_value(e->cue);
-    } else {
-      answer.set_value(nullptr);
-    }
-    return answer.get_future().share();
-  }
-
-  std::shared_future<CueBlock> request(const PullBlock& block) override {
-    const auto entries = block.kind == PullBlock::Kind::kLatest
-                             ? producer_.latest(block.n)
-                             : producer_.range(block.t0, block.t1);
-    CueBlock cues;
-    cues.reserve(entries.size());
-    for (const auto& e : entries) {
-      consumer_.buffer().push(e.cue, e.t, wall_now());
-      cues.push_back(e.cue);
-    }
-    std::promise<CueBlock> answer;
-    answer.set_value(std::move(cues));
-    return answer.get_future().share();
-  }
+  std::shared_future<std::shared_ptr<const void>> request(PullQuery query, Stamp t,
+                                                          std::chrono::nanoseconds wait) override;
+  std::shared_future<CueBlock> request(const PullBlock& block) override;
+  /// Pulls held now, waiting for a cue.
+  std::size_t held() const { return held_.held(); }
 
  private:
+  void watch_output();  // once, before the first pull is held
+
   const RingBuffer& producer_;
   InputPort& consumer_;
+  OutputPort* output_;
+  // Connected to the output like a push input: its arrival hook, on the publishing thread,
+  // answers the held pulls the new cue matches.
+  InputPort watcher_;
+  std::once_flag watching_;
+  HeldPulls held_;  // declared last: destroyed (answering what is held) before the watcher
 };
 
 }  // namespace oscar::internal

@@ -319,6 +319,109 @@ kernels:
   EXPECT_FALSE(in.pull_at(all[0].t - 1)) << "nothing at or before a time older than the ring";
 }
 
+const char* const kPullingModule = R"(
+name: pulling
+mode: single_step
+kernels:
+  - { type: test_counter, name: src, mode: { single_step: { trigger: command } } }
+  - { type: test_collect, name: sink, inputs: { in: { source: src/out, transfer: prefetch } }, mode: deactivated }
+)";
+
+// A producer whose generation stamps the test sets; write() returns once the output handed the
+// cue to every consumer (a probe, connected last, has it), held pulls included.
+struct StampedProducer {
+  Module& m;
+  OutputPort& out;
+  InputPort probe{"test", "probe", cue_type_info<Bool>(), {}};
+  std::atomic<Stamp> stamp_next{1'000};
+  explicit StampedProducer(Module& module)
+      : m(module), out(*module.kernel("src").ports().find_output("out")) {
+    out.set_clock([this] { return stamp_next.load(); });
+  }
+  ~StampedProducer() { out.disconnect(&probe); }
+  void write(Stamp t) {
+    stamp_next = t;
+    out.disconnect(&probe);
+    out.connect(&probe);  // last of the consumers
+    const auto before = probe.buffer().pushed();
+    m.apply(command(CMD_TRIGGER, {"src"}));
+    ASSERT_TRUE(eventually([&] { return probe.buffer().pushed() == before + 1; }));
+  }
+};
+
+TEST(Module, APullForACueAtOrAfterATimeIsAnsweredWhenTheProducerWritesOne) {
+  Module m(spec(kPullingModule), {});
+  m.start(-1);
+  StampedProducer src(m);
+  auto& in = kernel_of<test::Collect>(m, "sink").in_;
+  src.write(1'000);
+  const auto future = in.prefetch(PullQuery::kAtOrAfter, 2'000, 10s);
+  EXPECT_FALSE(future.ready()) << "the producer holds no cue generated at or after 2000";
+  src.write(1'500);
+  EXPECT_FALSE(future.ready()) << "a cue older than asked does not answer it";
+  src.write(2'500);
+  ASSERT_TRUE(future.ready()) << "answered where the output took the matching cue";
+  const auto cue = future.get(0s);
+  ASSERT_TRUE(cue);
+  EXPECT_EQ(cue->header().seq(), 3u);
+  EXPECT_EQ(in.latest(), cue) << "the answer lands in the input's ring too";
+}
+
+TEST(Module, APullForACueAtOrAfterATimeIsAnsweredAtOnceIfTheProducerHoldsOne) {
+  Module m(spec(kPullingModule), {});
+  m.start(-1);
+  StampedProducer src(m);
+  auto& in = kernel_of<test::Collect>(m, "sink").in_;
+  for (const Stamp t : {1'000, 2'000, 3'000}) src.write(t);
+  const auto future = in.prefetch(PullQuery::kAtOrAfter, 1'500, 10s);
+  ASSERT_TRUE(future.ready());
+  EXPECT_EQ(future.get(0s)->header().seq(), 2u) << "the first cue generated at or after 1500";
+  EXPECT_FALSE(in.prefetch(PullQuery::kAtOrAfter, 3'001).get(0s)) << "no wait: answered empty";
+}
+
+TEST(Module, APullForACueAtOrAfterATimeIsAnsweredEmptyWhenItsWaitIsUp) {
+  Module m(spec(kPullingModule), {});
+  m.start(-1);
+  StampedProducer src(m);
+  auto& in = kernel_of<test::Collect>(m, "sink").in_;
+  src.write(1'000);
+  const auto future = in.prefetch(PullQuery::kAtOrAfter, 2'000, 50ms);
+  EXPECT_FALSE(future.get(10s)) << "nothing";
+  EXPECT_TRUE(future.ready()) << "answered (empty), not left waiting";
+  EXPECT_EQ(in.buffer().size(), 0u);
+}
+
+TEST(Module, HeldPullsAreBoundedPerInputAndTheirWait) {
+  Module m(spec(kPullingModule), {});
+  m.start(-1);
+  auto& in = kernel_of<test::Collect>(m, "sink").in_;
+  std::vector<CueFuture<Bool>> held;
+  for (std::size_t i = 0; i < kMaxHeldPulls; ++i) {
+    held.push_back(in.prefetch(PullQuery::kAtOrAfter, 1'000, 10s));
+  }
+  EXPECT_THAT([&] { in.prefetch(PullQuery::kAtOrAfter, 1'000, 10s); },
+              ThrowsMessage<std::length_error>(HasSubstr("a producer holds at most 16 per input")));
+  EXPECT_THAT([&] { in.prefetch(PullQuery::kAtOrAfter, 1'000, 11s); },
+              ThrowsMessage<std::invalid_argument>(
+                  HasSubstr("a pull may ask the producer to wait 0 to 10 s, not 11000 ms")));
+  StampedProducer src(m);
+  src.write(1'000);
+  for (const auto& f : held) EXPECT_TRUE(f.ready()) << "one cue answers every held pull";
+  EXPECT_NO_THROW(in.prefetch(PullQuery::kAtOrAfter, 5'000, 10s)) << "room again";
+}
+
+TEST(Module, HeldPullsAreAnsweredEmptyWhenTheProducersModuleStops) {
+  std::optional<CueFuture<Bool>> future;
+  {
+    Module m(spec(kPullingModule), {});
+    m.start(-1);
+    future = kernel_of<test::Collect>(m, "sink").in_.prefetch(PullQuery::kAtOrAfter, 1'000, 10s);
+    EXPECT_FALSE(future->ready());
+  }
+  ASSERT_TRUE(future->ready()) << "answered when the module went, not at the end of its wait";
+  EXPECT_FALSE(future->get(0s));
+}
+
 std::vector<std::uint64_t> seqs(const std::vector<Input<Bool>::Ptr>& cues) {
   std::vector<std::uint64_t> out;
   for (const auto& c : cues) out.push_back(c->header().seq());

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <thread>
 
 #include <fmt/format.h>
 
@@ -12,13 +11,18 @@
 #include "perception_geometry.hpp"
 
 namespace oscar::modules {
+namespace {
+// How long after wait_b the fusion still waits for the producer's answer (it travels back).
+constexpr std::chrono::milliseconds kAnswerSlack{50};
+}  // namespace
 
 void LandmarkPoseFusion::Params::describe(ParamSpec& spec) {
   spec.field("tag_layout", tag_layout, "tags on the target 'id:x,y,z;...' (target frame, m)");
   spec.field("max_skew", max_skew, "B's image may be this much older than A's (newer: any)")
       .at_least(0);
-  spec.field("wait_b", wait_b, "pull/prefetch: how long to ask B for this cycle's result")
-      .at_least(0);
+  spec.field("wait_b", wait_b,
+             "pull/prefetch: how long B's frame holds the ask for this cycle's result")
+      .range(0, static_cast<double>(kMaxPullWait.count()));
   spec.field("log_every", log_every, "log a summary this often (0 = never)").at_least(0);
 }
 
@@ -35,29 +39,21 @@ void LandmarkPoseFusion::on_params_changed() {
   for (const auto& t : parse_tag_layout(params_.tag_layout)) layout_[t.id] = t.offset_m;
 }
 
-// B's newest detections, if its image was taken at most max_skew before A's (on one host B's
-// image is taken after A's; across hosts B is triggered first, just before A). With push they
-// are in the ring already (on one host MarkBDetect runs before this kernel). With pull or
-// prefetch (B on another host, seed 004 §4.2) B may still be working on this cycle's image: ask
-// again until wait_b is up.
+// B's detections, if its image was taken at most max_skew before A's (on one host B's image is
+// taken after A's; across hosts B is triggered first, just before A). With push they are in the
+// ring already (on one host MarkBDetect runs before this kernel). With pull or prefetch (B on
+// another host, seed 004 §4.2) B may still be working on this cycle's image: the producer holds
+// the request until B's first result from an image at most max_skew older than A's is there, up
+// to wait_b, and answers it then.
 Input<TagDetections>::Ptr LandmarkPoseFusion::matching_b(Stamp acquired) {
-  const auto matches = [&](const Input<TagDetections>::Ptr& b) {
-    return b && generation_stamp(b->header()) >= acquired - params_.max_skew.count();
-  };
+  const Stamp oldest = acquired - params_.max_skew.count();
   if (tags_b_.transfer() == Transfer::kPush) {
     auto b = tags_b_.latest();
-    return matches(b) ? b : nullptr;
+    return b && generation_stamp(b->header()) >= oldest ? b : nullptr;
   }
-  const auto deadline = std::chrono::steady_clock::now() + params_.wait_b;
-  for (;;) {
-    auto future = tags_b_.prefetch(PullQuery::kLatest);
-    const auto left = deadline - std::chrono::steady_clock::now();
-    auto b = future.get(std::max<std::chrono::nanoseconds>(left, std::chrono::nanoseconds(0)));
-    if (matches(b)) return b;
-    if (std::chrono::steady_clock::now() >= deadline) return nullptr;
-    // B's result for this cycle is not there yet; a short pause keeps the asking gentle.
-    std::this_thread::sleep_for(std::chrono::microseconds(200));
-  }
+  // The producer answers (empty) when the wait is up; a little longer here covers the way back.
+  return tags_b_.prefetch(PullQuery::kAtOrAfter, oldest, params_.wait_b)
+      .get(params_.wait_b + kAnswerSlack);
 }
 
 void LandmarkPoseFusion::add_estimates(const TagDetections& tags,

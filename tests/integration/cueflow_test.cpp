@@ -267,6 +267,99 @@ kernels:
   EXPECT_EQ(image->dx(), 768);
 }
 
+ConfigCommand trigger_command(const std::string& kernel) {
+  ConfigCommand c;
+  c.id(1);
+  c.sender("coordinator");
+  c.kind(CMD_TRIGGER);
+  c.args({kernel});
+  return c;
+}
+
+// The producer and the consumer are two modules with a participant each: the pull crosses DDS
+// (the producer's frame holds it) as between processes, and the test sets the stamps.
+TEST(CueFlow, APullAtOrAfterATimeAcrossDdsIsAnsweredWhenTheProducerWritesAMatchingCue) {
+  std::atomic<Stamp> stamp_next{1'000};  // the producer's clock: it stamps its next cue so
+  auto producer = local_module(R"(
+name: src
+mode: single_step
+kernels: [ { type: test_counter, name: src, mode: { single_step: { trigger: command } } } ]
+)");
+  auto consumer = local_module(R"(
+name: consumer
+mode: deactivated
+kernels:
+  - { type: test_collect, name: sink, inputs: { in: { source: src/out, transfer: prefetch } } }
+)");
+  auto& out = *producer->kernel("src").ports().find_output("out");
+  out.set_clock([&] { return stamp_next.load(); });
+  const auto write = [&](Stamp t) {
+    stamp_next = t;
+    const auto before = out.published();
+    producer->apply(trigger_command("src"));
+    ASSERT_TRUE(eventually([&] { return out.published() == before + 1; }));
+  };
+  auto& in = collect(*consumer, "sink").in_;
+  write(1'000);
+  ASSERT_TRUE(eventually([&] { return in.pull() != nullptr; })) << "the pull path is open";
+  // Requests and replies of one input travel in order: an answered pull after another request
+  // shows the producer has that one, and a reply sent before would be here.
+  const auto future = in.prefetch(PullQuery::kAtOrAfter, 2'000, 10s);
+  ASSERT_TRUE(in.pull());
+  EXPECT_FALSE(future.ready()) << "the producer holds no cue generated at or after 2000";
+  write(1'500);
+  ASSERT_TRUE(in.pull());
+  EXPECT_FALSE(future.ready()) << "a cue older than asked does not answer it";
+  write(2'500);
+  const auto cue = future.get(10s);
+  ASSERT_TRUE(cue) << "answered when the producer wrote the matching cue";
+  EXPECT_EQ(static_cast<Stamp>(cue->header().stamps()[0]), 2'500);
+
+  const auto there = in.prefetch(PullQuery::kAtOrAfter, 1'200, 10s).get(10s);
+  ASSERT_TRUE(there) << "a cue already there answers at once";
+  EXPECT_EQ(static_cast<Stamp>(there->header().stamps()[0]), 1'500) << "the first at or after";
+
+  const auto empty = in.prefetch(PullQuery::kAtOrAfter, 3'000, 50ms);
+  EXPECT_FALSE(empty.get(10s));
+  EXPECT_TRUE(empty.ready()) << "answered empty at the end of its wait";
+
+  std::vector<CueFuture<Bool>> held;
+  for (std::size_t i = 0; i < kMaxHeldPulls; ++i) {
+    held.push_back(in.prefetch(PullQuery::kAtOrAfter, 4'000, 10s));
+  }
+  EXPECT_THROW(in.prefetch(PullQuery::kAtOrAfter, 4'000, 10s), std::length_error);
+  write(4'000);
+  for (const auto& f : held) EXPECT_TRUE(f.get(10s)) << "one cue answers every held pull";
+}
+
+TEST(CueFlow, APullHeldByAProducerInAnotherProcessIsAnsweredEmptyWhenItStops) {
+  auto src = test::run_module("src", {"-k", "bench_source:src", "-m", "single_step:command"});
+  auto consumer = local_module(R"(
+name: consumer
+mode: deactivated
+kernels:
+  - { type: test_collect, name: sink, inputs: { in: { source: src/out, transfer: prefetch } } }
+)");
+  auto& in = collect(*consumer, "sink").in_;
+  ASSERT_TRUE(eventually(
+      [&] {
+        const auto probe = in.prefetch(PullBlock::latest(0));  // a pull of nothing, answered
+        return eventually([&] { return probe.ready(); }, 200ms);
+      },
+      20s))
+      << "the pull path is open\n"
+      << src->output();
+  const auto future = in.prefetch(PullQuery::kAtOrAfter, 0, 10s);  // it has published nothing
+  EXPECT_TRUE(in.pull_latest(1).empty()) << "(an answered pull: the producer has the request)";
+  EXPECT_FALSE(future.ready());
+  const auto asked = std::chrono::steady_clock::now();
+  src->stop();
+  EXPECT_FALSE(future.get(10s));
+  EXPECT_TRUE(future.ready());
+  EXPECT_LT(std::chrono::steady_clock::now() - asked, 9s)
+      << "answered when the producer stopped, not at the end of the wait";
+}
+
 TEST(CueFlow, RewireMidStreamLosesNothingAfterTheSwitch) {
   auto a = test::run_module("a", {"-k", "bench_source:a", "-m", "continuous:3ms"});
   auto b = test::run_module("b", {"-k", "bench_source:b", "-m", "continuous:3ms"});

@@ -28,7 +28,18 @@ const char* to_string(Transfer t);
 Transfer parse_transfer(std::string_view text);
 
 /// Which cue of the producer's ring a pull asks for.
-enum class PullQuery { kLatest, kAtOrBefore, kNearest };
+enum class PullQuery {
+  kLatest,      ///< the newest cue
+  kAtOrBefore,  ///< the newest cue generated at or before t
+  kNearest,     ///< the cue generated nearest to t
+  kAtOrAfter    ///< the first cue generated at or after t; the producer holds the request until
+                ///< such a cue is in its ring, up to the pull's wait, and then answers nothing
+};
+
+/// The longest wait a pull may ask the producer to hold it (PullQuery::kAtOrAfter).
+inline constexpr std::chrono::seconds kMaxPullWait{10};
+/// How many held pulls (PullQuery::kAtOrAfter) one consumer input may have at a producer at once.
+inline constexpr std::size_t kMaxHeldPulls = 16;
 
 /// Which cues of the producer's ring a block pull asks for: its n newest, or those generated in
 /// [t0, t1]. The answer is oldest first.
@@ -77,8 +88,11 @@ struct InputOverrides {
 class PullSource {
  public:
   virtual ~PullSource() = default;
-  /// Resolves to the cue, or to nullptr if the producer holds none that matches.
-  virtual std::shared_future<std::shared_ptr<const void>> request(PullQuery query, Stamp t) = 0;
+  /// Resolves to the cue, or to nullptr if the producer holds none that matches (for
+  /// kAtOrAfter: none within `wait`).
+  /// @throws std::length_error if kMaxHeldPulls of this input's pulls are held already.
+  virtual std::shared_future<std::shared_ptr<const void>> request(
+      PullQuery query, Stamp t, std::chrono::nanoseconds wait) = 0;
   /// Resolves to the cues of the block, oldest first (none if the producer holds none).
   virtual std::shared_future<CueBlock> request(const PullBlock& block) = 0;
 };
@@ -111,9 +125,13 @@ class InputPort {
   /// Called after every delivery, on the delivering thread (the frame triggers kernels with it).
   void set_arrival_hook(std::function<void()> hook);
   void set_pull_source(std::shared_ptr<PullSource> source);
-  /// Asks the producer; the answer is also stored in the ring buffer.
+  /// Asks the producer; the answer is also stored in the ring buffer. A kAtOrAfter query is held
+  /// by the producer up to `wait` (other queries are answered at once).
   /// @throws std::logic_error if the input is not connected to a producer.
-  std::shared_future<std::shared_ptr<const void>> request(PullQuery query, Stamp t);
+  /// @throws std::invalid_argument if `wait` is negative or longer than kMaxPullWait.
+  /// @throws std::length_error if kMaxHeldPulls of this input's pulls are held already.
+  std::shared_future<std::shared_ptr<const void>> request(PullQuery query, Stamp t,
+                                                          std::chrono::nanoseconds wait = {});
   /// Asks the producer for a block of cues; the answer is also stored in the ring buffer.
   /// @throws std::logic_error if the input is not connected to a producer.
   /// @throws std::invalid_argument for a range whose start is after its end.
@@ -219,14 +237,20 @@ class Input final : public InputPort {
   Ptr pull(std::chrono::nanoseconds timeout = std::chrono::seconds(1)) {
     return CueFuture<T>(request(PullQuery::kLatest, 0)).get(timeout);
   }
-  /// Pulls the producer's cue at or before (or nearest to) t.
+  /// Pulls the producer's cue at or before (or nearest to, or first at or after) t. For
+  /// kAtOrAfter the producer holds the pull up to `timeout` (at most kMaxPullWait).
   Ptr pull_at(Stamp t, PullQuery query = PullQuery::kAtOrBefore,
               std::chrono::nanoseconds timeout = std::chrono::seconds(1)) {
-    return CueFuture<T>(request(query, t)).get(timeout);
+    const auto wait = query == PullQuery::kAtOrAfter ? timeout : std::chrono::nanoseconds{};
+    return CueFuture<T>(request(query, t, wait)).get(timeout);
   }
-  /// Starts a pull and returns at once (prefetch transfer).
-  CueFuture<T> prefetch(PullQuery query = PullQuery::kLatest, Stamp t = 0) {
-    return CueFuture<T>(request(query, t));
+  /// Starts a pull and returns at once (prefetch transfer). `wait`: how long the producer may
+  /// hold a kAtOrAfter pull for a matching cue (at most kMaxPullWait); then it answers nothing.
+  /// @throws std::invalid_argument if `wait` is negative or longer than kMaxPullWait.
+  /// @throws std::length_error if kMaxHeldPulls of this input's pulls are held already.
+  CueFuture<T> prefetch(PullQuery query = PullQuery::kLatest, Stamp t = 0,
+                        std::chrono::nanoseconds wait = {}) {
+    return CueFuture<T>(request(query, t, wait));
   }
   /// Pulls the producer's n newest cues, oldest first (fewer if its ring holds fewer); none if it
   /// has none or did not answer in time.

@@ -94,13 +94,19 @@ std::vector<RingEntry> answer(const RingBuffer& ring, const PullRequest& request
       const auto t1 = static_cast<Stamp>(request.t1_ns());
       return t <= t1 ? ring.range(t, t1) : std::vector<RingEntry>{};  // inverted: nothing
     }
+    case PULL_AT_OR_AFTER:
+      return one(first_at_or_after(ring, t));  // a request with no wait (held ones: hold())
   }
   return {};  // a kind this version does not know
 }
 }  // namespace
 
 DdsPullServer::DdsPullServer(DdsParticipant& participant, OutputPort& output)
-    : participant_(participant), output_(output) {
+    : participant_(participant),
+      output_(output),
+      watcher_(output.kernel(), output.name() + " (held pulls)", output.type(),
+               InputOptions{.depth = 1}),
+      held_(std::make_unique<HeldPulls>(output.buffer())) {
   register_requester_filter(participant);  // before the writer meets a filtered reader
   const auto replies = topics::pull_reply(output.address());
   const auto requests = topics::pull_request(output.address());
@@ -115,8 +121,34 @@ DdsPullServer::DdsPullServer(DdsParticipant& participant, OutputPort& output)
 }
 
 DdsPullServer::~DdsPullServer() {
-  participant_.subscriber().delete_datareader(requests_);
+  participant_.subscriber().delete_datareader(requests_);  // no new requests
+  output_.disconnect(&watcher_);                           // no new answers from the output
+  held_.reset();  // answers what is held: empty, while the reply writer is still there
   participant_.publisher().delete_datawriter(replies_);
+}
+
+void DdsPullServer::hold(const PullRequest& request) {
+  auto answer = [this, requester = request.requester(),
+                 id = request.id()](std::optional<RingEntry> e) {
+    PullReply reply;
+    reply.requester(requester);
+    reply.id(id);
+    if (e) reply.cues().emplace_back().cdr(output_.type().serialize(e->cue.get()));
+    replies_->write(&reply);
+  };
+  const auto wait = std::chrono::nanoseconds(request.wait_ns());
+  if (wait > kMaxPullWait) return answer(std::nullopt);  // the consumer's side refuses it first
+  std::call_once(watching_, [this] {
+    watcher_.set_arrival_hook([this] {
+      if (auto e = watcher_.buffer().latest()) held_->arrived(*e);
+    });
+    output_.connect(&watcher_);
+  });
+  try {
+    held_->ask(request.requester(), static_cast<Stamp>(request.t_ns()), wait, answer);
+  } catch (const std::length_error&) {
+    answer(std::nullopt);  // beyond its requester's limit (the consumer's side refuses it first)
+  }
 }
 
 void DdsPullServer::on_data_available(dds::DataReader* reader) {
@@ -124,6 +156,10 @@ void DdsPullServer::on_data_available(dds::DataReader* reader) {
   dds::SampleInfo info;
   while (take_next(*reader, &request, info) == ReturnCode_t::RETCODE_OK) {
     if (!info.valid_data) continue;
+    if (request.query() == PULL_AT_OR_AFTER && request.wait_ns() > 0) {
+      hold(request);
+      continue;
+    }
     PullReply reply;
     reply.requester(request.requester());
     reply.id(request.id());
@@ -201,25 +237,65 @@ bool DdsPullSource::wait_matched(std::chrono::milliseconds timeout) {
   }
 }
 
-void DdsPullSource::send(PullRequest& request, Pending pending) {
+void DdsPullSource::send(PullRequest& request, Pending pending, std::chrono::nanoseconds held_for) {
   request.requester(requester_);
   {
     std::lock_guard lock(mutex_);
+    const bool held = held_for > std::chrono::nanoseconds::zero();
+    if (held) make_room_to_hold_locked();
     request.id(next_id_++);
+    if (held) held_.emplace(request.id(), std::chrono::steady_clock::now() + held_for);
     pending_.emplace(request.id(), std::move(pending));
   }
   requests_->write(&request);
 }
 
-std::shared_future<std::shared_ptr<const void>> DdsPullSource::request(PullQuery query, Stamp t) {
+void DdsPullSource::make_room_to_hold_locked() {
+  // A producer that went away answers nothing: a held request unanswered well after its wait
+  // ended is answered empty here, so it neither blocks its asker nor counts against the limit.
+  const auto now = std::chrono::steady_clock::now();
+  for (auto it = held_.begin(); it != held_.end();) {
+    if (it->second + std::chrono::seconds(1) < now) {
+      if (auto p = pending_.find(it->first); p != pending_.end()) {
+        std::get<std::promise<std::shared_ptr<const void>>>(p->second).set_value(nullptr);
+        pending_.erase(p);
+      }
+      it = held_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  if (held_.size() >= kMaxHeldPulls) {
+    throw std::length_error(
+        fmt::format("pull of {} refused: {} of its pulls wait for a cue already, and a producer "
+                    "holds at most {} per input",
+                    requester_, held_.size(), kMaxHeldPulls));
+  }
+}
+
+std::shared_future<std::shared_ptr<const void>> DdsPullSource::request(
+    PullQuery query, Stamp t, std::chrono::nanoseconds wait) {
   PullRequest request;
-  request.query(query == PullQuery::kLatest       ? PULL_LATEST
-                : query == PullQuery::kAtOrBefore ? PULL_AT_OR_BEFORE
-                                                  : PULL_NEAREST);
+  switch (query) {
+    case PullQuery::kLatest:
+      request.query(PULL_LATEST);
+      break;
+    case PullQuery::kAtOrBefore:
+      request.query(PULL_AT_OR_BEFORE);
+      break;
+    case PullQuery::kNearest:
+      request.query(PULL_NEAREST);
+      break;
+    case PullQuery::kAtOrAfter:
+      request.query(PULL_AT_OR_AFTER);
+      request.wait_ns(static_cast<unsigned long long>(std::max(wait.count(), std::int64_t{0})));
+      break;
+  }
   request.t_ns(static_cast<unsigned long long>(t));
   std::promise<std::shared_ptr<const void>> promise;
   auto answer = promise.get_future().share();
-  send(request, std::move(promise));
+  send(request, std::move(promise),
+       query == PullQuery::kAtOrAfter ? wait : std::chrono::nanoseconds::zero());
   return answer;
 }
 
@@ -264,6 +340,7 @@ void DdsPullSource::on_data_available(dds::DataReader* reader) {
       input_.buffer().push(cue, generation_stamp(input_.type().header(cue.get())), wall_now());
     }
     std::lock_guard lock(mutex_);
+    held_.erase(reply.id());
     if (auto it = pending_.find(reply.id()); it != pending_.end()) {
       if (auto* one = std::get_if<std::promise<std::shared_ptr<const void>>>(&it->second)) {
         one->set_value(cues.empty() ? nullptr : cues.front());

@@ -71,6 +71,26 @@ TEST(LandmarkPose, PrefetchesBFromItsProducer) {
   EXPECT_NEAR(out->spread_m(), 0.01, 1e-12);
 }
 
+TEST(LandmarkPose, WithPrefetchAnOlderResultOfBIsNotTakenAndTheWaitEndsWithAAlone) {
+  KernelHarness h("landmark_pose", YAML::Load("{wait_b: 20ms, max_skew: 10ms}"), "pose",
+                  {{"tags_b", InputOverrides{.depth = {}, .transfer = Transfer::kPrefetch}}});
+  h.feed("tags_b", tags("cam_b", 0.1, 1, {0.5, 0, 1}, 1'000'000'000));
+  h.feed("tags_a", tags("cam_a", 0.0, 0, {-0.08, 0, 2}, 1'100'000'000));  // 100 ms later
+  h.step();  // asks B for its first result at most 10 ms older than A's image: none in 20 ms
+  const auto out = h.take<oscar::LandmarkPose>("pose").at(0);
+  EXPECT_EQ(out->estimates(), 1u);
+  EXPECT_THAT(out->cameras(), ElementsAre("cam_a"));
+}
+
+TEST(LandmarkPose, AWaitForBLongerThanAProducerHoldsAPullIsRefused) {
+  try {
+    KernelHarness h("landmark_pose", YAML::Load("{wait_b: 11s}"));
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("wait_b"));
+  }
+}
+
 TEST(LandmarkPose, TagsOutsideTheLayoutOrWithoutPoseAreNoEstimates) {
   KernelHarness h("landmark_pose", YAML::Load("{tag_layout: '4:0,0,0'}"));
   h.feed("tags_a", tags("cam_a", 0, 0, {0, 0, 1}, 1));
