@@ -80,9 +80,13 @@ void HeldPulls::expire_until_stopped() {
       changed_.wait(lock);
       continue;
     }
-    const auto first = std::min_element(
-        held_.begin(), held_.end(), [](const Held& a, const Held& b) { return a.until < b.until; });
-    if (changed_.wait_until(lock, first->until) == std::cv_status::no_timeout) continue;
+    // A copy: wait_until() reads its deadline again after waking, and while it waits (unlocked)
+    // arrived() may answer and free the pull it came from.
+    const auto until =
+        std::min_element(held_.begin(), held_.end(), [](const Held& a, const Held& b) {
+          return a.until < b.until;
+        })->until;
+    if (changed_.wait_until(lock, until) == std::cv_status::no_timeout) continue;
     std::list<Held> ended;
     const auto now = std::chrono::steady_clock::now();
     for (auto it = held_.begin(); it != held_.end();) {
