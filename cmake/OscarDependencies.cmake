@@ -21,8 +21,10 @@ if(NOT TARGET oscar_deps::ompl)
   target_link_libraries(oscar_deps::ompl INTERFACE ${OSCAR_OMPL_LIBRARY} Boost::boost)
 endif()
 
+# GoogleTest also without the tests: oscar::testing (the kernel conformance suite and the
+# booted-system fixture for modules' own tests) is part of the installed package.
+find_package(GTest REQUIRED)
 if(OSCAR_BUILD_TESTS)
-  find_package(GTest REQUIRED)
   include(GoogleTest)
 endif()
 
