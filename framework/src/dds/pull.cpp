@@ -123,7 +123,11 @@ DdsPullServer::DdsPullServer(DdsParticipant& participant, OutputPort& output)
 DdsPullServer::~DdsPullServer() {
   participant_.subscriber().delete_datareader(requests_);  // no new requests
   output_.disconnect(&watcher_);                           // no new answers from the output
+  const bool answered = held_->held() > 0;
   held_.reset();  // answers what is held: empty, while the reply writer is still there
+  // A writer deleted at once drops what its readers have not acknowledged: those answers would
+  // be lost, and their consumers would wait out their whole wait.
+  if (answered) replies_->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(0, 500'000'000));
   participant_.publisher().delete_datawriter(replies_);
 }
 
