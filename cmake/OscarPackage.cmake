@@ -3,7 +3,7 @@
 # generator, oscar_add_module() and oscar_add_system_test().
 include(CMakePackageConfigHelpers)
 
-install(TARGETS oscar_types oscar_framework oscar_run_main oscar_testing oscar_command_line
+install(TARGETS oscar_types oscar_plain_types oscar_framework oscar_run_main oscar_testing oscar_command_line
   oscar_registry
   EXPORT oscarTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}

@@ -5,6 +5,7 @@
 #include "oscar/cue_type_info.hpp"
 #include "oscar/cue_types.hpp"
 #include "oscar/perception_types.hpp"
+#include "oscar/plain_cue_types.hpp"
 #include "oscar/swarm_types.hpp"
 
 namespace oscar {
@@ -42,6 +43,18 @@ std::vector<std::string> cue_type_names() {
   return names;
 }
 
+CueHeaderLayout cue_header_layout(const std::string& type_name) {
+  register_plain_cue_types();
+  const auto* type = find_cue_type(type_name);
+  return type ? type->header.layout : CueHeaderLayout::kSequences;
+}
+
+void register_plain_cue_types() {
+  cue_type_info<PlainBool>();
+  cue_type_info<PlainLineSeg3DSeq>();
+  cue_type_info<PlainGvImage>();
+}
+
 void register_standard_cue_types() {
   cue_type_info<Bool>();
   cue_type_info<LineSeg3DSeq>();
@@ -51,6 +64,7 @@ void register_standard_cue_types() {
   cue_type_info<LandmarkPose>();
   cue_type_info<RobotState>();
   cue_type_info<SafetyViolation>();
+  register_plain_cue_types();
 }
 
 }  // namespace oscar

@@ -61,7 +61,7 @@ InputPort& KernelHarness::input_port(const std::string& name) {
 
 void KernelHarness::feed_erased(InputPort& port, const CueTypeInfo& type,
                                 std::shared_ptr<const void> cue) {
-  produced_.at(port.name())->push(cue, generation_stamp(type.header(cue.get())), now_);
+  produced_.at(port.name())->push(cue, type.header.generation_stamp(cue.get()), now_);
   if (port.transfer() == Transfer::kPush) port.deliver_from(type, std::move(cue));
 }
 

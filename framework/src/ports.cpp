@@ -38,7 +38,7 @@ InputPort::InputPort(std::string kernel, std::string name, const CueTypeInfo& ty
       buffer_(options.depth) {}
 
 void InputPort::deliver(std::shared_ptr<const void> cue) {
-  const Stamp t = generation_stamp(type_.header(cue.get()));
+  const Stamp t = type_.header.generation_stamp(cue.get());
   buffer_.push(std::move(cue), t, wall_now());
   std::function<void()> hook;
   {
@@ -100,26 +100,31 @@ OutputPort::OutputPort(std::string kernel, std::string name, const CueTypeInfo& 
       type_(type),
       options_(options),
       buffer_(options.depth),
-      clock_(&wall_now) {}
+      clock_(&wall_now) {
+  // Checked now, where the address is known: the header's source holds it on every cue.
+  if (address().size() > type_.header.max_source_length) {
+    throw std::invalid_argument(fmt::format(
+        "output '{}' ({}): its address has {} characters, but a {} cue's header holds a source "
+        "of at most {}; shorten the kernel's or the output's name",
+        address(), type_.name, address().size(), type_.name, type_.header.max_source_length));
+  }
+}
 
 void OutputPort::publish_erased(std::shared_ptr<void> cue) {
-  // The header is a const view in CueTypeInfo; the cue is still ours to complete here.
-  auto& header = const_cast<CueHeader&>(type_.header(cue.get()));
   std::lock_guard lock(mutex_);
-  header.seq(++seq_);
+  type_.header.complete(cue.get(), ++seq_, address(), clock_());
   if (persisted_seq_) *persisted_seq_ = seq_;
-  header.source(address());
-  if (header.stamps().empty()) header.stamps().push_back(static_cast<unsigned long long>(clock_()));
   std::shared_ptr<const void> frozen = std::move(cue);
   // The cue evicted from the ring is freed at the end, after the cue is on its way.
-  const auto evicted = buffer_.push(frozen, generation_stamp(header), wall_now());
+  const auto evicted =
+      buffer_.push(frozen, type_.header.generation_stamp(frozen.get()), wall_now());
   for (auto* input : consumers_) input->deliver_from(type_, frozen);
   if (remote_) remote_(frozen.get());
 }
 
 void OutputPort::forward_erased(std::shared_ptr<const void> cue) {
   std::lock_guard lock(mutex_);
-  const auto evicted = buffer_.push(cue, generation_stamp(type_.header(cue.get())), wall_now());
+  const auto evicted = buffer_.push(cue, type_.header.generation_stamp(cue.get()), wall_now());
   for (auto* input : consumers_) input->deliver_from(type_, cue);
   if (remote_) remote_(cue.get());
 }

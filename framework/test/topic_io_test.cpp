@@ -30,5 +30,12 @@ TEST(CueQos, AnInputThatReadsBestEffortDoesSoFromAReliableProducer) {
   EXPECT_EQ(reader.reliability().kind, dds::BEST_EFFORT_RELIABILITY_QOS);
 }
 
+TEST(CueQos, CuesTravelSerializedWithoutFastDdsDataSharing) {
+  // Fast DDS's default (automatic) would share the plain types' cues through /dev/shm pools.
+  EXPECT_EQ(qos::cue_writer(OutputOptions{}).data_sharing().kind(), dds::OFF);
+  EXPECT_EQ(qos::cue_reader(OutputOptions{}, 16, Reliability::kAsProducer).data_sharing().kind(),
+            dds::OFF);
+}
+
 }  // namespace
 }  // namespace oscar

@@ -38,7 +38,7 @@ std::string header_text(const std::string& topic, const std::vector<std::uint8_t
                      : topic.find("/lines/") != std::string::npos ? cue_type_info<LineSeg3DSeq>()
                                                                   : cue_type_info<Bool>();
   const auto cue = info.deserialize(bytes);
-  const auto& h = info.header(cue.get());
+  const auto h = info.header.read(cue.get());
   return fmt::format("{} #{} @ {}", h.source(), h.seq(), fmt::join(h.stamps(), " "));
 }
 

@@ -2,7 +2,9 @@
 /// @file What makes a type a cue, and the run-time description the framework keeps of each.
 
 #include <concepts>
+#include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -15,12 +17,24 @@ class TopicDataType;
 
 namespace oscar {
 
-/// A cue type is an IDL struct whose first member is `CueHeader header` (docs/architecture.md,
-/// "Topics and QoS classes").
+/// The fixed-size header of the plain cue types (oscar/plain_cues.idl; declared with its cue
+/// types in oscar/plain_cue_types.hpp): the CueHeader's meaning, bounded.
+class PlainCueHeader;
+
+/// A reference to one of the two headers a cue may start with.
+template <class R>
+concept CueHeaderRef = std::same_as<R, CueHeader&> || std::same_as<R, PlainCueHeader&>;
+template <class R>
+concept ConstCueHeaderRef =
+    std::same_as<R, const CueHeader&> || std::same_as<R, const PlainCueHeader&>;
+
+/// A cue type is an IDL struct whose first member is its header: `CueHeader header`
+/// (docs/architecture.md, "Topics and QoS classes"), or `PlainCueHeader header` for the plain
+/// types (docs/zero_copy.md).
 template <class T>
 concept CueType = requires(T cue, const T ccue) {
-  { cue.header() } -> std::same_as<CueHeader&>;
-  { ccue.header() } -> std::same_as<const CueHeader&>;
+  { cue.header() } -> CueHeaderRef;
+  { ccue.header() } -> ConstCueHeaderRef;
 };
 
 /// Compile-time facts about a cue type; specialised by OSCAR_DECLARE_CUE_TYPE.
@@ -30,15 +44,40 @@ struct CueTraits;
 template <class T>
 struct IdlTraits;
 
+/// How a header lies in CDR: CueHeader's length-prefixed stamps and source, or PlainCueHeader's
+/// fixed arrays (8 stamps, a count, 64 characters).
+enum class CueHeaderLayout : std::uint8_t { kSequences, kFixed };
+
+/// What the framework does with a cue's header without knowing the cue's type or its header's
+/// form: read the generation stamp, complete the header on publish, read it for tools.
+struct CueHeaderAccess {
+  CueHeaderLayout layout = CueHeaderLayout::kSequences;
+  /// The first stamp (generation time), 0 if there is none.
+  std::int64_t (*generation_stamp)(const void* cue) = nullptr;
+  /// The stamps, source and seq as a CueHeader value (a copy): what raw inputs and tools read.
+  CueHeader (*read)(const void* cue) = nullptr;
+  /// On publish: sets seq and source, and `stamp` as the generation stamp if there is none.
+  /// The source must fit (max_source_length; outputs check it when they are declared).
+  void (*complete)(void* cue, std::uint64_t seq, const std::string& source,
+                   std::int64_t stamp) = nullptr;
+  /// The longest source ("<kernel>/<channel>") the header holds.
+  std::size_t max_source_length = std::numeric_limits<std::size_t>::max();
+};
+
+/// How the framework reads and completes a header of type H; specialised below for CueHeader
+/// and in oscar/plain_cue_types.hpp for PlainCueHeader.
+template <class H>
+struct CueHeaderForm;
+
 /// What the framework needs to move a cue type it does not know at compile time.
 struct CueTypeInfo {
   std::string name;  ///< the DDS type name, e.g. "oscar::GvImage"
-  eprosima::fastdds::dds::TopicDataType* (*new_topic_type)();
-  const CueHeader& (*header)(const void* cue);
-  std::shared_ptr<void> (*make)();
-  std::vector<std::uint8_t> (*serialize)(const void* cue);
+  eprosima::fastdds::dds::TopicDataType* (*new_topic_type)() = nullptr;
+  CueHeaderAccess header{};
+  std::shared_ptr<void> (*make)() = nullptr;
+  std::vector<std::uint8_t> (*serialize)(const void* cue) = nullptr;
   /// @throws std::runtime_error if the bytes are not a valid CDR encoding of the type.
-  std::shared_ptr<void> (*deserialize)(const std::vector<std::uint8_t>& bytes);
+  std::shared_ptr<void> (*deserialize)(const std::vector<std::uint8_t>& bytes) = nullptr;
 };
 
 /// Registers (or finds) the description of a type by name; used by cue_type_info<T>().
@@ -47,6 +86,10 @@ const CueTypeInfo& register_cue_type(CueTypeInfo info);
 const CueTypeInfo* find_cue_type(const std::string& name);
 /// Names of all registered types, sorted.
 std::vector<std::string> cue_type_names();
+/// How the header of a cue of that DDS type name lies in CDR: the registered type's layout
+/// (the plain types are always registered), kSequences for a type this process does not know
+/// (every other OSCAR cue type starts with a CueHeader).
+CueHeaderLayout cue_header_layout(const std::string& type_name);
 
 /// The first stamp of a header (its generation time), or 0 if it has none.
 inline std::int64_t generation_stamp(const CueHeader& h) {
@@ -57,6 +100,21 @@ inline std::int64_t generation_stamp(const CueHeader& h) {
 inline void append_stamp(CueHeader& h, std::int64_t stamp) {
   h.stamps().push_back(static_cast<unsigned long long>(stamp));
 }
+
+template <>
+struct CueHeaderForm<CueHeader> {
+  static constexpr CueHeaderLayout kLayout = CueHeaderLayout::kSequences;
+  static constexpr std::size_t kMaxSourceLength = std::numeric_limits<std::size_t>::max();
+  static std::int64_t generation_stamp(const CueHeader& h) { return oscar::generation_stamp(h); }
+  static std::size_t stamp_count(const CueHeader& h) { return h.stamps().size(); }
+  static CueHeader read(const CueHeader& h) { return h; }
+  static void complete(CueHeader& h, std::uint64_t seq, const std::string& source,
+                       std::int64_t stamp) {
+    h.seq(seq);
+    h.source(source);
+    if (h.stamps().empty()) append_stamp(h, stamp);
+  }
+};
 
 }  // namespace oscar
 

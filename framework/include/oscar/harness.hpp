@@ -7,6 +7,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "oscar/kernel_instance.hpp"
@@ -33,7 +34,8 @@ class KernelHarness {
       throw std::invalid_argument("harness: input '" + input + "' takes " + port.type().name +
                                   ", not " + type.name);
     }
-    if (cue.header().stamps().empty()) append_stamp(cue.header(), now_);
+    using Form = CueHeaderForm<std::remove_cvref_t<decltype(cue.header())>>;
+    if (Form::stamp_count(cue.header()) == 0) append_stamp(cue.header(), now_);
     feed_erased(port, type, std::make_shared<const T>(std::move(cue)));
   }
 

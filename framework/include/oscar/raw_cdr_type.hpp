@@ -18,13 +18,17 @@ class RawCdrType final : public eprosima::fastdds::dds::TopicDataType {
   explicit RawCdrType(const std::string& type_name);
   /// Writes RawCue::cdr as it is.
   bool serialize(void* data, eprosima::fastrtps::rtps::SerializedPayload_t* payload) override;
-  /// Fills a RawCue: this type's name, the payload and the header read from it.
+  /// Fills a RawCue: this type's name, the payload and the header read from it (laid out as
+  /// the type's name says: cue_header_layout()).
   bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data) override;
   std::function<std::uint32_t()> getSerializedSizeProvider(void* data) override;
   void* createData() override;
   void deleteData(void* data) override;
   bool getKey(void* data, eprosima::fastrtps::rtps::InstanceHandle_t* handle,
               bool force_md5) override;
+
+ private:
+  CueHeaderLayout layout_ = CueHeaderLayout::kSequences;
 };
 
 }  // namespace oscar

@@ -341,7 +341,7 @@ void DdsPullSource::on_data_available(dds::DataReader* reader) {
       cues.clear();  // a malformed reply answers "nothing", never garbage
     }
     for (const auto& cue : cues) {
-      input_.buffer().push(cue, generation_stamp(input_.type().header(cue.get())), wall_now());
+      input_.buffer().push(cue, input_.type().header.generation_stamp(cue.get()), wall_now());
     }
     std::lock_guard lock(mutex_);
     held_.erase(reply.id());

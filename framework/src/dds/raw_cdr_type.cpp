@@ -6,7 +6,7 @@
 
 namespace oscar {
 
-RawCdrType::RawCdrType(const std::string& type_name) {
+RawCdrType::RawCdrType(const std::string& type_name) : layout_(cue_header_layout(type_name)) {
   setName(type_name.c_str());
   // The reader's history reallocates for bigger samples; this is only the initial size.
   m_typeSize = 4096;
@@ -27,7 +27,7 @@ bool RawCdrType::deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payl
   auto& s = *static_cast<RawCue*>(data);
   s.type = getName();
   s.cdr.assign(payload->data, payload->data + payload->length);
-  s.cue_header = read_cue_header(s.cdr).value_or(CueHeader{});
+  s.cue_header = read_cue_header(s.cdr, layout_).value_or(CueHeader{});
   return true;
 }
 

@@ -13,9 +13,7 @@ const CueTypeInfo& raw_cue_type() {
         // A raw input's topic type is the producer's (RawCdrType under its name), never this.
         throw std::logic_error("oscar::RawCue has no DDS type of its own");
       },
-      .header = [](const void* cue) -> const CueHeader& {
-        return static_cast<const RawCue*>(cue)->header();
-      },
+      .header = cue_header_access<RawCue>(),
       .make = []() -> std::shared_ptr<void> { return std::make_shared<RawCue>(); },
       .serialize = [](const void* cue) { return static_cast<const RawCue*>(cue)->cdr; },
       .deserialize = [](const std::vector<std::uint8_t>&) -> std::shared_ptr<void> {
@@ -29,7 +27,7 @@ std::shared_ptr<const RawCue> to_raw_cue(const CueTypeInfo& type, const void* cu
   auto raw = std::make_shared<RawCue>();
   raw->type = type.name;
   raw->cdr = type.serialize(cue);
-  raw->cue_header = type.header(cue);
+  raw->cue_header = type.header.read(cue);
   return raw;
 }
 

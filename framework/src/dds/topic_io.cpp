@@ -101,6 +101,11 @@ dds::DataWriterQos cue_writer(const OutputOptions& o) {
   q.durability().kind =
       o.transient_local ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
   q.publish_mode().kind = dds::SYNCHRONOUS_PUBLISH_MODE;
+  // Cues travel serialized through DDS. Fast DDS would otherwise share the cues of a plain
+  // (bounded) type with same-host readers through a pool file per writer in /dev/shm
+  // (fast_datasharing_<guid>, depth x 442 KB for PlainGvImage) that stays when the process is
+  // killed; the same-host zero-copy path is iceoryx's (docs/zero_copy.md).
+  q.data_sharing().off();
   return q;
 }
 
@@ -113,6 +118,7 @@ dds::DataReaderQos cue_reader(const OutputOptions& producer, std::size_t depth, 
   q.history().depth = static_cast<std::int32_t>(std::max<std::size_t>(depth, 1));
   q.durability().kind =
       producer.transient_local ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
+  q.data_sharing().off();  // as cue_writer
   return q;
 }
 

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "dds/cdr_cursor.hpp"
+#include "dds/plain_header_cdr.hpp"
 #include "oscar/cue.hpp"
 
 namespace oscar::internal {
@@ -52,10 +53,48 @@ std::optional<std::string> check_line_seg_3d_seq(std::span<const std::uint8_t> p
   return check_count(*cdr, 48, 8, "lines", lines);
 }
 
+// A plain cue (oscar/plain_cues.idl): its arrays have fixed sizes, so nothing is allocated for
+// a count; the header's stamp count and source are checked (a consumer trusts them).
+std::optional<std::string> check_plain_cue(std::span<const std::uint8_t> payload) {
+  auto cdr = CdrCursor::open(payload);
+  if (!cdr) return "it has no CDR encapsulation";
+  return read_plain_header(*cdr, nullptr);
+}
+
+// Reads a count of valid elements after the plain header and checks it against the array's
+// size: a consumer indexes the array with it.
+std::optional<std::string> check_plain_count(CdrCursor& cdr, std::uint64_t most, const char* what) {
+  std::uint64_t count = 0;
+  if (!cdr.read(4, count)) return fmt::format("it ends before its {}", what);
+  if (count > most) return fmt::format("its {} is {}, but it holds at most {}", what, count, most);
+  return std::nullopt;
+}
+
+// oscar::PlainLineSeg3DSeq: the plain header, line_count (at most 256), the lines.
+std::optional<std::string> check_plain_line_seg_3d_seq(std::span<const std::uint8_t> payload) {
+  auto cdr = CdrCursor::open(payload);
+  if (!cdr) return "it has no CDR encapsulation";
+  if (auto why = read_plain_header(*cdr, nullptr)) return why;
+  return check_plain_count(*cdr, 256, "line_count");
+}
+
+// oscar::PlainGvImage: the plain header, dx, dy (2 bytes each), byte_count (at most 768 x 576).
+std::optional<std::string> check_plain_gv_image(std::span<const std::uint8_t> payload) {
+  auto cdr = CdrCursor::open(payload);
+  if (!cdr) return "it has no CDR encapsulation";
+  if (auto why = read_plain_header(*cdr, nullptr)) return why;
+  std::uint64_t dx = 0, dy = 0;
+  if (!cdr->read(2, dx) || !cdr->read(2, dy)) return "it ends before its dx and dy";
+  return check_plain_count(*cdr, 768 * 576, "byte_count");
+}
+
 }  // namespace
 
 WireCheck wire_check(const std::string& type_name) {
   if (type_name == "oscar::LineSeg3DSeq") return &check_line_seg_3d_seq;
+  if (type_name == "oscar::PlainLineSeg3DSeq") return &check_plain_line_seg_3d_seq;
+  if (type_name == "oscar::PlainGvImage") return &check_plain_gv_image;
+  if (cue_header_layout(type_name) == CueHeaderLayout::kFixed) return &check_plain_cue;
   if (find_cue_type(type_name)) return &check_cue;
   return nullptr;
 }

@@ -16,7 +16,9 @@ namespace oscar::internal {
 using WireCheck = std::optional<std::string> (*)(std::span<const std::uint8_t> payload);
 
 /// The check for the type of that DDS name, or nullptr if there is none: every cue type's
-/// header (its stamps sequence) is checked, and oscar::LineSeg3DSeq's lines too.
+/// header is checked (a CueHeader's stamps sequence; a PlainCueHeader's stamp count and source),
+/// oscar::LineSeg3DSeq's lines too, and the counts of valid lines and pixels of
+/// oscar::PlainLineSeg3DSeq and oscar::PlainGvImage.
 WireCheck wire_check(const std::string& type_name);
 
 }  // namespace oscar::internal

@@ -234,6 +234,15 @@ class Decoder {
       case IdlType::Kind::kArray: {
         const auto n = t.kind == IdlType::Kind::kSequence ? uint(4, 4) : t.array_size;
         const auto& e = *t.element;
+        // A char array (a plain cue's source): its text up to the first NUL.
+        if (t.kind == IdlType::Kind::kArray && e.kind == IdlType::Kind::kPrimitive &&
+            e.name == "char") {
+          need(n);
+          const auto* chars = reinterpret_cast<const char*>(body_.data() + at_);
+          out += fmt::format("\"{}\"", std::string(chars, std::find(chars, chars + n, '\0')));
+          at_ += n;
+          break;
+        }
         const bool scalar = e.kind != IdlType::Kind::kStruct || is_enum(e);
         if (scalar) {
           out += "[";
@@ -291,9 +300,10 @@ class Decoder {
       const auto start = out.size();
       value(m.type, indent, out, false);
       // A cue header's stamps: the generation time in UTC, readably.
-      if (name == "oscar::CueHeader" && m.name == "stamps" && out.size() > start + 2) {
+      if ((name == "oscar::CueHeader" || name == "oscar::PlainCueHeader") && m.name == "stamps" &&
+          out.size() > start + 2) {
         const auto first = out.substr(start + 1, out.find_first_of(",]", start) - start - 1);
-        if (!first.empty() && std::isdigit(static_cast<unsigned char>(first[0])))
+        if (!first.empty() && first != "0" && std::isdigit(static_cast<unsigned char>(first[0])))
           out += "  # generated " + utc_text(std::stoull(first));
       }
     }

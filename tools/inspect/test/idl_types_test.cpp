@@ -11,6 +11,7 @@
 #include "oscar/cue_types.hpp"
 #include "oscar/idl_texts.hpp"
 #include "oscar/perception_types.hpp"
+#include "oscar/plain_cue_types.hpp"
 
 namespace oscar::inspect {
 namespace {
@@ -47,6 +48,22 @@ TEST(IdlTypes, ShowsABoolCueWithItsHeader) {
             "header:\n"
             "  stamps: [1700000000123456789, 1700000000200000000]  # generated "
             "2023-11-14T22:13:20.123456789Z\n"
+            "  source: \"sig/out\"\n"
+            "  seq: 42\n"
+            "value: true");
+}
+
+TEST(IdlTypes, ShowsAPlainCueWithItsFixedHeaderAndTheSourceAsText) {
+  PlainBool b;
+  append_stamp(b.header(), 1'700'000'000'123'456'789);
+  set_source(b.header(), "sig/out");
+  b.header().seq(42);
+  b.value(true);
+  EXPECT_EQ(oscar_types().to_text("oscar::PlainBool", bytes_of(b), {}),
+            "header:\n"
+            "  stamps: [1700000000123456789, 0, 0, 0, 0, 0, 0, 0]  # generated "
+            "2023-11-14T22:13:20.123456789Z\n"
+            "  stamp_count: 1\n"
             "  source: \"sig/out\"\n"
             "  seq: 42\n"
             "value: true");
