@@ -4,6 +4,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -145,6 +147,39 @@ hosts:
   const auto static_net = NetworkConfig::for_host(YAML::Load("{hosts: {}}"), "");
   EXPECT_EQ(static_net.discovery, Discovery::kStaticPeers);
   EXPECT_TRUE(static_net.discovery_servers.empty());
+}
+
+TEST(ParticipantIds, ASystemOfSeveralHostsProbesAsManyAsItsBusiestHostHolds) {
+  const auto system = YAML::Load(R"(
+hosts:
+  base: { local: true, address: 10.77.0.1 }
+  scooter: { netns: scooter, address: 10.77.0.2 }
+modules:
+  - { name: a, host: base }
+  - { name: b, host: scooter }
+  - { name: c, host: scooter }
+  - { name: d, host: scooter }
+coordinator: { host: base, applets: [ { type: t, name: x }, { type: t, name: y } ] }
+)");
+  // scooter's 3 modules, the coordinator and its 2 applets (counted on every host), and room.
+  const int expected = 3 + 1 + 2 + kParticipantsBesideModules;
+  EXPECT_EQ(NetworkConfig::for_host(system, "base").max_participants_per_host, expected);
+  EXPECT_EQ(NetworkConfig::for_host(system, "scooter").max_participants_per_host, expected);
+  BuiltinAttributes builtin;
+  internal::configure_discovery(builtin, NetworkConfig::for_host(system, "base"), 3);
+  const auto to_scooter =
+      std::count_if(builtin.initialPeersList.begin(), builtin.initialPeersList.end(),
+                    [](const Locator_t& l) { return IPLocator::toIPv4string(l) == "10.77.0.2"; });
+  EXPECT_EQ(to_scooter, expected) << "base announces itself to that many ids of scooter";
+
+  auto set = YAML::Clone(system);
+  set["network"]["max_participants_per_host"] = 50;
+  EXPECT_EQ(NetworkConfig::for_host(set, "scooter").max_participants_per_host, 50)
+      << "the file's network: decides";
+  const auto one_host = YAML::Load("{modules: [ { name: a } ]}");
+  EXPECT_EQ(NetworkConfig::for_host(one_host, "").max_participants_per_host,
+            kParticipantIdsPerDomain)
+      << "on loopback a participant announces itself only to the ids claimed there";
 }
 
 TEST(DiscoveryServers, AModulesParticipantIsAPlainClientAndOnlyIt) {

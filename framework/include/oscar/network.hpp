@@ -22,6 +22,10 @@ struct ParticipantSecurity {
 /// Participant ids one domain has on one address: RTPS gives a domain 250 ports (spec 9.6.1.1)
 /// and each participant two of them, from offset 10, so ids 0-119 stay in their domain's range.
 inline constexpr int kParticipantIdsPerDomain = 120;
+/// Participant ids a system of several hosts keeps free on each host beyond its modules there
+/// (NetworkConfig::for_host): the monitor, boot, the registry, two discovery servers, a hung
+/// module's successor, and tools (oscar ps, echo, record, the bridge) run at once.
+inline constexpr int kParticipantsBesideModules = 16;
 
 /// How the participants of a system find each other (docs/network.md).
 enum class Discovery {
@@ -49,7 +53,8 @@ struct NetworkConfig {
   std::uint32_t udp_buffer_bytes = 4u << 20;
   /// The largest UDP datagram; larger samples go in fragments of it. 0: Fast DDS's 65500.
   std::uint32_t udp_max_message_bytes = 0;
-  /// Participant ids taken and probed per address (at most kParticipantIdsPerDomain).
+  /// Participant ids taken and probed per address (at most kParticipantIdsPerDomain; a system
+  /// of several hosts: its busiest host's modules and kParticipantsBesideModules).
   int max_participants_per_host = kParticipantIdsPerDomain;
   Discovery discovery = Discovery::kStaticPeers;
   /// kServer: the address of each discovery server, one or two (then either one suffices); the
@@ -67,7 +72,9 @@ struct NetworkConfig {
   static NetworkConfig from_yaml(const YAML::Node& node);
   /// The profile of a process on `host` of a system file: a host with an `address:` (a test host
   /// in a network namespace) uses that address and announces itself to the addresses of all the
-  /// system's hosts, else the loopback default; the file's `network:` keys override that.
+  /// system's hosts, and to as many participant ids on each as the file puts on its busiest host
+  /// (its modules there, the coordinator and its applets, kParticipantsBesideModules), else
+  /// the loopback default; the file's `network:` keys override that.
   /// Discovery servers default to the address of the system's local host (where boot runs).
   static NetworkConfig for_host(const YAML::Node& system, const std::string& host);
 };

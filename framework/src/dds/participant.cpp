@@ -35,11 +35,6 @@ using internal::user_unicast_port;
 
 namespace {
 
-bool is_ipv4(const std::string& s) {
-  in_addr a{};
-  return inet_pton(AF_INET, s.c_str(), &a) == 1;
-}
-
 // True if nobody on this host has bound the UDP port on that address.
 bool udp_port_free(const std::string& address, std::uint32_t port) {
   const int fd = socket(AF_INET, SOCK_DGRAM, 0);
@@ -130,121 +125,6 @@ dds::DomainParticipantQos participant_qos(const std::string& name, const Network
 }
 
 }  // namespace
-
-NetworkConfig NetworkConfig::from_yaml(const YAML::Node& node, NetworkConfig base) {
-  NetworkConfig net = std::move(base);
-  if (!node || node.IsNull()) return net;
-  if (!node.IsMap()) throw std::invalid_argument("network: expected a map");
-  const auto addresses = [](const YAML::Node& list, const char* key) {
-    std::vector<std::string> out;
-    if (!list.IsSequence() || list.size() == 0) {
-      throw std::invalid_argument(fmt::format("network.{}: expected a non-empty list", key));
-    }
-    for (const auto& a : list) {
-      const auto s = a.as<std::string>();
-      if (!is_ipv4(s)) {
-        throw std::invalid_argument(fmt::format("network.{}: '{}' is not an IPv4 address", key, s));
-      }
-      out.push_back(s);
-    }
-    return out;
-  };
-  bool servers_given = false;
-  for (const auto& kv : node) {
-    const auto key = kv.first.as<std::string>();
-    if (key == "interfaces") {
-      net.interfaces = addresses(kv.second, "interfaces");
-    } else if (key == "peers") {
-      net.peers = addresses(kv.second, "peers");
-    } else if (key == "shared_memory") {
-      net.shared_memory = kv.second.as<bool>();
-    } else if (key == "shm_segment_bytes") {
-      net.shm_segment_bytes = kv.second.as<std::uint32_t>();
-    } else if (key == "udp_buffer_bytes") {
-      net.udp_buffer_bytes =
-          internal::udp_buffer_bytes("network.udp_buffer_bytes", kv.second.as<std::string>());
-    } else if (key == "udp_max_message_bytes") {
-      net.udp_max_message_bytes = internal::udp_max_message_bytes("network.udp_max_message_bytes",
-                                                                  kv.second.as<std::string>());
-    } else if (key == "max_participants_per_host") {
-      net.max_participants_per_host = kv.second.as<int>();
-      if (net.max_participants_per_host < 1 ||
-          net.max_participants_per_host > kParticipantIdsPerDomain) {
-        throw std::invalid_argument(
-            fmt::format("network.max_participants_per_host: {} is not in 1..{} (the ids a domain's "
-                        "ports leave room for)",
-                        net.max_participants_per_host, kParticipantIdsPerDomain));
-      }
-    } else if (key == "discovery") {
-      const auto kind = kv.second.as<std::string>();
-      if (kind == "static") {
-        net.discovery = Discovery::kStaticPeers;
-      } else if (kind == "server") {
-        net.discovery = Discovery::kServer;
-      } else {
-        throw std::invalid_argument(
-            fmt::format("network.discovery: '{}' is neither static nor server", kind));
-      }
-    } else if (key == "discovery_servers") {
-      net.discovery_servers = addresses(kv.second, "discovery_servers");
-      servers_given = true;
-      if (net.discovery_servers.size() > 2) {
-        throw std::invalid_argument(fmt::format(
-            "network.discovery_servers: {} addresses; one server, or two for redundancy",
-            net.discovery_servers.size()));
-      }
-    } else {
-      throw std::invalid_argument(
-          fmt::format("network: unknown key '{}' (allowed: interfaces, peers, shared_memory, "
-                      "shm_segment_bytes, udp_buffer_bytes, udp_max_message_bytes, "
-                      "max_participants_per_host, discovery, discovery_servers)",
-                      key));
-    }
-  }
-  if (servers_given && net.discovery != Discovery::kServer) {
-    throw std::invalid_argument("network.discovery_servers: given without discovery: server");
-  }
-  if (net.discovery == Discovery::kServer && net.discovery_servers.empty()) {
-    net.discovery_servers = {net.interfaces.front()};
-  }
-  return net;
-}
-
-NetworkConfig NetworkConfig::from_yaml(const YAML::Node& node) {
-  return from_yaml(node, NetworkConfig{});
-}
-
-NetworkConfig NetworkConfig::for_host(const YAML::Node& system, const std::string& host) {
-  NetworkConfig net;
-  const auto hosts = system["hosts"];
-  if (hosts && hosts.IsMap()) {
-    if (!host.empty() && hosts[host] && hosts[host]["address"]) {
-      net.interfaces = {hosts[host]["address"].as<std::string>()};
-      net.peers.clear();
-      for (const auto& kv : hosts) {
-        if (kv.second.IsMap() && kv.second["address"]) {
-          net.peers.push_back(kv.second["address"].as<std::string>());
-        }
-      }
-    }
-    // Boot starts the discovery servers on its own host: every host's processes reach them there.
-    for (const auto& kv : hosts) {
-      if (kv.second.IsMap() && kv.second["local"] && kv.second["address"]) {
-        net.discovery_servers = {kv.second["address"].as<std::string>()};
-        break;
-      }
-    }
-  }
-  if (net.discovery_servers.empty()) net.discovery_servers = {"127.0.0.1"};
-  // from_yaml keeps these only for discovery: server (where they are the default).
-  const auto default_servers = std::move(net.discovery_servers);
-  net.discovery_servers.clear();
-  net = from_yaml(system["network"], std::move(net));
-  if (net.discovery == Discovery::kServer && !system["network"]["discovery_servers"]) {
-    net.discovery_servers = default_servers;
-  }
-  return net;
-}
 
 int domain_from_env(int fallback) {
   const char* env = std::getenv("OSCAR_DOMAIN");
@@ -414,8 +294,10 @@ DdsParticipant::DdsParticipant(int domain, const std::string& name, const Networ
   if (!participant_) {
     throw std::runtime_error(fmt::format(
         "cannot create a DDS participant '{}' on domain {}: no free participant id among {} "
-        "on {}",
-        name, domain, ids, network.interfaces.front()));
+        "on {} (network.max_participants_per_host; a system of several hosts makes it its "
+        "busiest host's modules plus {}: set it higher in the system file's network: for more "
+        "tools at once)",
+        name, domain, ids, network.interfaces.front(), kParticipantsBesideModules));
   }
   publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
   subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
