@@ -186,10 +186,10 @@ DiscoveryScope Module::Dds::discovery_scope_of(const Module& module) {
 
 Module::Dds::Dds(Module& module, int domain)
     : module_(module),
-      participant_(domain, "oscar:" + module.spec_.name, module.spec_.network,
-                   discovery_scope_of(module)),
+      discovery_scope_(discovery_scope_of(module)),
+      participant_(domain, "oscar:" + module.spec_.name, module.spec_.network, discovery_scope_),
       learns_only_shared_topics_(module.spec_.network.discovery == Discovery::kServer &&
-                                 discovery_scope_of(module) == DiscoveryScope::kSharedTopics) {
+                                 discovery_scope_ == DiscoveryScope::kSharedTopics) {
   // Samples dropped as malformed are reported where the module's other lines go: its console
   // and oscar/log. The logger outlives this (shared), and its DDS sink is detached below.
   set_malformed_sample_log(module.log_);

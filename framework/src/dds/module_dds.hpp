@@ -92,6 +92,7 @@ class Module::Dds {
   void beat();
 
   Module& module_;
+  const DiscoveryScope discovery_scope_;  ///< discovery_scope_of(module_), before participant_
   DdsParticipant participant_;
   /// A plain client of discovery servers: it learns of a producer's writer only by reading the
   /// producer's topic (ask_servers_for_producer).
