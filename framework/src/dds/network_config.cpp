@@ -25,22 +25,27 @@ bool is_ipv4(const std::string& s) {
 // process of its own), counted on every host. Unmapped or odd input counts as nothing: the
 // system file's own checks report it.
 int participants_per_host(const YAML::Node& system) {
+  // A key the file does not have is an invalid node, whose type yaml-cpp refuses to tell.
+  const auto is = [](const YAML::Node& n, YAML::NodeType::value type) {
+    return n && n.Type() == type;
+  };
   std::map<std::string, int> modules;  // host -> its modules
   const auto hosts = system["hosts"];
-  const std::string only_host =
-      hosts.IsMap() && hosts.size() == 1 ? hosts.begin()->first.as<std::string>() : "";
-  if (const auto list = system["modules"]; list.IsSequence()) {
+  const std::string only_host = is(hosts, YAML::NodeType::Map) && hosts.size() == 1
+                                    ? hosts.begin()->first.as<std::string>()
+                                    : "";
+  if (const auto list = system["modules"]; is(list, YAML::NodeType::Sequence)) {
     for (const auto& m : list) {
       if (!m.IsMap()) continue;
-      ++modules[m["host"] && m["host"].IsScalar() ? m["host"].as<std::string>() : only_host];
+      const auto host = m["host"];
+      ++modules[is(host, YAML::NodeType::Scalar) ? host.as<std::string>() : only_host];
     }
   }
   int most = 0;
   for (const auto& [name, count] : modules) most = std::max(most, count);
-  if (const auto coordinator = system["coordinator"]; coordinator.IsMap()) {
-    most +=
-        1 +
-        (coordinator["applets"].IsSequence() ? static_cast<int>(coordinator["applets"].size()) : 0);
+  if (const auto coordinator = system["coordinator"]; is(coordinator, YAML::NodeType::Map)) {
+    const auto applets = coordinator["applets"];
+    most += 1 + (is(applets, YAML::NodeType::Sequence) ? static_cast<int>(applets.size()) : 0);
   }
   return std::min(most + kParticipantsBesideModules, kParticipantIdsPerDomain);
 }
