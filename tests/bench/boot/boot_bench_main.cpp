@@ -23,10 +23,11 @@
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/registry/system_spec.hpp"
 #include "oscar/time.hpp"
-#include "percentile.hpp"  // tests/common
-#include "process.hpp"     // tests/common
-#include "ssh_hosts.hpp"   // tests/netns
-#include "test_hosts.hpp"  // tests/netns
+#include "percentile.hpp"   // tests/common
+#include "process.hpp"      // tests/common
+#include "process_cpu.hpp"  // tests/common
+#include "ssh_hosts.hpp"    // tests/netns
+#include "test_hosts.hpp"   // tests/netns
 
 namespace {
 using namespace std::chrono_literals;
@@ -142,6 +143,9 @@ double restart_ms(oscar::RegistryClient& registry, const std::string& module) {
 
 struct Figures {
   std::vector<double> boot_ms, restart_ms;
+  /// The machine's busy CPU-seconds from boot's start until the bench saw it report running
+  /// (within 50 ms): every process of the system on every test host, and whatever else runs.
+  std::vector<double> machine_cpu_s;
 };
 
 // One boot: the time boot reports to `running`, then one module's restart (the last sink),
@@ -158,6 +162,7 @@ void run_once(const Options& o, const Hosts& hosts, const std::string& file,
   if (!keystore.empty()) argv.insert(argv.end(), {"--keystore", keystore});
   // A log of its own per run: the last run's log must not be read before this one truncates it.
   const auto log = oscar::test::temp_path(fmt::format("bench_boot_{}", run)) + ".log";
+  const double busy_before = oscar::test::machine_busy_cpu_seconds();
   oscar::test::Process boot(argv, log);
   const std::regex running("running after ([0-9]+) ms");
   std::smatch m;
@@ -166,6 +171,7 @@ void run_once(const Options& o, const Hosts& hosts, const std::string& file,
     out = boot.output();
     if (std::regex_search(out, m, running)) {
       f.boot_ms.push_back(std::stod(m[1]));
+      f.machine_cpu_s.push_back(oscar::test::machine_busy_cpu_seconds() - busy_before);
       break;
     }
     if (boot.wait(0ms) || std::chrono::steady_clock::now() > until) {
@@ -240,10 +246,11 @@ int main(int argc, char** argv) {
       std::printf(
           "{\"hosts\":%d,\"modules\":%d,\"ssh\":%s,\"discovery\":\"%s\",\"security\":%s,\"boot_ms_"
           "p50\":%.0f,"
-          "\"boot_ms_max\":%.0f,\"restart_ms_p50\":%.0f,\"runs\":%d}\n",
+          "\"boot_ms_max\":%.0f,\"restart_ms_p50\":%.0f,\"runs\":%d,"
+          "\"machine_cpu_s_until_running_p50\":%.1f,\"cores\":%ld}\n",
           o.hosts, o.modules, o.ssh ? "true" : "false", discovery, o.security ? "true" : "false",
           percentile(f.boot_ms, 0.5), percentile(f.boot_ms, 1.0), percentile(f.restart_ms, 0.5),
-          o.runs);
+          o.runs, percentile(f.machine_cpu_s, 0.5), sysconf(_SC_NPROCESSORS_ONLN));
     } else {
       std::printf(
           "oscar bench boot: %d modules on %d host%s%s, %s discovery%s, lease %s, %d runs\n",
@@ -251,6 +258,9 @@ int main(int argc, char** argv) {
           o.security ? ", DDS Security" : "", o.lease.c_str(), o.runs);
       std::printf("  boot to running: p50 %.0f ms, max %.0f ms\n", percentile(f.boot_ms, 0.5),
                   percentile(f.boot_ms, 1.0));
+      std::printf(
+          "  CPU the machine spent until then (all its %ld cores, every process): p50 %.1f s\n",
+          sysconf(_SC_NPROCESSORS_ONLN), percentile(f.machine_cpu_s, 0.5));
       std::printf("  restart of one module (kill -9 to running): p50 %.0f ms\n",
                   percentile(f.restart_ms, 0.5));
     }
