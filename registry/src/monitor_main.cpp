@@ -169,7 +169,11 @@ int main(int argc, char** argv) {
       spdlog::flush_on(spdlog::level::info);
     }
     const auto network = system.network_for(host, oscar::security_files::monitor_identity(host));
-    oscar::DdsParticipant participant(system.domain, "oscar-monitor:" + host, network);
+    // With discovery servers, a monitor learns only of the participants it shares a topic with
+    // (the registry, boot, the tools that read its reports), not of every module's endpoints
+    // on every host (docs/network.md).
+    oscar::DdsParticipant participant(system.domain, "oscar-monitor:" + host, network,
+                                      oscar::DiscoveryScope::kSharedTopics);
     oscar::TopicWriter<oscar::ProcessEvent, oscar::ProcessEventPubSubType> events(
         participant, oscar::topics::process_events());
     oscar::TopicWriter<oscar::MonitorBeat, oscar::MonitorBeatPubSubType> beats(
