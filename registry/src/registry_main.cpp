@@ -35,8 +35,12 @@ int main(int argc, char** argv) {
     if (domain >= 0) system.override_domain(domain);
     if (host.empty()) host = system.local_host().name;
     {
+      // With discovery servers, the registry learns only of the participants it shares a topic
+      // with (every module, monitor and tool shares its configuration or registry topics), not
+      // of the modules' cue endpoints (docs/network.md).
       oscar::DdsParticipant participant(system.domain, "oscar-registry",
-                                        system.network_for(host, oscar::security_files::kRegistry));
+                                        system.network_for(host, oscar::security_files::kRegistry),
+                                        oscar::DiscoveryScope::kSharedTopics);
       oscar::Registry registry(system, participant, journal, recover);
       std::thread signal_waiter([&] {
         int sig = 0;
