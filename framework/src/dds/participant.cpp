@@ -15,7 +15,6 @@
 #include <fastrtps/utils/IPLocator.h>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
-#include <yaml-cpp/yaml.h>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/log/Log.hpp>
 #include "dds/discovery.hpp"
