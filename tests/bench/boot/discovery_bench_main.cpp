@@ -193,11 +193,9 @@ std::string identity_of(int id) {
 std::string make_keystore(int participants) {
   std::string yaml = "system: bench_discovery\nmodules:\n";
   for (int id = 0; id < participants; ++id) {
-    yaml += fmt::format(
-        "  - {{ name: p{}, kernels: [ {{ type: bench_source, name: k{}, params: {{ type: Bool }} "
-        "}} "
-        "] }}\n",
-        id, id);
+    const auto kernel =
+        fmt::format("{{ type: bench_source, name: k{}, params: {{ type: Bool }} }}", id);
+    yaml += fmt::format("  - {{ name: p{}, kernels: [ {} ] }}\n", id, kernel);
   }
   const auto file = oscar::test::temp_path("bench_discovery") + ".yaml";
   std::ofstream(file) << yaml;
