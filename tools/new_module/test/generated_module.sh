@@ -8,11 +8,17 @@ set -euo pipefail
 build_dir="$1"
 work="$(mktemp -d)"
 boot=""
+recorder=""
 stop_boot() {
   if [ -n "$boot" ] && kill -0 "$boot" 2>/dev/null; then kill -INT "$boot"; wait "$boot" || true; fi
   boot=""
 }
 cleanup() {
+  # A failure between starting the recorder and stopping it must not leave it running.
+  if [ -n "$recorder" ] && kill -0 "$recorder" 2>/dev/null; then
+    kill -INT "$recorder"
+    wait "$recorder" || true
+  fi
   stop_boot
   rm -rf "$work"
 }
@@ -66,8 +72,8 @@ unset OSCAR_PLUGIN_PATH  # the system file says where the plugin is
 boot=$!
 "$bin/oscar-record" --all -o rec.mcap --domain "$domain" >record.log 2>&1 &
 recorder=$!
-out="$(timeout 60 "$bin/oscar-echo" fuse/out -n 3 -d "$domain" --timeout 40)" ||
-  fail "oscar echo: $out; boot: $(cat boot.log)"
+out="$(timeout 60 "$bin/oscar-echo" fuse/out -n 3 -d "$domain" --timeout 40 2>echo.err)" ||
+  fail "oscar echo (exit $?): $out $(cat echo.err); boot: $(cat boot.log)"
 echo "$out"
 grep -q '^--- oscar/cue/fuse/out (oscar::Bool)' <<<"$out" || fail "no sample of fuse/out"
 grep -q '  source: "fuse/out"' <<<"$out" || fail "no header source"
@@ -79,6 +85,7 @@ grep -Eq '^fuser +localhost +[0-9]+ +1 +running' <<<"$ps_out" || fail "fuser not
 sleep 1
 kill -INT "$recorder"
 wait "$recorder" || fail "oscar record exited with $?: $(cat record.log)"
+recorder=""
 kill -INT "$boot"
 wait "$boot" || fail "boot exited with $?: $(cat boot.log)"
 boot=""
