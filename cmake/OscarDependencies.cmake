@@ -41,4 +41,6 @@ if(OSCAR_WITH_FRAMEWORK)
   find_package(PkgConfig REQUIRED)
   pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)
   pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)
+  # The zero-copy path (docs/zero_copy.md) where Debian's libiceoryx-posh-dev is installed.
+  find_package(iceoryx_posh CONFIG QUIET)
 endif()

@@ -22,6 +22,21 @@ std::string sibling_program(const std::string& program) {
   return (program_dir() / program).string();
 }
 
+std::optional<std::filesystem::path> find_on_path(const std::string& program) {
+  const char* path = std::getenv("PATH");
+  const std::string dirs = path ? path : "/usr/bin:/bin";  // execvp's default
+  for (std::size_t start = 0; start <= dirs.size();) {
+    const auto end = std::min(dirs.find(':', start), dirs.size());
+    if (end > start) {
+      auto candidate = std::filesystem::path(dirs.substr(start, end - start)) / program;
+      if (::access(candidate.c_str(), X_OK) == 0 && !std::filesystem::is_directory(candidate))
+        return candidate;
+    }
+    start = end + 1;
+  }
+  return std::nullopt;
+}
+
 sigset_t block_stop_signals() {
   sigset_t signals;
   sigemptyset(&signals);

@@ -2,13 +2,9 @@
 // cues across processes through a RouDi of the test's own. Every test process runs in a private
 // mount namespace with its own /dev/shm and /tmp (iceoryx 2.0's names there are fixed:
 // /dev/shm/iceoryx_mgmt, /tmp/roudi), so tests run in parallel and leave no files behind.
-#include <sched.h>
 #include <signal.h>
-#include <sys/mount.h>
 
 #include <algorithm>
-#include <cerrno>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -22,6 +18,7 @@
 #include <spdlog/spdlog.h>
 
 #include "oscar/cue_types.hpp"
+#include "private_tmp.hpp"
 #include "process.hpp"
 #include "zero_copy/cue_path.hpp"
 #include "zero_copy/mempools.hpp"
@@ -30,18 +27,6 @@
 
 namespace oscar::zero_copy {
 namespace {
-
-// Enters the private namespace before main() (and before any thread): empty if that worked,
-// else why not.
-const std::string kNoPrivateShm = [] {
-  if (::unshare(CLONE_NEWNS) != 0) return std::string("unshare(CLONE_NEWNS): ") + strerror(errno);
-  if (::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) != 0)
-    return std::string("making / private: ") + strerror(errno);
-  for (const char* dir : {"/dev/shm", "/tmp"})
-    if (::mount("tmpfs", dir, "tmpfs", 0, "size=256m") != 0)
-      return std::string("tmpfs on ") + dir + ": " + strerror(errno);
-  return std::string();
-}();
 
 template <class Condition>
 bool eventually(Condition condition, std::chrono::seconds timeout = std::chrono::seconds(60)) {
@@ -106,8 +91,8 @@ std::map<std::string, std::string> by_seq(const std::vector<std::string>& lines)
 class ZeroCopy : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (!kNoPrivateShm.empty())
-      GTEST_SKIP() << "needs a private mount namespace (root): " << kNoPrivateShm;
+    if (!oscar::test::kNoPrivateTmp.empty())
+      GTEST_SKIP() << "needs a private mount namespace (root): " << oscar::test::kNoPrivateTmp;
     ASSERT_TRUE(std::filesystem::exists(peer())) << peer() << " is missing (OSCAR_BUILD_DIR?)";
   }
 };

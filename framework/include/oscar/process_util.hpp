@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 namespace oscar {
@@ -15,6 +16,8 @@ namespace oscar {
 std::filesystem::path program_dir();
 /// `<program_dir>/<program>`.
 std::string sibling_program(const std::string& program);
+/// Where `program` is found on $PATH (as execvp would look: the first executable file), if it is.
+std::optional<std::filesystem::path> find_on_path(const std::string& program);
 
 /// Blocks SIGINT and SIGTERM in this thread and every thread started after it, so they can be
 /// waited for with wait_for_stop(). Call first thing in main().

@@ -4,14 +4,14 @@
 #include <sys/un.h>
 #include <unistd.h>
 
-#include <algorithm>
-#include <cstdlib>
 #include <cstring>
 #include <mutex>
 #include <stdexcept>
 
 #include <fmt/format.h>
 #include <iceoryx_posh/runtime/posh_runtime.hpp>
+
+#include "oscar/process_util.hpp"
 
 namespace oscar::zero_copy {
 namespace {
@@ -21,19 +21,6 @@ namespace {
 std::string roudi_socket() {
   return std::string(iox::platform::IOX_UDS_SOCKET_PATH_PREFIX) +
          iox::roudi::IPC_CHANNEL_ROUDI_NAME;
-}
-
-bool roudi_installed() {
-  const char* path = std::getenv("PATH");
-  std::string dirs = path ? path : "/usr/bin:/bin";
-  for (std::size_t start = 0; start <= dirs.size();) {
-    const auto end = std::min(dirs.find(':', start), dirs.size());
-    if (end > start &&
-        ::access((dirs.substr(start, end - start) + "/iox-roudi").c_str(), X_OK) == 0)
-      return true;
-    start = end + 1;
-  }
-  return false;
 }
 
 }  // namespace
@@ -63,7 +50,7 @@ std::optional<std::string> join_roudi(const std::string& name) {
   std::lock_guard lock(mutex);
   if (joined) return std::nullopt;
   if (!roudi_running()) {
-    if (!roudi_installed())
+    if (!find_on_path("iox-roudi"))
       return fmt::format(
           "iox-roudi is not installed (Debian package iceoryx) and no RouDi listens "
           "on {}",
