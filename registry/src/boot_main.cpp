@@ -266,6 +266,15 @@ int main(int argc, char** argv) {
     oscar::coordinator::SwarmSetup::from(system);
     const auto& local = system.local_host();
     check_hosts(system);
+    const bool hosts_here =
+        std::any_of(system.hosts.begin(), system.hosts.end(), [](const auto& h) {
+          return h.kind != oscar::HostSpec::Kind::kSsh;  // an ssh host's check asks there
+        });
+    if (system.zero_copy && hosts_here) {
+      if (const auto problem = oscar::zero_copy_unavailable()) {
+        throw std::invalid_argument(fmt::format("{}: {}", system.zero_copy->where, *problem));
+      }
+    }
     // Remote hosts read the file at the same path: an absolute one.
     const auto remote_file = std::filesystem::absolute(file).lexically_normal().string();
     check_ssh_hosts(system, remote_file, copy_system_file);

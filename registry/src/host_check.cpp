@@ -11,6 +11,7 @@
 #include <fmt/ranges.h>
 
 #include "oscar/module.hpp"
+#include "oscar/process_util.hpp"
 #include "oscar/registry/launch_command.hpp"
 
 #ifndef OSCAR_VERSION
@@ -62,6 +63,17 @@ std::string read_text_file(const std::string& path) {
   return std::string((std::istreambuf_iterator<char>(in)), {});
 }
 
+std::optional<std::string> zero_copy_unavailable() {
+  if (!OSCAR_ZERO_COPY) {
+    return "zero_copy: this OSCAR was built without iceoryx (install the Debian package "
+           "libiceoryx-posh-dev and build it again)";
+  }
+  if (!find_on_path("iox-roudi")) {
+    return "zero_copy: iox-roudi is not installed on this host (Debian package iceoryx)";
+  }
+  return std::nullopt;
+}
+
 std::string check_banner() { return "oscar-monitor " + oscar_version(); }
 
 std::vector<std::string> check_this_host(const std::string& file, const std::string& host,
@@ -79,6 +91,9 @@ std::vector<std::string> check_this_host(const std::string& file, const std::str
   try {
     const auto system = SystemSpec::load(file);  // its relative paths resolve here as at boot
     system.host(host);
+    if (system.zero_copy) {
+      if (auto problem = zero_copy_unavailable()) problems.push_back(std::move(*problem));
+    }
     for (const auto& m : system.modules) {
       if (m.spec.host != host) continue;  // standby modules too: they may be started there
       const auto program = program_path(m.program);

@@ -20,6 +20,9 @@
 #include <oscar/command_line.hpp>
 
 #include "clock_prober.hpp"
+#if OSCAR_ZERO_COPY
+#include "host_roudi.hpp"
+#endif
 #include "janitor.hpp"
 #include "oscar/cue_types.hpp"
 #include "oscar/kernel_registry.hpp"
@@ -224,6 +227,12 @@ int main(int argc, char** argv) {
                  log_dir);
     std::map<std::string, Clock::time_point> stopping;  // SIGKILL if still there by then
     oscar::Janitor janitor(system.domain, network);
+#if OSCAR_ZERO_COPY
+    std::optional<oscar::HostRoudi> roudi;  // the host's RouDi, for zero-copy cues
+    if (system.zero_copy) roudi.emplace(system.zero_copy->chunks, log_dir);
+#else
+    if (system.zero_copy) spdlog::error("{}", oscar::zero_copy_unavailable().value_or(""));
+#endif
     // The heartbeat has a thread of its own: starting processes must not delay it.
     std::jthread beater([&](std::stop_token stop) {
       auto next = Clock::now();
@@ -313,6 +322,9 @@ int main(int argc, char** argv) {
         janitor.after_death(x.module);
       }
       janitor.tick();
+#if OSCAR_ZERO_COPY
+      if (roudi) roudi->tick();
+#endif
       if (auto now = report(host, own_pid, supervisor);
           !same_children(now, last_report) || Clock::now() >= next_report) {
         reports.write(now);
@@ -323,6 +335,9 @@ int main(int argc, char** argv) {
     beater.request_stop();
     beater.join();
     stop_modules();
+#if OSCAR_ZERO_COPY
+    roudi.reset();  // after the modules: a stopping RouDi sends SIGTERM to those that joined it
+#endif
   } catch (const std::exception& e) {
     std::fprintf(stderr, "oscar-monitor: %s\n", e.what());
     code = 2;

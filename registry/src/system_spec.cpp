@@ -196,6 +196,28 @@ SecuritySpec parse_security(const YAML::Node& node, const std::string& file) {
   return sec;
 }
 
+// `zero_copy: true|false` or `zero_copy: {chunks: N}`.
+std::optional<ZeroCopySpec> parse_zero_copy(const YAML::Node& node, const std::string& file) {
+  ZeroCopySpec z;
+  z.where = yaml_where(file, node);
+  constexpr auto kForm =
+      "zero_copy: expected true, false or {chunks: N} (N chunks of each plain cue type, 1..4096)";
+  if (node.IsScalar()) {
+    bool on = false;
+    if (!YAML::convert<bool>::decode(node, on)) fail(z.where, kForm);
+    return on ? std::optional(z) : std::nullopt;
+  }
+  if (!node.IsMap()) fail(z.where, kForm);
+  check_yaml_keys(node, file, "zero_copy", {"chunks"});
+  if (const auto c = node["chunks"]) {
+    long long n = 0;
+    if (!c.IsScalar() || !YAML::convert<long long>::decode(c, n) || n < 1 || n > 4096)
+      fail(yaml_where(file, c), kForm);
+    z.chunks = static_cast<std::uint32_t>(n);
+  }
+  return z;
+}
+
 // A replace chain must end at a standby module and never come back to where it started.
 void check_replace_chains(const SystemSpec& s) {
   for (const auto& m : s.modules) {
@@ -316,7 +338,7 @@ SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
   if (!root.IsMap()) fail(file, "a system file is a map with system, hosts and modules");
   check_yaml_keys(root, file, "system file",
                   {"system", "domain", "hosts", "modules", "network", "lease", "headless_limit",
-                   "plugins", "services", "coordinator", "security"});
+                   "plugins", "services", "coordinator", "security", "zero_copy"});
   const auto plugins = ModuleSpec::plugins_of(root, file);
   s.name = root["system"] ? root["system"].as<std::string>() : "system";
   if (root["domain"]) {
@@ -330,6 +352,7 @@ SystemSpec SystemSpec::parse(const YAML::Node& root, const std::string& file) {
         none ? std::nullopt : std::optional(millis(limit, file, "headless_limit (or none)"));
   }
   if (root["security"]) s.security = parse_security(root["security"], file);
+  if (root["zero_copy"]) s.zero_copy = parse_zero_copy(root["zero_copy"], file);
   if (const auto hosts = root["hosts"]) {
     if (!hosts.IsMap() || hosts.size() == 0) fail(yaml_where(file, hosts), "hosts: a map");
     for (const auto& kv : hosts) {

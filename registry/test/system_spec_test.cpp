@@ -300,5 +300,25 @@ modules:
   }
 }
 
+TEST(SystemSpec, ZeroCopyIsOffByDefaultAndTakesTrueFalseOrAChunkCount) {
+  constexpr const char* kModules = "modules: [ { name: m, kernels: [ { type: relay } ] } ]\n";
+  EXPECT_FALSE(parse(kModules).zero_copy);
+  EXPECT_FALSE(parse(std::string(kModules) + "zero_copy: false\n").zero_copy);
+  const auto on = parse(std::string(kModules) + "zero_copy: true\n").zero_copy;
+  ASSERT_TRUE(on);
+  EXPECT_EQ(on->chunks, 32u);
+  EXPECT_EQ(on->where, "s.yaml:2");
+  const auto sized = parse(std::string(kModules) + "zero_copy: { chunks: 100 }\n").zero_copy;
+  ASSERT_TRUE(sized);
+  EXPECT_EQ(sized->chunks, 100u);
+  const std::string form =
+      "zero_copy: expected true, false or {chunks: N} (N chunks of each plain cue type, 1..4096)";
+  EXPECT_EQ(error_of(std::string(kModules) + "zero_copy: yes please\n"), "s.yaml:2: " + form);
+  EXPECT_EQ(error_of(std::string(kModules) + "zero_copy: { chunks: 0 }\n"), "s.yaml:2: " + form);
+  EXPECT_EQ(error_of(std::string(kModules) + "zero_copy: { chunks: many }\n"), "s.yaml:2: " + form);
+  EXPECT_EQ(error_of(std::string(kModules) + "zero_copy: [1]\n"), "s.yaml:2: " + form);
+  EXPECT_THAT(error_of(std::string(kModules) + "zero_copy: { chunk: 8 }\n"), HasSubstr("chunk"));
+}
+
 }  // namespace
 }  // namespace oscar

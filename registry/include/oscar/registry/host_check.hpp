@@ -34,6 +34,11 @@ std::vector<std::string> check_this_host(const std::string& file, const std::str
                                          const std::vector<std::string>& plugin_path,
                                          const ProgramPath& program_path);
 
+/// Why this host cannot run a RouDi for `zero_copy:` (this OSCAR built without iceoryx, or no
+/// iox-roudi on PATH), naming what to install; nothing when it can. Boot asks for the hosts of
+/// this machine, check_this_host() for an ssh host.
+std::optional<std::string> zero_copy_unavailable();
+
 /// The first line `oscar-monitor --check` prints: "oscar-monitor <version>".
 std::string check_banner();
 

@@ -3,6 +3,7 @@
 /// debug wrappers — parsed and checked whole before anything is started.
 
 #include <chrono>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -144,6 +145,15 @@ struct SecuritySpec {
 /// "none", "sign", "encrypt".
 const char* to_string(SecuritySpec::CueProtection protection);
 
+/// `zero_copy:` (docs/zero_copy.md): each host's monitor keeps an iceoryx RouDi running, which
+/// carries the plain cue types between the host's processes without copies.
+struct ZeroCopySpec {
+  /// Chunks of each plain cue type in a host's RouDi: per type at least its consumers on the
+  /// host × (ring depth + queue) + its producers × 2 (docs/zero_copy.md, "Limits learned").
+  std::uint32_t chunks = 32;
+  std::string where;  ///< "file:line"
+};
+
 /// Services and applets added to a running system (docs/coordinator.md, "Adding and removing at
 /// run time"), as SystemSpec::parse_addition reads them.
 struct SystemAddition {
@@ -164,6 +174,7 @@ struct SystemSpec {
   std::vector<ServiceSpec> services;
   std::optional<CoordinatorSpec> coordinator;
   std::optional<SecuritySpec> security;
+  std::optional<ZeroCopySpec> zero_copy;  ///< none: cues go serialized through DDS only
   YAML::Node root;
 
   /// The module name the `coordinator:` section's process announces itself under.

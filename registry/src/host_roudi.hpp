@@ -1,0 +1,52 @@
+#pragma once
+// The monitor's keeper of its host's RouDi, iceoryx's shared-memory daemon that carries plain
+// cues between the host's processes without copies (docs/zero_copy.md, "RouDi per host").
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+
+#include "oscar/registry/supervisor.hpp"
+
+namespace oscar {
+
+class HostRoudi {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  /// Writes RouDi's configuration, `chunks` of each plain cue type, to `<log_dir>/roudi.toml`;
+  /// RouDi's output goes to `<log_dir>/iox-roudi.log`. Starts nothing yet (tick() does).
+  HostRoudi(std::uint32_t chunks, const std::string& log_dir);
+  /// Stops the RouDi it started (call it after the host's modules have stopped).
+  ~HostRoudi();
+  HostRoudi(const HostRoudi&) = delete;
+  HostRoudi& operator=(const HostRoudi&) = delete;
+
+  /// Call it often (the monitor does every 5 ms; it looks every 100 ms): starts a RouDi when
+  /// none listens on this host, and says when one ended. A RouDi another process started (an
+  /// earlier monitor's, another system's) is used, not doubled; when it goes, this one starts
+  /// its own. A RouDi that ends within 5 s of its start is started again after a pause that
+  /// doubles from 0.5 s to 8 s; one that ran longer, at once.
+  void tick(Clock::time_point now = Clock::now());
+
+  /// How many RouDis it has started so far (a restart invalidates what processes that joined the
+  /// one before hold: iceoryx 2.0 cannot re-register them).
+  unsigned started() const { return started_; }
+  /// The pid of the RouDi it started, if that one runs (0 otherwise).
+  pid_t pid() const;
+  const std::string& config_path() const { return config_path_; }
+
+ private:
+  void start(Clock::time_point now);
+
+  Supervisor processes_;
+  std::string config_path_;
+  unsigned started_ = 0;
+  Clock::time_point started_at_{}, next_look_{}, next_start_{};
+  std::chrono::milliseconds pause_{0};
+  bool listening_said_ = false;  // "RouDi runs" logged for the current RouDi
+  bool foreign_said_ = false;    // "uses the RouDi already running" logged
+  bool failure_said_ = false;    // why it cannot start RouDi, logged
+};
+
+}  // namespace oscar

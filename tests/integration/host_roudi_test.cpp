@@ -1,0 +1,196 @@
+// `zero_copy:` in a system file: each host's monitor keeps the host's RouDi running
+// (docs/zero_copy.md, "RouDi per host"). The test process has a mount namespace of its own with
+// fresh /dev/shm and /tmp (private_tmp.hpp), so its RouDis meet nobody else's.
+#include <signal.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "oscar/registry/host_check.hpp"
+#include "private_tmp.hpp"
+#include "proc.hpp"
+#include "process.hpp"
+#include "zero_copy/mempools.hpp"
+#include "zero_copy/roudi.hpp"
+
+namespace oscar {
+namespace {
+
+using namespace std::chrono_literals;
+using ::testing::HasSubstr;
+
+template <class Condition>
+bool eventually(Condition condition, std::chrono::milliseconds timeout = 30s) {
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  while (!condition()) {
+    if (std::chrono::steady_clock::now() > until) return false;
+    std::this_thread::sleep_for(20ms);
+  }
+  return true;
+}
+
+// The iox-roudi processes in this test's mount namespace (tests running beside it have their
+// own).
+std::vector<long> roudis() {
+  std::error_code ec;
+  const auto ours = std::filesystem::read_symlink("/proc/self/ns/mnt", ec);
+  std::vector<long> out;
+  for (const auto pid : test::listed_pids()) {
+    if (test::proc_file(pid, "comm") != "iox-roudi\n") continue;
+    const auto theirs =
+        std::filesystem::read_symlink("/proc/" + std::to_string(pid) + "/ns/mnt", ec);
+    if (!ec && theirs == ours) out.push_back(pid);
+  }
+  return out;
+}
+
+std::string read(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+class HostRoudi : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!test::kNoPrivateTmp.empty())
+      GTEST_SKIP() << "needs a private mount namespace (root): " << test::kNoPrivateTmp;
+    ASSERT_FALSE(zero_copy::roudi_running());
+    std::ofstream(file_) << fmt::format(R"(system: zc
+domain: {}
+zero_copy: {{ chunks: 8 }}
+modules:
+  - name: src
+    kernels: [ {{ type: bench_source, name: src }} ]
+)",
+                                        test::test_domain());
+  }
+  void TearDown() override {
+    if (monitor_) monitor_->stop();
+    for (const auto pid : roudis()) ::kill(static_cast<pid_t>(pid), SIGKILL);
+  }
+  test::Process& start_monitor() {
+    monitor_ = std::make_unique<test::Process>(
+        std::vector<std::string>{test::bin("oscar-monitor"), "--system", file_, "--host",
+                                 "localhost", "--log-dir", log_dir_},
+        "/tmp/monitor.log");
+    return *monitor_;
+  }
+  bool monitor_said(const std::string& text) const {
+    return monitor_->output().find(text) != std::string::npos;
+  }
+  test::Process peer(std::vector<std::string> args, const std::string& name) {
+    args.insert(args.begin(), test::bin("oscar-zero-copy-peer"));
+    return test::Process(std::move(args), "/tmp/" + name + ".log");
+  }
+  // `count` cues of `type`, 10 ms apart, from one zero-copy peer to another through this host's
+  // RouDi: every one arrives; the consumer holds `hold`, the producer `loans` loaned chunks.
+  void cues_flow(const std::string& type, const std::string& count, const std::string& hold,
+                 const std::string& loans) {
+    auto sub = peer({"sub", type, "topic", count, hold}, "sub");
+    ASSERT_TRUE(eventually([&] { return sub.output().find("subscribed") != std::string::npos; }))
+        << sub.output();
+    auto pub = peer({"pub", type, "topic", count, "10", loans, "0", "1"}, "pub");
+    EXPECT_EQ(pub.wait(60s), 0) << pub.output();
+    EXPECT_EQ(sub.wait(60s), 0) << sub.output();
+  }
+
+  const std::string file_ = "/tmp/zc.yaml";
+  const std::string log_dir_ = "/tmp/zc-logs";
+  std::unique_ptr<test::Process> monitor_;
+};
+
+TEST_F(HostRoudi, TheMonitorStartsOneWithThePlainTypesMempoolsAndCuesFlowThroughIt) {
+  auto& monitor = start_monitor();
+  ASSERT_TRUE(eventually([&] { return monitor_said("RouDi runs"); })) << monitor.output();
+  EXPECT_TRUE(zero_copy::roudi_running());
+  EXPECT_EQ(roudis().size(), 1u);
+  EXPECT_EQ(read(log_dir_ + "/roudi.toml"),
+            zero_copy::roudi_config(zero_copy::plain_cue_mempools(8)));
+  // Images through the monitor's RouDi: 8 chunks are enough for a producer holding 2 loans and a
+  // consumer holding 4 cues.
+  cues_flow("PlainGvImage", "20", "4", "2");
+}
+
+TEST_F(HostRoudi, StoppingTheMonitorStopsItsRouDiWhichStopsTheProcessesThatJoinedIt) {
+  auto& monitor = start_monitor();
+  ASSERT_TRUE(eventually([&] { return monitor_said("RouDi runs"); })) << monitor.output();
+  auto sub = peer({"sub", "PlainBool", "flag", "1000", "1"}, "sub");  // waits for cues
+  ASSERT_TRUE(eventually([&] { return sub.output().find("subscribed") != std::string::npos; }))
+      << sub.output();
+  ::kill(monitor.pid(), SIGTERM);
+  EXPECT_EQ(monitor.wait(20s), 0) << monitor.output();
+  EXPECT_THAT(monitor.output(), HasSubstr("stopped RouDi"));
+  EXPECT_FALSE(zero_copy::roudi_running());
+  EXPECT_TRUE(roudis().empty());
+  EXPECT_EQ(sub.wait(10s), 128 + SIGTERM) << sub.output();
+  EXPECT_FALSE(std::filesystem::exists("/dev/shm/iceoryx_mgmt"))
+      << read(log_dir_ + "/iox-roudi.log");
+}
+
+TEST_F(HostRoudi, AKilledRouDiIsStartedAgainAndSaysWhatThatMeansForJoinedProcesses) {
+  auto& monitor = start_monitor();
+  ASSERT_TRUE(eventually([&] { return monitor_said("RouDi runs"); })) << monitor.output();
+  const auto first = roudis();
+  ASSERT_EQ(first.size(), 1u);
+  ::kill(static_cast<pid_t>(first.front()), SIGKILL);
+  ASSERT_TRUE(eventually([&] { return monitor_said("started RouDi again"); })) << monitor.output();
+  EXPECT_TRUE(monitor_said("killed by signal 9")) << monitor.output();
+  EXPECT_TRUE(monitor_said("processes that joined the RouDi before carry no zero-copy cues"));
+  ASSERT_TRUE(eventually([] { return zero_copy::roudi_running(); }));
+  const auto second = roudis();
+  ASSERT_EQ(second.size(), 1u);
+  EXPECT_NE(second.front(), first.front());
+  cues_flow("PlainBool", "5", "1", "0");  // the new one carries cues
+}
+
+TEST_F(HostRoudi, ARouDiAlreadyRunningIsUsedAndWhenItGoesTheMonitorStartsItsOwn) {
+  std::ofstream("/tmp/other.toml") << zero_copy::roudi_config(zero_copy::plain_cue_mempools(4));
+  test::Process other({"/usr/bin/iox-roudi", "-c", "/tmp/other.toml"}, "/tmp/other.log");
+  ASSERT_TRUE(eventually([] { return zero_copy::roudi_running(); })) << other.output();
+  auto& monitor = start_monitor();
+  ASSERT_TRUE(eventually([&] { return monitor_said("a RouDi this monitor did not start"); }))
+      << monitor.output();
+  std::this_thread::sleep_for(500ms);  // five of the monitor's looks
+  EXPECT_EQ(roudis().size(), 1u);
+  EXPECT_FALSE(monitor_said("started RouDi")) << monitor.output();
+  ::kill(other.pid(), SIGTERM);
+  EXPECT_EQ(other.wait(10s), 0) << other.output();
+  ASSERT_TRUE(eventually([&] { return monitor_said("RouDi runs"); })) << monitor.output();
+  EXPECT_TRUE(monitor_said("the RouDi this host's processes used is gone"));
+  EXPECT_TRUE(zero_copy::roudi_running());
+}
+
+// Without iox-roudi the host's cues go serialized: the monitor says so and goes on; boot and the
+// ssh host check refuse such a system beforehand, naming the package.
+TEST_F(HostRoudi, WithoutIoxRoudiMonitorBootAndTheHostCheckNameThePackage) {
+  const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+  ::setenv("PATH", "/nonexistent", 1);  // the children find no iox-roudi
+  auto& monitor = start_monitor();
+  test::Process boot({test::bin("oscar-boot"), file_, "--check"}, "/tmp/boot.log");
+  test::Process check({test::bin("oscar-monitor"), "--system", file_, "--host", "localhost",
+                       "--check", content_fingerprint(read(file_))},
+                      "/tmp/check.log");
+  ::setenv("PATH", path.c_str(), 1);
+  ASSERT_TRUE(eventually([&] { return monitor_said("zero_copy:"); })) << monitor.output();
+  EXPECT_TRUE(
+      monitor_said("zero_copy: iox-roudi is not installed on this host (Debian package "
+                   "iceoryx): its cues go serialized through DDS"))
+      << monitor.output();
+  EXPECT_FALSE(monitor.wait(300ms)) << "the monitor goes on: " << monitor.output();
+  EXPECT_EQ(boot.wait(30s), 2) << boot.output();
+  EXPECT_THAT(boot.output(), HasSubstr(file_ + ":3: zero_copy: iox-roudi is not installed on "
+                                               "this host (Debian package iceoryx)"));
+  EXPECT_EQ(check.wait(30s), 2) << check.output();
+  EXPECT_THAT(check.output(),
+              HasSubstr("\nzero_copy: iox-roudi is not installed on this host (Debian package "
+                        "iceoryx)\n"));
+}
+
+}  // namespace
+}  // namespace oscar
