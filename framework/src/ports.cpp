@@ -115,6 +115,7 @@ void OutputPort::publish_erased(std::shared_ptr<void> cue) {
   type_.header.complete(cue.get(), ++seq_, address(), clock_());
   if (persisted_seq_) *persisted_seq_ = seq_;
   std::shared_ptr<const void> frozen = std::move(cue);
+  if (chunks_) frozen = chunks_->publish(std::move(frozen));
   // The cue evicted from the ring is freed at the end, after the cue is on its way.
   const auto evicted =
       buffer_.push(frozen, type_.header.generation_stamp(frozen.get()), wall_now());
@@ -124,6 +125,7 @@ void OutputPort::publish_erased(std::shared_ptr<void> cue) {
 
 void OutputPort::forward_erased(std::shared_ptr<const void> cue) {
   std::lock_guard lock(mutex_);
+  if (chunks_) cue = chunks_->publish(std::move(cue));
   const auto evicted = buffer_.push(cue, type_.header.generation_stamp(cue.get()), wall_now());
   for (auto* input : consumers_) input->deliver_from(type_, cue);
   if (remote_) remote_(cue.get());
@@ -164,6 +166,23 @@ void OutputPort::disconnect(InputPort* input) {
 void OutputPort::set_remote(std::function<void(const void*)> remote) {
   std::lock_guard lock(mutex_);
   remote_ = std::move(remote);
+}
+
+void OutputPort::set_chunks(std::shared_ptr<CueChunks> chunks) {
+  std::lock_guard lock(mutex_);
+  chunks_ = std::move(chunks);
+}
+
+std::shared_ptr<void> OutputPort::loan_erased() {
+  std::shared_ptr<CueChunks> chunks;
+  {
+    std::lock_guard lock(mutex_);
+    chunks = chunks_;
+  }
+  if (chunks) {
+    if (auto cue = chunks->loan()) return cue;
+  }
+  return type_.make();
 }
 
 void OutputPort::persist_sequence(std::uint64_t* counter) {

@@ -43,6 +43,16 @@ TEST(PlainCueHarness, APlainSourcesCuesCarryTheFramesHeaderAndTheirWholeImage) {
   }
 }
 
+// Output::loan() without the zero-copy path: heap memory, published as it is (no copy).
+TEST(PlainCueHarness, ALoanedCueIsPublishedWhereTheKernelFilledIt) {
+  KernelHarness h("test_plain_source");
+  h.step();
+  const auto images = h.take<PlainGvImage>("image");
+  ASSERT_EQ(images.size(), 1u);
+  EXPECT_EQ(images[0].get(), dynamic_cast<test::PlainSource&>(h.kernel()).last_image());
+  EXPECT_TRUE(test::plain_image_complete(*images[0]));
+}
+
 TEST(PlainCueHarness, APlainSinkGetsFedCuesStampedWithTheHarnessTimeIfUnstamped) {
   KernelHarness h("test_plain_sink");
   auto image = std::make_unique<PlainGvImage>();

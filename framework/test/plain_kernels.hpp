@@ -2,6 +2,7 @@
 // Kernels of the plain cue types (oscar/plain_cue_types.hpp) for oscar_plain_cue_test, and as a
 // plugin (liboscar_kernel_test_plain.so) for its oscar-run children.
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <mutex>
@@ -30,19 +31,23 @@ std::uint64_t plain_image_frame(const PlainGvImage& image);
 /// first 8 pixels), with the full size.
 bool plain_image_complete(const PlainGvImage& image);
 
-/// Publishes a PlainBool on "flag" (true on odd cycles) and a full PlainGvImage on "image"
-/// (fill_plain_image with the cycle number, from 1) on every cycle; the frame completes the
-/// headers.
+/// Publishes a PlainBool on "flag" (true on odd cycles, published by value) and a full
+/// PlainGvImage on "image" (fill_plain_image with the cycle number, from 1, filled in a loan) on
+/// every cycle; the frame completes the headers.
 class PlainSource final : public Kernel {
  public:
   explicit PlainSource(KernelSetup& setup);
   void process(Cycle& cycle) override;
   void stub(Cycle& cycle) override { process(cycle); }
+  /// Where the last image was filled: it is loaned from the output (Output::loan()), so on the
+  /// zero-copy path a chunk, which the output publishes without a copy.
+  const void* last_image() const { return last_image_.load(); }
 
  private:
   Output<PlainBool>& flag_;
   Output<PlainGvImage>& image_;
   std::uint64_t cycles_ = 0;
+  std::atomic<const void*> last_image_{nullptr};
 };
 
 /// What PlainSink saw of one cue: its header as read through the framework, and its content.

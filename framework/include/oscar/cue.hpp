@@ -69,6 +69,18 @@ struct CueHeaderAccess {
 template <class H>
 struct CueHeaderForm;
 
+/// How a cue lies in memory: what the zero-copy path needs to build one in a shared-memory chunk
+/// (docs/zero_copy.md).
+struct CueMemory {
+  /// Self-contained (fixed-size members, no pointer into a heap), as Fast DDS's is_plain() says:
+  /// a cue another process can read in place.
+  bool plain = false;
+  std::size_t size = 0;
+  std::size_t alignment = 0;
+  void (*construct_at)(void* where) = nullptr;              ///< a default cue at `where`
+  void (*copy_to)(const void* cue, void* where) = nullptr;  ///< a copy of `cue` at `where`
+};
+
 /// What the framework needs to move a cue type it does not know at compile time.
 struct CueTypeInfo {
   std::string name;  ///< the DDS type name, e.g. "oscar::GvImage"
@@ -78,6 +90,7 @@ struct CueTypeInfo {
   std::vector<std::uint8_t> (*serialize)(const void* cue) = nullptr;
   /// @throws std::runtime_error if the bytes are not a valid CDR encoding of the type.
   std::shared_ptr<void> (*deserialize)(const std::vector<std::uint8_t>& bytes) = nullptr;
+  CueMemory memory{};
 };
 
 /// Registers (or finds) the description of a type by name; used by cue_type_info<T>().

@@ -1,6 +1,7 @@
 #pragma once
 /// @file cue_type_info<T>(): the run-time description of a declared cue type.
 
+#include <new>
 #include <type_traits>
 #include <utility>
 
@@ -29,6 +30,18 @@ CueHeaderAccess cue_header_access() {
   };
 }
 
+/// How a T lies in memory.
+template <CueType T>
+CueMemory cue_memory() {
+  return CueMemory{
+      .plain = typename CueTraits<T>::PubSubType().is_plain(),
+      .size = sizeof(T),
+      .alignment = alignof(T),
+      .construct_at = [](void* where) { new (where) T(); },
+      .copy_to = [](const void* cue, void* where) { new (where) T(*static_cast<const T*>(cue)); },
+  };
+}
+
 /// The registered description of T (registered on first use).
 template <CueType T>
 const CueTypeInfo& cue_type_info() {
@@ -41,6 +54,7 @@ const CueTypeInfo& cue_type_info() {
       .make = []() -> std::shared_ptr<void> { return std::make_shared<T>(); },
       .serialize = &internal::serialize_idl<T>,
       .deserialize = &internal::deserialize_idl<T>,
+      .memory = cue_memory<T>(),
   });
   return info;
 }

@@ -21,6 +21,19 @@ struct OutputOptions {
   bool transient_local = false;  ///< late joiners get the history (up to depth)
 };
 
+/// Keeps an output's cues in shared memory, where the zero-copy path carries them to the other
+/// processes of the host (docs/zero_copy.md); the frame sets one for an output of a plain type.
+class CueChunks {
+ public:
+  virtual ~CueChunks() = default;
+  /// A default cue in a fresh chunk, to be filled and published; nullptr when none is left.
+  virtual std::shared_ptr<void> loan() = 0;
+  /// Publishes `cue` to the host's other processes: in place if it is a loan() that nobody else
+  /// holds, else copied into a fresh chunk. Returns the cue as they read it (the published chunk,
+  /// which the ring then keeps), or `cue` itself if it could not be published (it says why).
+  virtual std::shared_ptr<const void> publish(std::shared_ptr<const void> cue) = 0;
+};
+
 /// The type-independent part of an output; the framework works with this.
 class OutputPort {
  public:
@@ -43,6 +56,9 @@ class OutputPort {
   void publish_erased(std::shared_ptr<void> cue);
   /// Re-publishes a cue exactly as it is (replay): header untouched.
   void forward_erased(std::shared_ptr<const void> cue);
+  /// A default cue to fill and publish: in a chunk where the zero-copy path carries this output,
+  /// else on the heap.
+  std::shared_ptr<void> loan_erased();
 
   /// Hands every cue to `input` too.
   /// @throws std::invalid_argument if the types differ or check_reliability() refuses the pair.
@@ -50,6 +66,8 @@ class OutputPort {
   void disconnect(InputPort* input);
   /// The frame's DDS writer; called on the publishing thread after in-process delivery.
   void set_remote(std::function<void(const void*)> remote);
+  /// The zero-copy path's chunks for this output, or nullptr for none.
+  void set_chunks(std::shared_ptr<CueChunks> chunks);
   /// The clock that stamps generation times (wall clock by default; harnesses set their own).
   void set_clock(std::function<Stamp()> clock);
   /// Continues numbering after `*counter` and stores every new number there (the frame points
@@ -67,6 +85,7 @@ class OutputPort {
   std::vector<InputPort*> consumers_;
   std::function<void(const void*)> remote_;
   std::function<Stamp()> clock_;
+  std::shared_ptr<CueChunks> chunks_;
 };
 
 /// @throws std::invalid_argument naming both ends if `input` does not take the cue type `type` of
@@ -86,8 +105,26 @@ template <CueType T>
 class Output final : public OutputPort {
  public:
   using OutputPort::OutputPort;
+
+  /// A cue to fill where it lies and then publish: for a plain type on the zero-copy path, in
+  /// the shared-memory chunk the host's consumers will read it from (docs/zero_copy.md).
+  class Loan {
+   public:
+    T& operator*() const { return *static_cast<T*>(cue_.get()); }
+    T* operator->() const { return static_cast<T*>(cue_.get()); }
+
+   private:
+    friend class Output;
+    explicit Loan(std::shared_ptr<void> cue) : cue_(std::move(cue)) {}
+    std::shared_ptr<void> cue_;
+  };
+
+  /// A default-constructed cue to fill and publish(); dropped unpublished, it goes back.
+  Loan loan() { return Loan(loan_erased()); }
   /// Publishes one cue; the frame fills in header.source and header.seq.
   void publish(T cue) { publish_erased(std::make_shared<T>(std::move(cue))); }
+  /// Publishes a loaned cue without copying it.
+  void publish(Loan cue) { publish_erased(std::move(cue.cue_)); }
 };
 
 }  // namespace oscar
