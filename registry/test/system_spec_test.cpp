@@ -306,7 +306,7 @@ TEST(SystemSpec, ZeroCopyIsOffByDefaultAndTakesTrueFalseOrAChunkCount) {
   EXPECT_FALSE(parse(std::string(kModules) + "zero_copy: false\n").zero_copy);
   const auto on = parse(std::string(kModules) + "zero_copy: true\n").zero_copy;
   ASSERT_TRUE(on);
-  EXPECT_EQ(on->chunks, 32u);
+  EXPECT_EQ(on->chunks, 64u);
   EXPECT_EQ(on->where, "s.yaml:2");
   const auto sized = parse(std::string(kModules) + "zero_copy: { chunks: 100 }\n").zero_copy;
   ASSERT_TRUE(sized);

@@ -21,6 +21,13 @@
 #include <oscar/configPubSubTypes.h>
 #include <oscar/registryPubSubTypes.h>
 
+#if OSCAR_ZERO_COPY
+#include "zero_copy/chunk_feed.hpp"
+#include "zero_copy/cue_path.hpp"
+#include "zero_copy/output_chunks.hpp"
+#include "zero_copy/roudi.hpp"
+#endif
+
 namespace oscar {
 namespace dds = eprosima::fastdds::dds;
 
@@ -186,6 +193,7 @@ DiscoveryScope Module::Dds::discovery_scope_of(const Module& module) {
 
 Module::Dds::Dds(Module& module, int domain)
     : module_(module),
+      domain_(domain),
       discovery_scope_(discovery_scope_of(module)),
       participant_(domain, "oscar:" + module.spec_.name, module.spec_.network, discovery_scope_),
       learns_only_shared_topics_(module.spec_.network.discovery == Discovery::kServer &&
@@ -206,9 +214,17 @@ Module::Dds::Dds(Module& module, int domain)
           security->keystore, identity);
     }
   }
+  join_zero_copy();
 }
 
 Module::Dds::~Dds() {
+  std::map<InputPort*, std::shared_ptr<void>> feeds;
+  {
+    std::lock_guard lock(readers_mutex_);
+    feeds.swap(feeds_);
+  }
+  feeds.clear();  // their threads deliver nothing more
+  for (auto* out : chunked_outputs_) out->set_chunks(nullptr);
   wishes_.reset();
   module_.log_sink_->attach(nullptr);
   stop_config();
@@ -240,13 +256,86 @@ void Module::Dds::wire_outputs(std::vector<std::unique_ptr<Slot>>& slots) {
     for (auto& out : s->instance->ports().outputs) {
       writers_.push_back(std::make_unique<OutputWriter>(participant_, *out));
       pull_servers_.push_back(std::make_unique<internal::DdsPullServer>(participant_, *out));
+#if OSCAR_ZERO_COPY
+      if (!zero_copy_ || !out->type().memory.plain) continue;
+      try {
+        out->set_chunks(std::make_shared<zero_copy::OutputChunks>(
+            zero_copy::zero_copy_topic(domain_, topics::cue(out->address())), out->type()));
+        chunked_outputs_.push_back(out.get());
+      } catch (const std::exception& e) {
+        module_.log_->warn("output {}: its cues go through DDS only: {}", out->address(), e.what());
+      }
+#endif
     }
   }
+}
+
+void Module::Dds::join_zero_copy() {
+#if OSCAR_ZERO_COPY
+  bool plain = false;
+  for (const auto& s : module_.slots_) {
+    const auto& ports = s->instance->ports();
+    for (const auto& out : ports.outputs) plain = plain || out->type().memory.plain;
+    for (const auto& in : ports.inputs) {
+      plain = plain || (!in->takes_any_type() && in->type().memory.plain);
+    }
+  }
+  if (!plain) return;
+  try {
+    // A runtime name of its own per process: a restarted module must not look like the old one.
+    if (const auto why =
+            zero_copy::join_roudi(fmt::format("{}-{}", module_.spec_.name, getpid()))) {
+      module_.log_->info("its plain cues go through DDS only: {}", *why);
+      return;
+    }
+    zero_copy_ = true;
+  } catch (const std::exception& e) {
+    module_.log_->warn("its plain cues go through DDS only: {}", e.what());
+  }
+#endif
+}
+
+std::optional<std::string> Module::Dds::feed_zero_copy(InputPort& input,
+                                                       const std::string& source) {
+#if OSCAR_ZERO_COPY
+  if (!zero_copy_ || input.takes_any_type()) return std::nullopt;
+  const auto topic = zero_copy::zero_copy_topic(domain_, topics::cue(source));
+  std::shared_ptr<zero_copy::ChunkFeed> feed;
+  try {
+    const bool offered =
+        input.type().memory.plain && zero_copy::offered_on_this_host(topic, input.type().name);
+    const auto facts = zero_copy::connection_facts(source, input.type(), offered);
+    // Logs why, for a serialized path.
+    if (zero_copy::choose_cue_path(facts).path != zero_copy::CuePath::kZeroCopy) {
+      return std::nullopt;
+    }
+    feed = std::make_shared<zero_copy::ChunkFeed>(topic, input, input.type());
+  } catch (const std::exception& e) {
+    module_.log_->warn("input {}/{}: its cues go through DDS: {}", input.kernel(), input.name(),
+                       e.what());
+    return std::nullopt;
+  }
+  disconnect_input(input);  // what fed it before
+  {
+    std::lock_guard lock(readers_mutex_);
+    feeds_[&input] = std::move(feed);
+  }
+  module_.log_->info("input {}/{}: cues of {} come zero-copy (read in place in shared memory)",
+                     input.kernel(), input.name(), source);
+  return std::string();
+#else
+  (void)input;
+  (void)source;
+  return std::nullopt;
+#endif
 }
 
 std::string Module::Dds::connect_input(InputPort& input, const std::string& source,
                                        std::optional<std::chrono::milliseconds> switch_wait) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(2000);
+  if (input.transfer() == Transfer::kPush) {
+    if (auto fed = feed_zero_copy(input, source)) return *fed;
+  }
   if (input.transfer() != Transfer::kPush) {
     auto puller = std::make_shared<internal::DdsPullSource>(
         participant_, input, source,
@@ -353,11 +442,16 @@ std::string Module::Dds::subscribe(InputPort& input, const std::string& source,
     module_.log_->warn("{}", note);
   }
   std::unique_ptr<CueReader> old;
+  std::shared_ptr<void> old_feed;  // a zero-copy feed from the source before, stopped below
   {
     std::lock_guard lock(readers_mutex_);
     auto& slot = readers_[&input];
     old = std::move(slot);
     slot = std::move(reader);
+    if (auto it = feeds_.find(&input); it != feeds_.end()) {
+      old_feed = std::move(it->second);
+      feeds_.erase(it);
+    }
   }
   if (old) {
     old->retire();
@@ -424,8 +518,13 @@ void Module::Dds::disconnect_input(InputPort& input) {
   }
   std::unique_ptr<CueReader> old;
   std::shared_ptr<internal::DdsPullSource> old_pull;  // the input reads elsewhere by now
+  std::shared_ptr<void> old_feed;
   {
     std::lock_guard lock(readers_mutex_);
+    if (auto it = feeds_.find(&input); it != feeds_.end()) {
+      old_feed = std::move(it->second);
+      feeds_.erase(it);
+    }
     if (auto it = readers_.find(&input); it != readers_.end()) {
       old = std::move(it->second);
       readers_.erase(it);

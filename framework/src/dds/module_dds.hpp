@@ -71,6 +71,12 @@ class Module::Dds {
     std::string source;
     OutputOptions offered;
   };
+  /// The zero-copy path (docs/zero_copy.md): a module with ports of a plain cue type joins this
+  /// host's RouDi, if one runs.
+  void join_zero_copy();
+  /// Feeds a push input of a plain type from its producer's chunks when this host's RouDi lists
+  /// the producer's output; "" then, nothing if its cues go through DDS (one line says why).
+  std::optional<std::string> feed_zero_copy(InputPort& input, const std::string& source);
   /// What the module's participant learns of from the discovery servers, if it uses them:
   /// only what shares a topic with it (docs/network.md), unless an input takes any type.
   static DiscoveryScope discovery_scope_of(const Module& module);
@@ -92,6 +98,8 @@ class Module::Dds {
   void beat();
 
   Module& module_;
+  const int domain_;
+  bool zero_copy_ = false;                ///< joined this host's RouDi
   const DiscoveryScope discovery_scope_;  ///< discovery_scope_of(module_), before participant_
   DdsParticipant participant_;
   /// A plain client of discovery servers: it learns of a producer's writer only by reading the
@@ -102,6 +110,10 @@ class Module::Dds {
   std::map<InputPort*, std::shared_ptr<internal::DdsPullSource>> pull_sources_;
   std::mutex readers_mutex_;
   std::map<InputPort*, std::unique_ptr<CueReader>> readers_;
+  /// Push inputs fed by the zero-copy path (zero_copy::ChunkFeed, which only the zero-copy build
+  /// knows), under readers_mutex_.
+  std::map<InputPort*, std::shared_ptr<void>> feeds_;
+  std::vector<OutputPort*> chunked_outputs_;  ///< outputs given zero-copy chunks
 
   // The configuration endpoints (topics::...), made by start_config().
   std::unique_ptr<TopicWriter<ModuleState, ModuleStatePubSubType>> state_writer_;

@@ -45,6 +45,11 @@ ChunkSubscriber::ChunkSubscriber(const std::string& topic, const std::string& ty
 
 ChunkSubscriber::~ChunkSubscriber() = default;
 
+bool ChunkSubscriber::subscribed() const {
+  std::lock_guard lock(state_->mutex);
+  return state_->subscriber.getSubscriptionState() == iox::SubscribeState::SUBSCRIBED;
+}
+
 std::shared_ptr<const void> ChunkSubscriber::take(std::chrono::nanoseconds timeout) {
   const auto until = std::chrono::steady_clock::now() + timeout;
   for (;;) {

@@ -28,6 +28,9 @@ class ChunkSubscriber {
   /// @throws std::runtime_error if this process holds too many chunks of the topic at once
   ///         (iceoryx's MAX_CHUNKS_HELD_PER_SUBSCRIBER_SIMULTANEOUSLY).
   std::shared_ptr<const void> take(std::chrono::nanoseconds timeout);
+  /// True once RouDi has connected it to the topic's publishers (iceoryx subscribes
+  /// asynchronously).
+  bool subscribed() const;
 
  private:
   struct State;

@@ -18,7 +18,9 @@ CuePathChoice choose_cue_path(const ConnectionFacts& facts) {
         "fixed-size members only, see idl/oscar/plain_cues.idl)",
         facts.type_name);
   else if (!facts.producer_on_this_host)
-    choice.reason = "the producer runs on another host (shared memory reaches this host only)";
+    choice.reason =
+        "no process of this host offers it in shared memory (the producer runs on another host, "
+        "has not started yet, or has no RouDi)";
   else if (!facts.roudi_running)
     choice.reason = "no RouDi runs on this host (iceoryx's daemon, iox-roudi)";
   else

@@ -10,8 +10,10 @@
 
 #include <fmt/format.h>
 #include <iceoryx_posh/runtime/posh_runtime.hpp>
+#include <iceoryx_posh/runtime/service_discovery.hpp>
 
 #include "oscar/process_util.hpp"
+#include "zero_copy/service.hpp"
 
 namespace oscar::zero_copy {
 namespace {
@@ -62,6 +64,24 @@ std::optional<std::string> join_roudi(const std::string& name) {
       iox::RuntimeName_t(iox::cxx::TruncateToCapacity, name.c_str()));
   joined = true;
   return std::nullopt;
+}
+
+bool offered_on_this_host(const std::string& topic, const std::string& type_name) {
+  const auto service = internal::service_for(topic, type_name);
+  static std::mutex mutex;  // one ServiceDiscovery for the process: it keeps a port with RouDi
+  static iox::runtime::ServiceDiscovery* discovery = nullptr;
+  std::lock_guard lock(mutex);
+  if (!discovery) discovery = new iox::runtime::ServiceDiscovery();  // lives as long as the process
+  bool found = false;
+  discovery->findService(
+      service.getServiceIDString(), service.getInstanceIDString(), service.getEventIDString(),
+      [&](const iox::capro::ServiceDescription&) { found = true; },
+      iox::popo::MessagingPattern::PUB_SUB);
+  return found;
+}
+
+std::string zero_copy_topic(int domain, const std::string& topic) {
+  return fmt::format("{}/{}", domain, topic);
 }
 
 }  // namespace oscar::zero_copy

@@ -16,4 +16,12 @@ bool roudi_running();
 /// @return nothing when registered, else why not (no RouDi, iox-roudi not installed).
 std::optional<std::string> join_roudi(const std::string& name);
 
+/// True if a process of this host's RouDi offers `topic` with cues of `type_name` (an iceoryx
+/// publisher of its service). Needs join_roudi() first.
+bool offered_on_this_host(const std::string& topic, const std::string& type_name);
+
+/// The iceoryx topic of the DDS topic `topic` in DDS domain `domain`: systems of other domains
+/// on the same host never meet.
+std::string zero_copy_topic(int domain, const std::string& topic);
+
 }  // namespace oscar::zero_copy

@@ -148,9 +148,10 @@ const char* to_string(SecuritySpec::CueProtection protection);
 /// `zero_copy:` (docs/zero_copy.md): each host's monitor keeps an iceoryx RouDi running, which
 /// carries the plain cue types between the host's processes without copies.
 struct ZeroCopySpec {
-  /// Chunks of each plain cue type in a host's RouDi: per type at least its consumers on the
-  /// host × (ring depth + queue) + its producers × 2 (docs/zero_copy.md, "Limits learned").
-  std::uint32_t chunks = 32;
+  /// Chunks of each plain cue type in a host's RouDi: per type at least its outputs' ring depths
+  /// + 2 loans per output + its consumers' ring depths × 2 (ring and queue) on the host
+  /// (docs/zero_copy.md, "Limits learned").
+  std::uint32_t chunks = 64;
   std::string where;  ///< "file:line"
 };
 

@@ -1,0 +1,214 @@
+// Plain cues on the zero-copy path between modules (docs/zero_copy.md, "Wiring into the ports"):
+// a kernel's output of a plain type publishes through this host's RouDi, and an input of another
+// module on the host reads the chunks in place. The test process has a mount namespace of its
+// own with a RouDi of its own (private_tmp.hpp; root, skipped otherwise).
+#include <signal.h>
+
+#include <chrono>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
+
+#include "oscar/module.hpp"
+#include "oscar/testing/eventually.hpp"
+#include "plain_kernels.hpp"
+#include "private_tmp.hpp"
+#include "process.hpp"
+#include "zero_copy/chunk_identity.hpp"
+#include "zero_copy/mempools.hpp"
+#include "zero_copy/roudi.hpp"
+
+namespace oscar {
+namespace {
+using namespace std::chrono_literals;
+using testing::HasSubstr;
+
+std::unique_ptr<Module> module(const std::string& yaml) {
+  auto m = std::make_unique<Module>(ModuleSpec::from_yaml(YAML::Load(yaml), "test"),
+                                    plugin_search_path());
+  m->start(test::test_domain());
+  return m;
+}
+
+const std::string kSource = R"(
+name: plain_src
+mode: { continuous: 20ms }
+kernels: [ { type: test_plain_source, name: src } ]
+)";
+const std::string kSink = R"(
+name: plain_sink
+mode: { continuous: 10ms }
+kernels:
+  - { type: test_plain_sink, name: sink, inputs: { flag: src/flag, image: src/image } }
+)";
+
+std::string zero_copy_topic_of(const std::string& address) {
+  return zero_copy::zero_copy_topic(test::test_domain(), "oscar/cue/" + address);
+}
+
+// One RouDi for the test process, which joins it once and for good (iceoryx 2.0 cannot join
+// another). It ends with SIGKILL: stopped with SIGTERM, RouDi would send SIGTERM to every process
+// registered with it, this one included.
+class Roudi {
+ public:
+  Roudi() {
+    std::ofstream("/tmp/roudi.toml") << zero_copy::roudi_config(zero_copy::plain_cue_mempools(64));
+    process_ = std::make_unique<test::Process>(
+        std::vector<std::string>{"/usr/bin/iox-roudi", "-c", "/tmp/roudi.toml"}, "/tmp/roudi.log");
+  }
+  ~Roudi() {
+    ::kill(process_->pid(), SIGKILL);
+    process_->wait(5s);
+  }
+  std::string output() const { return process_->output(); }
+
+ private:
+  std::unique_ptr<test::Process> process_;
+};
+
+class ZeroCopyWiring : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!test::kNoPrivateTmp.empty())
+      GTEST_SKIP() << "needs a private mount namespace (root): " << test::kNoPrivateTmp;
+    static const Roudi roudi;
+    ASSERT_TRUE(eventually([] { return zero_copy::roudi_running(); }, 30s)) << roudi.output();
+  }
+};
+
+// Both modules in this process, so that both ends of a cue can be looked at: the sink's ring holds
+// the very objects the source's ring holds, which the source filled where they lie.
+TEST_F(ZeroCopyWiring, ASinkReadsTheSourcesImagesInTheChunksTheSourceFilledThem) {
+  auto src = module(kSource);
+  ASSERT_TRUE(eventually(
+      [] {
+        return zero_copy::offered_on_this_host(zero_copy_topic_of("src/image"),
+                                               "oscar::PlainGvImage");
+      },
+      10s));
+  auto sink = module(kSink);
+  auto& k = dynamic_cast<test::PlainSink&>(sink->kernel("sink").kernel());
+  ASSERT_TRUE(eventually([&] { return k.images().size() >= 20 && k.flags().size() >= 20; }, 60s));
+  src->stop();
+  sink->stop();
+  auto& source = dynamic_cast<test::PlainSource&>(src->kernel("src").kernel());
+  auto& produced = src->kernel("src").ports().find_output("image")->buffer();
+  auto& received = sink->kernel("sink").ports().find_input("image")->buffer();
+  // The source filled its last image in the chunk its ring holds: published without a copy.
+  ASSERT_TRUE(produced.latest());
+  EXPECT_EQ(produced.latest()->cue.get(), source.last_image());
+  EXPECT_TRUE(zero_copy::identify_chunk(source.last_image())) << "a chunk, not heap memory";
+  std::map<std::uint64_t, const void*> by_seq;
+  for (const auto& e : produced.latest(produced.depth())) {
+    by_seq[cue_type_info<PlainGvImage>().header.read(e.cue.get()).seq()] = e.cue.get();
+  }
+  std::size_t same = 0;
+  for (const auto& e : received.latest(received.depth())) {
+    EXPECT_TRUE(zero_copy::identify_chunk(e.cue.get())) << "in shared memory";
+    const auto seq = cue_type_info<PlainGvImage>().header.read(e.cue.get()).seq();
+    if (const auto it = by_seq.find(seq); it != by_seq.end()) {
+      EXPECT_EQ(it->second, e.cue.get()) << "seq " << seq << ": the source's object";
+      ++same;
+    }
+  }
+  EXPECT_GE(same, 2u) << "the rings overlap (source depth 4, sink depth 8)";
+  const auto images = k.images();
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    EXPECT_TRUE(images[i].image_complete) << "seq " << images[i].header.seq();
+    EXPECT_EQ(images[i].frame, images[i].header.seq());
+    EXPECT_EQ(images[i].header.source(), "src/image");
+  }
+  // Bools are published by value: copied once into a chunk, read in place all the same.
+  const auto flag = sink->kernel("sink").ports().find_input("flag")->buffer().latest();
+  ASSERT_TRUE(flag);
+  EXPECT_TRUE(zero_copy::identify_chunk(flag->cue.get()));
+  const auto flags = k.flags();
+  for (std::size_t i = 1; i < flags.size(); ++i) {
+    EXPECT_EQ(flags[i].header.seq(), flags[i - 1].header.seq() + 1) << "none lost";
+    EXPECT_EQ(flags[i].value, flags[i].header.seq() % 2 == 1);
+  }
+}
+
+// The source in an oscar-run child: every image the sink gets lies in shared memory, whole, in
+// order; after a kill -9 of the source, another one's images come the same way.
+TEST_F(ZeroCopyWiring, ImagesCrossProcessesInPlaceAndAgainFromARestartedSource) {
+  const auto start_source = [] {
+    return test::run_module(
+        "plain_src",
+        {"--plugin", test::build_dir() + "/lib/oscar/test_plugins/liboscar_kernel_test_plain.so",
+         "-k", "test_plain_source:src", "-m", "continuous:20ms"});
+  };
+  auto src = start_source();
+  ASSERT_TRUE(eventually(
+      [] {
+        return zero_copy::join_roudi("zero_copy_flow_test") == std::nullopt &&
+               zero_copy::offered_on_this_host(zero_copy_topic_of("src/image"),
+                                               "oscar::PlainGvImage");
+      },
+      30s))
+      << src->output();
+  auto sink = module(kSink);
+  auto& k = dynamic_cast<test::PlainSink&>(sink->kernel("sink").kernel());
+  auto& received = sink->kernel("sink").ports().find_input("image")->buffer();
+  std::size_t in_shared_memory = 0, seen = 0;
+  const auto check_new = [&] {
+    for (const auto& e : received.latest(received.depth())) {
+      if (e.index <= seen) continue;
+      seen = e.index;
+      if (zero_copy::identify_chunk(e.cue.get())) ++in_shared_memory;
+    }
+  };
+  ASSERT_TRUE(eventually(
+      [&] {
+        check_new();
+        return k.images().size() >= 10;
+      },
+      60s))
+      << src->output();
+  ::kill(src->pid(), SIGKILL);
+  src->wait(10s);
+  const auto before = k.images().size();
+  auto again = start_source();
+  ASSERT_TRUE(eventually(
+      [&] {
+        check_new();
+        return k.images().size() >= before + 10;
+      },
+      60s))
+      << again->output();
+  sink->stop();
+  EXPECT_EQ(in_shared_memory, seen) << "every image the ring got lay in shared memory";
+  const auto images = k.images();
+  for (const auto& image : images)
+    EXPECT_TRUE(image.image_complete) << "seq " << image.header.seq();
+}
+
+// With RouDi joined, an input whose cues cannot come zero-copy reads through DDS and says why.
+TEST_F(ZeroCopyWiring, AnInputThatCannotGoZeroCopyReadsThroughDdsAndSaysWhy) {
+  std::ostringstream said;
+  auto capture = std::make_shared<spdlog::sinks::ostream_sink_mt>(said);
+  spdlog::default_logger()->sinks().push_back(capture);
+  auto m = module(R"(
+name: mixed
+mode: { continuous: 10ms }
+kernels:
+  - { type: test_plain_sink, name: sink, inputs: { flag: nobody/flag, image: nobody/image } }
+  - { type: test_gv, name: gv, inputs: { in: cam/image } }
+)");
+  m->stop();
+  std::erase(spdlog::default_logger()->sinks(), capture);
+  EXPECT_THAT(said.str(), HasSubstr("cues of cam/image go serialized, not zero-copy: cue type "
+                                    "oscar::GvImage is not plain"));
+  EXPECT_THAT(said.str(), HasSubstr("cues of nobody/image go serialized, not zero-copy: no "
+                                    "process of this host offers it in shared memory"));
+}
+
+}  // namespace
+}  // namespace oscar
