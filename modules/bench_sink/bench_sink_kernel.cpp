@@ -4,15 +4,20 @@
 #include <fstream>
 #include <map>
 
+#include <iterator>
+
 #include <fmt/format.h>
 #include <oscar/kernel_registry.hpp>
 
-#include "bench_pattern.hpp"  // modules/bench_source
+#include "bench_plain.hpp"  // modules/bench_source
 
 namespace oscar::modules {
 
 void BenchSink::Params::describe(ParamSpec& spec) {
-  spec.field("type", type, "cue type").one_of({"Bool", "LineSeg3DSeq", "GvImage"}).fixed();
+  spec.field("type", type, "cue type")
+      .one_of(std::vector<std::string>(std::begin(bench_pattern::kBenchTypes),
+                                       std::end(bench_pattern::kBenchTypes)))
+      .fixed();
   spec.field("report", report, "JSON report file (empty: log only)");
   spec.field("expect", expect, "write the report after this many cues; 0 = at the end").at_least(0);
   spec.field("warmup", warmup, "cues left out of the latency figures").at_least(0);
@@ -45,11 +50,11 @@ struct TypedPorts final : BenchSink::Ports {
         ++s.verified;
         s.corrupt += bench_pattern::checksum(*r.cue) != expected(*r.cue);
       }
-      const auto n = h.stamps().size();
+      const auto n = bench_pattern::stamp_count(h);
       s.stamps_min = s.received == 1 ? n : std::min<std::uint64_t>(s.stamps_min, n);
       s.stamps_max = std::max<std::uint64_t>(s.stamps_max, n);
       if (static_cast<std::int64_t>(s.received) <= warmup || n == 0) continue;
-      const auto generated = static_cast<std::int64_t>(h.stamps().front());
+      const auto generated = generation_stamp(h);
       if (s.delivery_ns.empty()) s.first_generated_ns = generated;
       s.last_generated_ns = generated;
       s.delivery_ns.push_back(r.received - generated);
@@ -58,13 +63,7 @@ struct TypedPorts final : BenchSink::Ports {
   }
   // bench_source's checksum for the shape of `cue`, computed once per shape.
   std::uint64_t expected(const T& cue) {
-    std::uint64_t shape = 0;
-    if constexpr (std::is_same_v<T, LineSeg3DSeq>) shape = cue.lines().size();
-    if constexpr (std::is_same_v<T, GvImage>) {
-      shape =
-          static_cast<std::uint16_t>(cue.dx()) * 65536ull + static_cast<std::uint16_t>(cue.dy());
-    }
-    const auto [it, added] = expected_by_shape.try_emplace(shape, 0);
+    const auto [it, added] = expected_by_shape.try_emplace(bench_pattern::shape_of(cue), 0);
     if (added) it->second = bench_pattern::expected_checksum(cue);
     return it->second;
   }
@@ -88,7 +87,7 @@ Percentiles percentiles_us(std::vector<std::int64_t> v) {
 
 BenchSink::BenchSink(KernelSetup& setup) {
   setup.params(params_);
-  ports_ = visit_standard_type(params_.type, [&]<class T>() -> std::unique_ptr<Ports> {
+  ports_ = bench_pattern::visit_bench_type(params_.type, [&]<class T>() -> std::unique_ptr<Ports> {
     return std::make_unique<TypedPorts<T>>(setup);
   });
 }

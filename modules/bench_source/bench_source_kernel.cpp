@@ -1,15 +1,22 @@
 #include "bench_source_kernel.hpp"
 
+#include <iterator>
+#include <type_traits>
+
 #include <oscar/kernel_registry.hpp>
 
-#include "bench_pattern.hpp"
+#include "bench_plain.hpp"
 
 namespace oscar::modules {
 
 void BenchSource::Params::describe(ParamSpec& spec) {
-  spec.field("type", type, "cue type").one_of({"Bool", "LineSeg3DSeq", "GvImage"}).fixed();
-  spec.field("lines", lines, "lines per LineSeg3DSeq (100 = 4800 bytes)").range(0, 1'000'000);
-  spec.field("dx", dx, "GvImage columns").range(1, 32767);
+  spec.field("type", type, "cue type (the Plain ones go zero-copy on one host)")
+      .one_of(std::vector<std::string>(std::begin(bench_pattern::kBenchTypes),
+                                       std::end(bench_pattern::kBenchTypes)))
+      .fixed();
+  spec.field("lines", lines, "lines per LineSeg3DSeq (100 = 4800 bytes; Plain: at most 256)")
+      .range(0, 1'000'000);
+  spec.field("dx", dx, "GvImage columns (Plain: dx x dy at most 768 x 576)").range(1, 32767);
   spec.field("dy", dy, "GvImage rows").range(1, 32767);
   spec.field("count", count, "cues to publish before going quiet; 0 = unlimited").at_least(0);
 }
@@ -23,24 +30,41 @@ namespace {
 template <class T>
 struct TypedPorts final : BenchSource::Ports {
   TypedPorts(KernelSetup& setup, const T& cue) : out(setup.output<T>("out")), prototype(cue) {}
-  void publish() override { out.publish(prototype); }  // the frame stamps and numbers it
+  // Filled before the frame stamps it, where it is published from: on the zero-copy path, in
+  // the shared-memory chunk the sink reads.
+  void publish() override {
+    auto cue = out.loan();
+    *cue = prototype;
+    out.publish(std::move(cue));
+  }
   Output<T>& out;
   T prototype;
 };
+
+template <class T>
+T payload(const BenchSource::Params& p) {
+  namespace bp = bench_pattern;
+  if constexpr (std::is_same_v<T, Bool> || std::is_same_v<T, PlainBool>) {
+    T b;
+    b.value(true);
+    return b;
+  } else if constexpr (std::is_same_v<T, LineSeg3DSeq>) {
+    return bp::lines(p.lines);
+  } else if constexpr (std::is_same_v<T, PlainLineSeg3DSeq>) {
+    return bp::plain_lines(p.lines);
+  } else if constexpr (std::is_same_v<T, GvImage>) {
+    return bp::image(p.dx, p.dy);
+  } else {
+    return bp::plain_image(p.dx, p.dy);
+  }
+}
 }  // namespace
 
 BenchSource::BenchSource(KernelSetup& setup) {
   setup.params(params_);
-  if (params_.type == "Bool") {
-    Bool b;
-    b.value(true);
-    ports_ = std::make_unique<TypedPorts<Bool>>(setup, b);
-  } else if (params_.type == "LineSeg3DSeq") {
-    ports_ = std::make_unique<TypedPorts<LineSeg3DSeq>>(setup, bench_pattern::lines(params_.lines));
-  } else {
-    ports_ =
-        std::make_unique<TypedPorts<GvImage>>(setup, bench_pattern::image(params_.dx, params_.dy));
-  }
+  ports_ = bench_pattern::visit_bench_type(params_.type, [&]<class T>() -> std::unique_ptr<Ports> {
+    return std::make_unique<TypedPorts<T>>(setup, payload<T>(params_));
+  });
 }
 
 BenchSource::~BenchSource() = default;

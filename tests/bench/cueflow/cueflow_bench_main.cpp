@@ -83,6 +83,7 @@ int main(int argc, char** argv) {
   std::string raw_config = "auto";
   std::vector<std::string> types{"Bool", "LineSeg3DSeq", "GvImage"};
   std::vector<std::string> constellations{"multicore", "local", "remote"};
+  if (OSCAR_ZERO_COPY) constellations.push_back("local_zero_copy");
   app.add_flag("--json", json, "print JSON instead of a table");
   app.add_option("--count", count, "measured cues per row (after the warm-up)")
       ->check(CLI::PositiveNumber);
@@ -92,9 +93,10 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--types", types, "rows to run")->delimiter(',');
   app.add_option("--constellations", constellations,
-                 "multicore, local, remote (two test hosts in network namespaces; root)")
+                 "multicore, local, remote (two test hosts in network namespaces; root), "
+                 "local_zero_copy (the plain types through a RouDi started here)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"multicore", "local", "remote"}));
+      ->check(CLI::IsMember({"multicore", "local", "remote", "local_zero_copy"}));
   oscar::bench::UdpSettings udp;
   app.add_option("--udp-buffer-bytes", udp.buffer_bytes,
                  "remote: UDP socket buffers of both sides (default OSCAR's 4 MiB; 0: the "
@@ -141,13 +143,29 @@ int main(int argc, char** argv) {
     }
   }
   std::vector<Peer> peers;
-  std::unique_ptr<Process> roudi;
+  std::unique_ptr<Process> roudi;  // for iceoryx and the zero-copy rows
+  const auto have_roudi = [&] {
+#if OSCAR_ZERO_COPY
+    if (!roudi) roudi = start_roudi(dir);
+#endif
+    return roudi != nullptr;
+  };
   for (const auto& peer : all ? std::span(kPeers) : std::span<const Peer>()) {
     if (!std::filesystem::exists(bin(peer.program))) {
       std::cerr << fmt::format("bench cueflow: {} not built (its package missing), no {} rows\n",
                                peer.program, peer.system);
-    } else if (peer.system != std::string("iceoryx") || (roudi = start_roudi(dir))) {
+    } else if (peer.system != std::string("iceoryx") || have_roudi()) {
       peers.push_back(peer);
+    }
+  }
+  if (std::find(constellations.begin(), constellations.end(), "local_zero_copy") !=
+      constellations.end()) {
+    if (!OSCAR_ZERO_COPY) {
+      std::cerr << "bench cueflow: local_zero_copy rows skipped: this OSCAR was built without "
+                   "iceoryx (libiceoryx-posh-dev)\n";
+      std::erase(constellations, "local_zero_copy");
+    } else if (!have_roudi()) {
+      std::erase(constellations, "local_zero_copy");
     }
   }
   nlohmann::json rows = nlohmann::json::array();
@@ -155,16 +173,19 @@ int main(int argc, char** argv) {
   int failures = 0;
   if (!json) {
     std::cout << fmt::format(
-        "{:<13} {:>7} {:<10} {:>9} {:>9} {:>9} {:>9} {:>10} {:>7} {:>10}  {}\n", "type", "bytes",
+        "{:<17} {:>7} {:<15} {:>9} {:>9} {:>9} {:>9} {:>10} {:>7} {:>10}  {}\n", "type", "bytes",
         "constell.", "p50 us", "p90 us", "p99 us", "max us", "raw p50", "ratio", "seed us",
         "raw config");
   }
   for (const auto& r : kRows) {
     if (std::find(types.begin(), types.end(), r.type) == types.end()) continue;
     for (const auto& c : constellations) {
-      const bool multicore = c == "multicore", remote = c == "remote";
+      const bool multicore = c == "multicore", remote = c == "remote",
+                 zero_copy = c == "local_zero_copy";
       // Remote: the raw program over the test hosts' UDP, in Fast DDS's default configuration.
-      std::string config = remote ? "listener,sync,udp" : raw_config;
+      // Zero-copy: raw iceoryx is the baseline (the same RouDi, its own minimal program).
+      std::string config = remote ? "listener,sync,udp" : zero_copy ? "iceoryx" : raw_config;
+      const auto type = zero_copy ? "Plain" + r.type : r.type;
       if (config == "auto") {
         // Two rounds over all configurations, each keeping its better run: a hiccup of the
         // machine during one short run does not decide the baseline.
@@ -192,16 +213,20 @@ int main(int argc, char** argv) {
         }
         config = *best;
       }
-      const auto raw_args = oscar::bench::raw_config_args(config);
+      const auto raw_args =
+          zero_copy ? std::vector<std::string>{} : oscar::bench::raw_config_args(config);
       std::vector<Latency> ours_runs, raw_runs;
       std::map<std::string, std::vector<Latency>> secured_runs;  // by cue protection
       std::map<std::string, std::vector<Latency>> peer_runs;     // by system
       for (int i = 1; i <= repeat; ++i) {
         std::cerr << fmt::format("bench cueflow: {} {} run {}/{} ({} cues)...\n", r.type, c, i,
                                  repeat, count);
-        const auto o = remote ? bench.framework_remote(r, *hosts) : bench.framework(r, multicore);
-        const auto w = remote ? bench.raw_remote(r, *hosts)
-                              : bench.program("oscar-bench-raw", raw_args, r, multicore);
+        const auto o = remote      ? bench.framework_remote(r, *hosts)
+                       : zero_copy ? bench.framework_zero_copy(r)
+                                   : bench.framework(r, multicore);
+        const auto w = remote      ? bench.raw_remote(r, *hosts)
+                       : zero_copy ? bench.program("oscar-bench-iceoryx", {}, r, false)
+                                   : bench.program("oscar-bench-raw", raw_args, r, multicore);
         if (!o || !w) {
           std::cerr << fmt::format("bench cueflow: {} {}: no report from {} (logs in {})\n", r.type,
                                    c, o ? "raw Fast DDS" : "OSCAR", dir.string());
@@ -211,7 +236,7 @@ int main(int argc, char** argv) {
         ours_runs.push_back(*o);
         raw_runs.push_back(*w);
         for (const auto& [protection, keystore] :
-             multicore || remote ? decltype(keystores){} : keystores) {
+             multicore || remote || zero_copy ? decltype(keystores){} : keystores) {
           if (const auto s = bench.framework(r, false, keystore)) {
             secured_runs[protection].push_back(*s);
           } else {
@@ -222,6 +247,7 @@ int main(int argc, char** argv) {
         }
         for (const auto& peer : peers) {
           if (remote && !peer.remote) continue;  // a same-host mechanism
+          if (zero_copy) continue;               // the local rows have them
           if (const auto l = remote ? bench.peer_remote(peer.program, r, *hosts)
                                     : bench.program(peer.program, {}, r, multicore)) {
             peer_runs[peer.system].push_back(*l);
@@ -240,7 +266,7 @@ int main(int argc, char** argv) {
       // The ratio of medians: each run's p50 is a median already, runs alternate OSCAR and raw.
       const double ratio = raw.p50 > 0 ? ours.p50 / raw.p50 : 0;
       rows.push_back({{"system", "oscar"},
-                      {"type", r.type},
+                      {"type", type},
                       {"bytes", r.bytes},
                       {"constellation", c},
                       {"p50_us", ours.p50},
@@ -258,9 +284,9 @@ int main(int argc, char** argv) {
                       {"seed_us", seed}});
       if (!json) {
         std::cout << fmt::format(
-                         "{:<13} {:>7} {:<10} {:>9.1f} {:>9.1f} {:>9.1f} {:>9.1f} {:>10.1f} "
+                         "{:<17} {:>7} {:<15} {:>9.1f} {:>9.1f} {:>9.1f} {:>9.1f} {:>10.1f} "
                          "{:>7.2f} {:>10.0f}  {}\n",
-                         r.type, r.bytes, c, ours.p50, ours.p90, ours.p99, ours.max, raw.p50, ratio,
+                         type, r.bytes, c, ours.p50, ours.p90, ours.p99, ours.max, raw.p50, ratio,
                          seed, config)
                   << std::flush;
       }
@@ -283,7 +309,7 @@ int main(int argc, char** argv) {
                         {"runs", runs.size()}});
         if (!json) {
           std::cout << fmt::format(
-                           "{:<13} {:>7} {:<10} {:>9.1f} {:>9.1f} {:>9} {:>9.1f} {:>10} {:>7.2f}  "
+                           "{:<17} {:>7} {:<15} {:>9.1f} {:>9.1f} {:>9} {:>9.1f} {:>10} {:>7.2f}  "
                            "(secured, cue topics: {}; ratio to OSCAR without security)\n",
                            r.type, r.bytes, c, s.p50, s.p90, "", s.max, "", vs_plain, protection)
                     << std::flush;

@@ -85,6 +85,36 @@ class Bench {
     return await_report(report, limit(r));
   }
 
+  // The zero-copy constellation (docs/zero_copy.md): the row's plain type ("Plain" + its type)
+  // between two modules on this host with a RouDi running. The source starts first, so that the
+  // sink finds its output offered in shared memory; a run whose sink does not say its cues come
+  // zero-copy gives no figure.
+  std::optional<Latency> framework_zero_copy(const Row& r) {
+    const auto type = "Plain" + r.type;
+    const auto report = file("oscar_zero_copy", r, false);
+    std::vector<std::unique_ptr<Process>> procs;
+    procs.push_back(std::make_unique<Process>(
+        std::vector<std::string>{bin("oscar-run"), "--name", "src", "--domain", dom(), "-k",
+                                 "bench_source:src", "-p", "src.type=" + type, "-m",
+                                 fmt::format("continuous:{}us", r.period_us)},
+        log("zero_copy_src")));
+    std::this_thread::sleep_for(500ms);  // its output offered through RouDi
+    procs.push_back(std::make_unique<Process>(
+        std::vector<std::string>{
+            bin("oscar-run"), "--name", "sink", "--domain", dom(), "-k", "bench_sink:sink", "-p",
+            "sink.type=" + type, "-p", "sink.report=" + report, "-p",
+            fmt::format("sink.expect={}", count_ + warmup_), "-p",
+            fmt::format("sink.warmup={}", warmup_), "-i", "sink.in=src/out", "-m", "single_step"},
+        log("zero_copy_sink")));
+    auto latency = await_report(report, limit(r));
+    if (latency && procs.back()->output().find("come zero-copy") == std::string::npos) {
+      std::cerr << fmt::format("bench cueflow: {}: the sink's cues did not come zero-copy: {}\n",
+                               type, procs.back()->output());
+      return std::nullopt;
+    }
+    return latency;
+  }
+
   // One run of a minimal program (oscar-bench-raw or a peer; `args` its configuration): `both`
   // for the multicore constellation, else `sub` and, 300 ms later, `pub`. `count` overrides the
   // measured cues (the pre-pass runs fewer).

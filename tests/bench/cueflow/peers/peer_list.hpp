@@ -11,6 +11,9 @@
 #include <vector>
 
 #include "process.hpp"  // tests/common
+#if OSCAR_ZERO_COPY
+#include "zero_copy/mempools.hpp"
+#endif
 
 namespace oscar::bench {
 
@@ -28,24 +31,27 @@ inline constexpr Peer kPeers[] = {
     {"floor", "oscar-bench-floor"},
 };
 
+#if OSCAR_ZERO_COPY
 // RouDi for the iceoryx rows, with mempools for the three rows' cues (16 in a subscriber's queue
-// plus those in flight); Process stops it with SIGTERM, on which it removes its shared memory.
-// None if it does not stay up (e.g. another RouDi runs on this machine).
+// plus those in flight), and for the zero-copy rows' plain cues (a ring of 16 at the source, a
+// ring and a queue of 16 at the sink, loans); Process stops it with SIGTERM, on which it removes
+// its shared memory. None if it does not stay up (e.g. another RouDi runs on this machine).
 inline std::unique_ptr<oscar::test::Process> start_roudi(const std::filesystem::path& dir) {
   const auto config = dir / "roudi.toml";
-  std::ofstream(config) << "[general]\nversion = 1\n\n[[segment]]\n\n"
-                           "[[segment.mempool]]\nsize = 128\ncount = 64\n\n"
-                           "[[segment.mempool]]\nsize = 8192\ncount = 64\n\n"
-                           "[[segment.mempool]]\nsize = 524288\ncount = 64\n";
+  std::vector<oscar::zero_copy::Mempool> pools{{128, 64}, {8192, 64}, {524288, 64}};
+  for (const auto& pool : oscar::zero_copy::plain_cue_mempools(64)) pools.push_back(pool);
+  std::ofstream(config) << oscar::zero_copy::roudi_config(pools);
   auto roudi = std::make_unique<oscar::test::Process>(
       std::vector<std::string>{"/usr/bin/iox-roudi", "-c", config.string(), "-l", "warning"},
       (dir / "roudi.log").string());
   std::this_thread::sleep_for(std::chrono::seconds(1));
   if (roudi->wait(std::chrono::milliseconds(0))) {
-    std::cerr << "bench cueflow: iox-roudi did not stay up, no iceoryx rows: " << roudi->output();
+    std::cerr << "bench cueflow: iox-roudi did not stay up, no iceoryx or zero-copy rows: "
+              << roudi->output();
     return nullptr;
   }
   return roudi;
 }
+#endif
 
 }  // namespace oscar::bench
