@@ -254,18 +254,21 @@ void Module::Dds::wire_wishes(std::vector<std::unique_ptr<Slot>>& slots) {
 void Module::Dds::wire_outputs(std::vector<std::unique_ptr<Slot>>& slots) {
   for (auto& s : slots) {
     for (auto& out : s->instance->ports().outputs) {
-      writers_.push_back(std::make_unique<OutputWriter>(participant_, *out));
-      pull_servers_.push_back(std::make_unique<internal::DdsPullServer>(participant_, *out));
 #if OSCAR_ZERO_COPY
-      if (!zero_copy_ || !out->type().memory.plain) continue;
-      try {
-        out->set_chunks(std::make_shared<zero_copy::OutputChunks>(
-            zero_copy::zero_copy_topic(domain_, topics::cue(out->address())), out->type()));
-        chunked_outputs_.push_back(out.get());
-      } catch (const std::exception& e) {
-        module_.log_->warn("output {}: its cues go through DDS only: {}", out->address(), e.what());
+      // Before its writer: a consumer that discovers the writer finds the chunks offered.
+      if (zero_copy_ && out->type().memory.plain) {
+        try {
+          out->set_chunks(std::make_shared<zero_copy::OutputChunks>(
+              zero_copy::zero_copy_topic(domain_, topics::cue(out->address())), out->type()));
+          chunked_outputs_.push_back(out.get());
+        } catch (const std::exception& e) {
+          module_.log_->warn("output {}: its cues go through DDS only: {}", out->address(),
+                             e.what());
+        }
       }
 #endif
+      writers_.push_back(std::make_unique<OutputWriter>(participant_, *out));
+      pull_servers_.push_back(std::make_unique<internal::DdsPullServer>(participant_, *out));
     }
   }
 }
@@ -295,15 +298,23 @@ void Module::Dds::join_zero_copy() {
 #endif
 }
 
-std::optional<std::string> Module::Dds::feed_zero_copy(InputPort& input,
-                                                       const std::string& source) {
+std::optional<std::string> Module::Dds::feed_zero_copy(InputPort& input, const std::string& source,
+                                                       bool producer_seen) {
 #if OSCAR_ZERO_COPY
   if (!zero_copy_ || input.takes_any_type()) return std::nullopt;
   const auto topic = zero_copy::zero_copy_topic(domain_, topics::cue(source));
   std::shared_ptr<zero_copy::ChunkFeed> feed;
   try {
-    const bool offered =
-        input.type().memory.plain && zero_copy::offered_on_this_host(topic, input.type().name);
+    // RouDi lists a new publisher within its next discovery round.
+    const auto until =
+        std::chrono::steady_clock::now() +
+        (producer_seen ? std::chrono::milliseconds(300) : std::chrono::milliseconds(0));
+    bool offered = false;
+    while (input.type().memory.plain &&
+           !(offered = zero_copy::offered_on_this_host(topic, input.type().name)) &&
+           std::chrono::steady_clock::now() < until) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
     const auto facts = zero_copy::connection_facts(source, input.type(), offered);
     // Logs why, for a serialized path.
     if (zero_copy::choose_cue_path(facts).path != zero_copy::CuePath::kZeroCopy) {
@@ -326,6 +337,7 @@ std::optional<std::string> Module::Dds::feed_zero_copy(InputPort& input,
 #else
   (void)input;
   (void)source;
+  (void)producer_seen;
   return std::nullopt;
 #endif
 }
@@ -333,9 +345,7 @@ std::optional<std::string> Module::Dds::feed_zero_copy(InputPort& input,
 std::string Module::Dds::connect_input(InputPort& input, const std::string& source,
                                        std::optional<std::chrono::milliseconds> switch_wait) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(2000);
-  if (input.transfer() == Transfer::kPush) {
-    if (auto fed = feed_zero_copy(input, source)) return *fed;
-  }
+
   if (input.transfer() != Transfer::kPush) {
     auto puller = std::make_shared<internal::DdsPullSource>(
         participant_, input, source,
@@ -365,6 +375,9 @@ std::string Module::Dds::connect_input(InputPort& input, const std::string& sour
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
   }
+  // A producer on this host whose writer discovery shows has its chunks offered too (its outputs
+  // get their chunks before their writers).
+  if (auto fed = feed_zero_copy(input, source, seen.has_value())) return *fed;
   OutputOptions producer;
   if (seen) {
     producer.reliable = seen->reliable;

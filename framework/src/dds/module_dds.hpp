@@ -75,8 +75,10 @@ class Module::Dds {
   /// host's RouDi, if one runs.
   void join_zero_copy();
   /// Feeds a push input of a plain type from its producer's chunks when this host's RouDi lists
-  /// the producer's output; "" then, nothing if its cues go through DDS (one line says why).
-  std::optional<std::string> feed_zero_copy(InputPort& input, const std::string& source);
+  /// the producer's output (waiting a moment for that if discovery shows the producer's writer:
+  /// `producer_seen`); "" then, nothing if its cues go through DDS (one line says why).
+  std::optional<std::string> feed_zero_copy(InputPort& input, const std::string& source,
+                                            bool producer_seen);
   /// What the module's participant learns of from the discovery servers, if it uses them:
   /// only what shares a topic with it (docs/network.md), unless an input takes any type.
   static DiscoveryScope discovery_scope_of(const Module& module);
