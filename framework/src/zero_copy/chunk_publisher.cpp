@@ -3,6 +3,7 @@
 #include <iceoryx_posh/popo/untyped_publisher.hpp>
 
 #include "zero_copy/service.hpp"
+#include "zero_copy/tsan_handoff.hpp"
 
 namespace oscar::zero_copy {
 
@@ -19,12 +20,20 @@ ChunkPublisher::~ChunkPublisher() = default;
 void* ChunkPublisher::loan(std::size_t bytes, std::size_t alignment) {
   auto chunk = impl_->publisher.loan(static_cast<std::uint32_t>(bytes),
                                      static_cast<std::uint32_t>(alignment));
-  return chunk.has_error() ? nullptr : chunk.value();
+  if (chunk.has_error()) return nullptr;
+  internal::taken_over(chunk.value());  // a chunk a subscriber gave back
+  return chunk.value();
 }
 
-void ChunkPublisher::publish(void* payload) { impl_->publisher.publish(payload); }
+void ChunkPublisher::publish(void* payload) {
+  internal::handing_over(payload);
+  impl_->publisher.publish(payload);
+}
 
-void ChunkPublisher::release(void* payload) { impl_->publisher.release(payload); }
+void ChunkPublisher::release(void* payload) {
+  internal::handing_over(payload);
+  impl_->publisher.release(payload);
+}
 
 bool ChunkPublisher::has_subscribers() const { return impl_->publisher.hasSubscribers(); }
 

@@ -8,6 +8,7 @@
 #include <iceoryx_posh/popo/wait_set.hpp>
 
 #include "zero_copy/service.hpp"
+#include "zero_copy/tsan_handoff.hpp"
 
 namespace oscar::zero_copy {
 
@@ -57,8 +58,10 @@ std::shared_ptr<const void> ChunkSubscriber::take(std::chrono::nanoseconds timeo
       std::lock_guard lock(state_->mutex);
       auto taken = state_->subscriber.take();
       if (!taken.has_error()) {
+        internal::taken_over(taken.value());
         auto state = state_;
         return std::shared_ptr<const void>(taken.value(), [state](const void* payload) {
+          internal::handing_over(payload);
           std::lock_guard release_lock(state->mutex);
           state->subscriber.release(payload);
         });
