@@ -1,10 +1,7 @@
 #include "zero_copy/cue_path.hpp"
 
-#include <memory>
-
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
-#include <fastdds/dds/topic/TopicDataType.hpp>
 
 #include "zero_copy/roudi.hpp"
 
@@ -32,11 +29,10 @@ CuePathChoice choose_cue_path(const ConnectionFacts& facts) {
 
 ConnectionFacts connection_facts(const std::string& source, const CueTypeInfo& type,
                                  bool producer_on_this_host) {
-  const std::unique_ptr<eprosima::fastdds::dds::TopicDataType> description(type.new_topic_type());
   ConnectionFacts facts;
   facts.source = source;
   facts.type_name = type.name;
-  facts.type_is_plain = description && description->is_plain();
+  facts.type_is_plain = type.memory.plain;
   facts.producer_on_this_host = producer_on_this_host;
   facts.roudi_running = producer_on_this_host && facts.type_is_plain && roudi_running();
   return facts;

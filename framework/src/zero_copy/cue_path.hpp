@@ -32,8 +32,8 @@ struct ConnectionFacts {
 /// with the first reason that rules zero-copy out. Logs one line for a serialized choice.
 CuePathChoice choose_cue_path(const ConnectionFacts& facts);
 
-/// The facts of a connection from `source` of cue type `type`: plainness as the type's Fast DDS
-/// description says, RouDi as roudi_running() finds it.
+/// The facts of a connection from `source` of cue type `type`: plainness as its CueMemory says
+/// (Fast DDS's is_plain()), RouDi as roudi_running() finds it.
 ConnectionFacts connection_facts(const std::string& source, const CueTypeInfo& type,
                                  bool producer_on_this_host);
 
