@@ -29,32 +29,39 @@ int main(int argc, char** argv) {
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   try {
     auto participant = tool.participant("oscar-topics");
+    // Per topic: samples since the first, and when the first came. The rate counts from the
+    // first sample, not from the subscription: a reader matched late (a loaded host, a writer
+    // discovered late) still measures the writer's rate, not the match time.
+    struct Heard {
+      std::uint64_t first_ns = 0, after_first = 0;
+    };
     std::mutex mutex;
-    std::map<std::string, std::uint64_t> counts;
-    oscar::inspect::RawTap tap(*participant, [&](const std::string& topic, auto, auto) {
+    std::map<std::string, Heard> heard;
+    oscar::inspect::RawTap tap(*participant, [&](const std::string& topic, auto, auto at_ns) {
       std::lock_guard lock(mutex);
-      ++counts[topic];
+      auto& h = heard[topic];
+      if (h.first_ns == 0) {
+        h.first_ns = at_ns;
+      } else {
+        ++h.after_first;
+      }
     });
     const auto wanted = [&](const std::string& t) { return all || oscar::topics::is_cue(t); };
-    // Discovery first (a quarter of the time), then count samples for the rest.
+    // Writers discovered at any time while listening are subscribed to.
     const auto total = std::chrono::milliseconds(static_cast<long>(duration_s * 1000));
-    const auto start = std::chrono::steady_clock::now();
-    std::this_thread::sleep_for(total / 4);
-    for (const auto& [name, w] : participant->discovered_writers()) {
-      if (wanted(name)) tap.subscribe(name);
+    const auto end = std::chrono::steady_clock::now() + total;
+    while (std::chrono::steady_clock::now() < end) {
+      for (const auto& [name, w] : participant->discovered_writers()) {
+        if (wanted(name)) tap.subscribe(name);
+      }
+      std::this_thread::sleep_until(
+          std::min(end, std::chrono::steady_clock::now() + std::chrono::milliseconds(100)));
     }
+    const auto end_ns = oscar::inspect::now_ns();
+    std::map<std::string, Heard> final_heard;
     {
       std::lock_guard lock(mutex);
-      counts.clear();
-    }
-    const auto counting_from = std::chrono::steady_clock::now();
-    std::this_thread::sleep_until(start + total);
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - counting_from).count();
-    std::map<std::string, std::uint64_t> final_counts;
-    {
-      std::lock_guard lock(mutex);
-      final_counts = counts;
+      final_heard = heard;
     }
     nlohmann::json out = nlohmann::json::array();
     std::size_t width = 5;
@@ -64,7 +71,10 @@ int main(int argc, char** argv) {
       fmt::print("{:<{}}  {:<22}  {:>9}  {}\n", "TOPIC", width, "TYPE", "RATE (Hz)", "QOS");
     for (const auto& [name, w] : writers) {
       if (!wanted(name)) continue;
-      const double hz = static_cast<double>(final_counts[name]) / seconds;
+      const auto& h = final_heard[name];
+      const double hz = h.after_first == 0 ? 0
+                                           : static_cast<double>(h.after_first) /
+                                                 (static_cast<double>(end_ns - h.first_ns) / 1e9);
       if (json) {
         out.push_back({{"topic", name}, {"type", w.type}, {"qos", w.qos}, {"rate_hz", hz}});
       } else {
