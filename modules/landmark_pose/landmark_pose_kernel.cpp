@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -95,6 +96,7 @@ void LandmarkPoseFusion::process(Cycle& cycle) {
   cue.truth(a.truth());
   std::vector<Eigen::Isometry3d> estimates;
   add_estimates(a, estimates, cue);
+  const auto from_a = estimates.size();
   if (b) {
     for (const auto s : b->header().stamps()) cue.header().stamps().push_back(s);
     add_estimates(*b, estimates, cue);
@@ -124,11 +126,24 @@ void LandmarkPoseFusion::process(Cycle& cycle) {
     cue.spread_m(spread);
   }
   append_stamp(cue.header(), fused_at);
-  account(cue, cycle);
+  // What the fused pose should be: where the target was at A's grab, or, with B's estimates,
+  // the mean of where it was at both grabs weighted as the estimates are (it moves in between).
+  std::optional<Eigen::Vector3d> expected;
+  if (a.truth().valid()) {
+    expected = from_pose3(a.truth().target()).translation();
+    const auto from_b = estimates.size() - from_a;
+    if (from_b > 0 && b->truth().valid()) {
+      const Eigen::Vector3d at_b = from_pose3(b->truth().target()).translation();
+      *expected = (*expected * static_cast<double>(from_a) + at_b * static_cast<double>(from_b)) /
+                  static_cast<double>(estimates.size());
+    }
+  }
+  account(cue, expected, cycle);
   pose_.publish(std::move(cue));
 }
 
-void LandmarkPoseFusion::account(const oscar::LandmarkPose& cue, Cycle& cycle) {
+void LandmarkPoseFusion::account(const oscar::LandmarkPose& cue,
+                                 const std::optional<Eigen::Vector3d>& expected, Cycle& cycle) {
   if (params_.log_every.count() == 0) return;
   if (window_start_ == 0) window_start_ = cycle.now();
   ++poses_;
@@ -139,10 +154,10 @@ void LandmarkPoseFusion::account(const oscar::LandmarkPose& cue, Cycle& cycle) {
   Stamp acquired = static_cast<Stamp>(st.front());
   if (st.size() >= 5) acquired = std::min(acquired, static_cast<Stamp>(st[2]));
   latencies_ms_.push_back((static_cast<Stamp>(st.back()) - acquired) / 1e6);
-  if (cue.valid() && cue.truth().valid()) {
+  if (cue.valid() && expected) {
     ++truths_;
     const auto pose = from_pose3(cue.pose()), truth = from_pose3(cue.truth().target());
-    worst_mm_ = std::max(worst_mm_, (pose.translation() - truth.translation()).norm() * 1000);
+    worst_mm_ = std::max(worst_mm_, (pose.translation() - *expected).norm() * 1000);
     worst_deg_ = std::max(
         worst_deg_,
         Eigen::Quaterniond(pose.rotation()).angularDistance(Eigen::Quaterniond(truth.rotation())) *

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,7 +32,8 @@ class LandmarkPoseFusion final : public Kernel {
 
  private:
   Input<TagDetections>::Ptr matching_b(Stamp acquired);
-  void account(const oscar::LandmarkPose& cue, Cycle& cycle);
+  void account(const oscar::LandmarkPose& cue, const std::optional<Eigen::Vector3d>& expected,
+               Cycle& cycle);
   void add_estimates(const TagDetections& tags, std::vector<Eigen::Isometry3d>& out,
                      oscar::LandmarkPose& cue) const;
 
