@@ -332,18 +332,22 @@ void Module::kernel_failed(Slot& slot, std::string failure) {
       return;
     }
     case KernelErrorPolicy::Action::kRestart: {
-      auto reason = fmt::format(
-          "kernel '{}' failed {} times in a row (on_kernel_error: restart); "
-          "last: {}",
-          name, slot.failures_in_a_row, slot.failure);
-      log_->error("stopping the module: {}", reason);  // not under mutex_: it writes to DDS
-      std::lock_guard lock(mutex_);
-      exit_reason_ = std::move(reason);
-      stop_requested_ = true;
-      stopped_.notify_all();
+      end_for_restart(
+          fmt::format("kernel '{}' failed {} times in a row (on_kernel_error: restart); "
+                      "last: {}",
+                      name, slot.failures_in_a_row, slot.failure));
       return;
     }
   }
+}
+
+void Module::end_for_restart(std::string reason) {
+  log_->error("stopping the module: {}", reason);  // not under mutex_: it writes to DDS
+  std::lock_guard lock(mutex_);
+  if (!exit_reason_.empty()) return;  // the first reason is the one to tell
+  exit_reason_ = std::move(reason);
+  stop_requested_ = true;
+  stopped_.notify_all();
 }
 
 // One thread runs every kernel of the module (seed 004 §2.2): the continuous kernel on its

@@ -88,8 +88,8 @@ void HostRoudi::start(Clock::time_point now) {
       spdlog::info("started RouDi (pid {})", pid);
     } else {
       spdlog::warn(
-          "started RouDi again (pid {}): processes that joined the RouDi before carry no "
-          "zero-copy cues until they restart (iceoryx 2.0 cannot join them to a new one)",
+          "started RouDi again (pid {}): modules that joined the RouDi before end and their "
+          "registry starts them again (iceoryx 2.0 cannot move a process to a new RouDi)",
           pid);
     }
   } catch (const std::runtime_error& e) {

@@ -12,6 +12,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "oscar/module_spec.hpp"
 #include "oscar/registry/host_check.hpp"
 #include "private_tmp.hpp"
 #include "proc.hpp"
@@ -141,12 +142,45 @@ TEST_F(HostRoudi, AKilledRouDiIsStartedAgainAndSaysWhatThatMeansForJoinedProcess
   ::kill(static_cast<pid_t>(first.front()), SIGKILL);
   ASSERT_TRUE(eventually([&] { return monitor_said("started RouDi again"); })) << monitor.output();
   EXPECT_TRUE(monitor_said("killed by signal 9")) << monitor.output();
-  EXPECT_TRUE(monitor_said("processes that joined the RouDi before carry no zero-copy cues"));
+  EXPECT_TRUE(
+      monitor_said("modules that joined the RouDi before end and their registry starts "
+                   "them again"));
   ASSERT_TRUE(eventually([] { return zero_copy::roudi_running(); }));
   const auto second = roudis();
   ASSERT_EQ(second.size(), 1u);
   EXPECT_NE(second.front(), first.front());
   cues_flow("PlainBool", "5", "1", "0");  // the new one carries cues
+}
+
+// A module that joined a RouDi which was killed and started again would publish where nobody
+// started since looks: it ends with kKernelFailureExit, saying why, and the registry starts it
+// again (on the new RouDi).
+TEST_F(HostRoudi, AModuleWhoseRouDiWasReplacedEndsSoThatTheRegistryStartsItAgain) {
+  auto& monitor = start_monitor();
+  ASSERT_TRUE(eventually([&] { return monitor_said("RouDi runs"); })) << monitor.output();
+  auto module = test::run_module(
+      "plain_src", {"-k", "bench_source:src", "-p", "src.type=PlainBool", "-m", "continuous:20ms"});
+  const auto joined = [&] {
+    return test::proc_file(module->pid(), "maps").find("/dev/shm/iceoryx_mgmt") !=
+           std::string::npos;
+  };
+  ASSERT_TRUE(eventually(joined)) << module->output();
+  const auto first = roudis();
+  ASSERT_EQ(first.size(), 1u);
+  ::kill(static_cast<pid_t>(first.front()), SIGKILL);
+  std::this_thread::sleep_for(100ms);
+  EXPECT_FALSE(module->wait(0ms)) << "a killed RouDi not yet replaced ends nothing";
+  ASSERT_TRUE(eventually([&] { return monitor_said("started RouDi again"); })) << monitor.output();
+  EXPECT_EQ(module->wait(10s), kKernelFailureExit) << module->output();
+  EXPECT_THAT(module->output(),
+              HasSubstr("stopping the module: the RouDi it joined is gone and another runs "
+                        "(/dev/shm/iceoryx_mgmt is a new segment)"));
+  EXPECT_THAT(module->output(), HasSubstr("the registry starts it again on the host's RouDi"));
+  // Started again, it joins the new RouDi and stays.
+  module = test::run_module(
+      "plain_src", {"-k", "bench_source:src", "-p", "src.type=PlainBool", "-m", "continuous:20ms"});
+  ASSERT_TRUE(eventually(joined)) << module->output();
+  EXPECT_FALSE(module->wait(1s)) << module->output();
 }
 
 TEST_F(HostRoudi, ARouDiAlreadyRunningIsUsedAndWhenItGoesTheMonitorStartsItsOwn) {

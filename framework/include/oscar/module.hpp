@@ -66,7 +66,8 @@ class Module {
   ModuleState state() const;
   /// True while one kernel call has run longer than the watchdog limit (the heartbeat stops).
   bool hung() const;
-  /// Why the module asked to be stopped on its own (on_kernel_error: restart); empty otherwise.
+  /// Why the module asked to be stopped on its own (on_kernel_error: restart, its RouDi gone);
+  /// empty otherwise.
   std::string exit_reason() const;
 
   const ModuleSpec& spec() const { return spec_; }
@@ -83,6 +84,9 @@ class Module {
   void processing_loop();
   void run_slot(Slot& slot, Trigger trigger, bool stub);
   void kernel_failed(Slot& slot, std::string failure);
+  /// Stops the module on its own: oscar-run exits with kKernelFailureExit and the registry
+  /// starts it again. Thread-safe; the first reason is kept.
+  void end_for_restart(std::string reason);
   void mark_pending(Slot& slot);
   void post_and_wait(const std::function<void()>& task);
   void report(const std::string& transition);

@@ -218,6 +218,7 @@ Module::Dds::Dds(Module& module, int domain)
 }
 
 Module::Dds::~Dds() {
+  roudi_watch_.reset();  // it may end the module, which logs through what follows
   std::map<InputPort*, std::shared_ptr<void>> feeds;
   {
     std::lock_guard lock(readers_mutex_);
@@ -292,6 +293,9 @@ void Module::Dds::join_zero_copy() {
       return;
     }
     zero_copy_ = true;
+    roudi_watch_ = std::make_shared<zero_copy::RoudiWatch>([this](const std::string& why) {
+      module_.end_for_restart(why + "; the registry starts it again on the host's RouDi");
+    });
   } catch (const std::exception& e) {
     module_.log_->warn("its plain cues go through DDS only: {}", e.what());
   }

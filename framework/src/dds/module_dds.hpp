@@ -116,6 +116,8 @@ class Module::Dds {
   /// knows), under readers_mutex_.
   std::map<InputPort*, std::shared_ptr<void>> feeds_;
   std::vector<OutputPort*> chunked_outputs_;  ///< outputs given zero-copy chunks
+  /// Ends the module when the RouDi it joined is replaced (zero_copy::RoudiWatch).
+  std::shared_ptr<void> roudi_watch_;
 
   // The configuration endpoints (topics::...), made by start_config().
   std::unique_ptr<TopicWriter<ModuleState, ModuleStatePubSubType>> state_writer_;

@@ -1,11 +1,13 @@
 #include "zero_copy/roudi.hpp"
 
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
 
 #include <cstring>
-#include <mutex>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -23,6 +25,23 @@ namespace {
 std::string roudi_socket() {
   return std::string(iox::platform::IOX_UDS_SOCKET_PATH_PREFIX) +
          iox::roudi::IPC_CHANNEL_ROUDI_NAME;
+}
+
+std::string management_segment() { return std::string("/dev/shm/") + iox::roudi::SHM_NAME; }
+
+// The inode of the management segment this process has mapped (/proc/self/maps: address perms
+// offset device inode path, the path with " (deleted)" once unlinked); 0 if none.
+unsigned long mapped_inode(const std::string& segment) {
+  std::ifstream maps("/proc/self/maps");
+  std::string line;
+  while (std::getline(maps, line)) {
+    std::istringstream fields(line);
+    std::string address, perms, offset, device, path;
+    unsigned long inode = 0;
+    if (!(fields >> address >> perms >> offset >> device >> inode >> path)) continue;
+    if (path == segment) return inode;
+  }
+  return 0;
 }
 
 }  // namespace
@@ -64,6 +83,40 @@ std::optional<std::string> join_roudi(const std::string& name) {
       iox::RuntimeName_t(iox::cxx::TruncateToCapacity, name.c_str()));
   joined = true;
   return std::nullopt;
+}
+
+RoudiWatch::RoudiWatch(std::function<void(const std::string& why)> gone,
+                       std::chrono::milliseconds period)
+    : gone_(std::move(gone)), period_(period), joined_inode_(mapped_inode(management_segment())) {
+  if (joined_inode_ == 0)
+    throw std::runtime_error(
+        fmt::format("this process maps no {}: it joined no RouDi", management_segment()));
+  thread_ = std::thread([this] { watch(); });
+}
+
+RoudiWatch::~RoudiWatch() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  thread_.join();
+}
+
+void RoudiWatch::watch() {
+  const auto segment = management_segment();
+  std::unique_lock lock(mutex_);
+  while (!wake_.wait_for(lock, period_, [this] { return stopping_; })) {
+    struct stat now {};
+    const bool there = ::stat(segment.c_str(), &now) == 0;
+    if (there && now.st_ino == joined_inode_) continue;
+    lock.unlock();
+    gone_(there ? fmt::format("the RouDi it joined is gone and another runs ({} is a new segment): "
+                              "its zero-copy cues would reach no process started since",
+                              segment)
+                : fmt::format("the RouDi it joined is gone ({} was removed)", segment));
+    return;
+  }
 }
 
 bool offered_on_this_host(const std::string& topic, const std::string& type_name) {

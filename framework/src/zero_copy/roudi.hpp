@@ -1,8 +1,13 @@
 #pragma once
 /// @file This process and the host's RouDi, iceoryx's shared-memory daemon (docs/zero_copy.md).
 
+#include <chrono>
+#include <condition_variable>
+#include <functional>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 
 namespace oscar::zero_copy {
 
@@ -15,6 +20,33 @@ bool roudi_running();
 /// @throws std::invalid_argument for a name iceoryx cannot take (empty, too long, with '/').
 /// @return nothing when registered, else why not (no RouDi, iox-roudi not installed).
 std::optional<std::string> join_roudi(const std::string& name);
+
+/// Watches that the RouDi this process joined is still the host's. A RouDi started after the
+/// joined one died makes a management segment of its own (`/dev/shm/iceoryx_mgmt`, a new file),
+/// and iceoryx 2.0 cannot move a process over: it would publish and wait where no process started
+/// since looks. Calls `gone` once, on the watch's thread, when the segment this process mapped is
+/// no longer the one of that name. A RouDi killed and not replaced leaves its segment: the
+/// processes that joined it go on reaching each other, and nothing is called.
+class RoudiWatch {
+ public:
+  /// Needs join_roudi() first. @throws std::runtime_error if this process maps no segment.
+  explicit RoudiWatch(std::function<void(const std::string& why)> gone,
+                      std::chrono::milliseconds period = std::chrono::milliseconds(250));
+  ~RoudiWatch();
+  RoudiWatch(const RoudiWatch&) = delete;
+  RoudiWatch& operator=(const RoudiWatch&) = delete;
+
+ private:
+  void watch();
+
+  const std::function<void(const std::string&)> gone_;
+  const std::chrono::milliseconds period_;
+  unsigned long joined_inode_ = 0;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stopping_ = false;
+  std::thread thread_;
+};
 
 /// True if a process of this host's RouDi offers `topic` with cues of `type_name` (an iceoryx
 /// publisher of its service). Needs join_roudi() first.
