@@ -73,6 +73,28 @@ TEST(NetworkBadInput, UdpKeysOutOfRangeNameTheKeyAndTheRange) {
             "from 1024 to 65500");
 }
 
+TEST(NetworkBadInput, ASharedMemorySegmentSmallerThanAMessageNamesTheKeyAndTheRule) {
+  try {
+    NetworkConfig::from_yaml(YAML::Load("{shm_segment_bytes: 4096}"));
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(),
+                 "network.shm_segment_bytes: 4096 is smaller than 65536 (Fast DDS's largest "
+                 "message through shared memory must fit)");
+  }
+}
+
+// Unset, the segment follows what the participant sends; set, it is taken as it is.
+TEST(Network, TheSharedMemorySegmentIsSmallForAParticipantThatPublishesNoCues) {
+  const NetworkConfig unset;
+  EXPECT_EQ(shm_segment_bytes_for(unset, true), kCueShmSegmentBytes);
+  EXPECT_EQ(shm_segment_bytes_for(unset, false), kQuietShmSegmentBytes);
+  EXPECT_LT(kQuietShmSegmentBytes, kCueShmSegmentBytes);
+  const auto set = NetworkConfig::from_yaml(YAML::Load("{shm_segment_bytes: 2097152}"));
+  EXPECT_EQ(shm_segment_bytes_for(set, true), 2u << 20);
+  EXPECT_EQ(shm_segment_bytes_for(set, false), 2u << 20);
+}
+
 // The system file's (or module file's) `network:` map sets them; the environment, where set,
 // overrides that for the participants a process makes (benchmarks, experiments).
 TEST(Network, UdpSettingsComeFromTheNetworkMapAndTheEnvironmentOverridesThem) {

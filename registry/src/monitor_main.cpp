@@ -171,7 +171,8 @@ int main(int argc, char** argv) {
       spdlog::default_logger()->sinks().push_back(on_host_log);
       spdlog::flush_on(spdlog::level::info);
     }
-    const auto network = system.network_for(host, oscar::security_files::monitor_identity(host));
+    auto network = system.network_for(host, oscar::security_files::monitor_identity(host));
+    network.shm_segment_bytes = oscar::shm_segment_bytes_for(network, false);  // reports only
     // With discovery servers, a monitor learns only of the participants it shares a topic with
     // (the registry, boot, the tools that read its reports), not of every module's endpoints
     // on every host (docs/network.md).

@@ -47,7 +47,11 @@ struct NetworkConfig {
   std::vector<std::string> interfaces{"127.0.0.1"};  ///< IPv4 addresses UDP may use
   std::vector<std::string> peers{"127.0.0.1"};       ///< hosts discovery announces itself to
   bool shared_memory = true;
-  std::uint32_t shm_segment_bytes = 8u << 20;  ///< must hold the largest cues in flight
+  /// Each participant's shared-memory segment: it holds what the participant sends until every
+  /// reader on the host took it. Unset: shm_segment_bytes_for() picks by what it sends. Fast DDS
+  /// writes the whole segment when the participant starts (8 MiB: about 8 ms of CPU), and it
+  /// stays in /dev/shm while the participant lives.
+  std::optional<std::uint32_t> shm_segment_bytes;
   /// UDP send and receive socket buffers: room for a 442 KB image in one burst (the kernel caps
   /// them at net.core.{w,r}mem_max); 0: the system's default.
   std::uint32_t udp_buffer_bytes = 4u << 20;
@@ -78,6 +82,16 @@ struct NetworkConfig {
   /// Discovery servers default to the address of the system's local host (where boot runs).
   static NetworkConfig for_host(const YAML::Node& system, const std::string& host);
 };
+
+/// The shared-memory segment of a participant that publishes cues: room for the largest (a
+/// 442 KB image goes in fragments of 64 KB) while the slowest reader of the host catches up.
+inline constexpr std::uint32_t kCueShmSegmentBytes = 8u << 20;
+/// ... and of one that publishes none (only its state, log lines, replies).
+inline constexpr std::uint32_t kQuietShmSegmentBytes = 1u << 20;
+
+/// The segment of a participant with `network`: its shm_segment_bytes where set, else by
+/// whether it publishes cues.
+std::uint32_t shm_segment_bytes_for(const NetworkConfig& network, bool publishes_cues);
 
 /// The participant id discovery server `index` (0 or 1) of a domain takes on its address: the
 /// highest ones, which clients, taking the lowest free id, reach last.

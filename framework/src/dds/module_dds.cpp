@@ -191,11 +191,21 @@ DiscoveryScope Module::Dds::discovery_scope_of(const Module& module) {
   return DiscoveryScope::kSharedTopics;
 }
 
+// A module without outputs sends no cues: a small shared-memory segment holds what it sends.
+NetworkConfig Module::Dds::network_of(const Module& module) {
+  auto network = module.spec_.network;
+  const bool publishes_cues = std::any_of(module.slots_.begin(), module.slots_.end(), [](auto& s) {
+    return !s->instance->ports().outputs.empty();
+  });
+  network.shm_segment_bytes = shm_segment_bytes_for(network, publishes_cues);
+  return network;
+}
+
 Module::Dds::Dds(Module& module, int domain)
     : module_(module),
       domain_(domain),
       discovery_scope_(discovery_scope_of(module)),
-      participant_(domain, "oscar:" + module.spec_.name, module.spec_.network, discovery_scope_),
+      participant_(domain, "oscar:" + module.spec_.name, network_of(module), discovery_scope_),
       learns_only_shared_topics_(module.spec_.network.discovery == Discovery::kServer &&
                                  discovery_scope_ == DiscoveryScope::kSharedTopics) {
   // Samples dropped as malformed are reported where the module's other lines go: its console

@@ -82,6 +82,7 @@ class Module::Dds {
   /// What the module's participant learns of from the discovery servers, if it uses them:
   /// only what shares a topic with it (docs/network.md), unless an input takes any type.
   static DiscoveryScope discovery_scope_of(const Module& module);
+  static NetworkConfig network_of(const Module& module);
   /// A plain client of the discovery servers learns of a writer only once it reads the topic:
   /// makes a reader of the topic that matches no writer (exclusive ownership), which makes the
   /// servers tell this participant of the source's writer, waits for it (at most until `until`)

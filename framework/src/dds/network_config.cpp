@@ -80,7 +80,16 @@ NetworkConfig NetworkConfig::from_yaml(const YAML::Node& node, NetworkConfig bas
     } else if (key == "shared_memory") {
       net.shared_memory = kv.second.as<bool>();
     } else if (key == "shm_segment_bytes") {
-      net.shm_segment_bytes = kv.second.as<std::uint32_t>();
+      const auto bytes = kv.second.as<std::uint32_t>();
+      // Fast DDS sends messages of up to 65500 bytes through shared memory, and refuses the
+      // transport (silently, for us) with a segment smaller than one message.
+      if (bytes < 65536)
+        throw std::invalid_argument(
+            fmt::format("network.shm_segment_bytes: {} is smaller than 65536 (Fast DDS's largest "
+                        "message through "
+                        "shared memory must fit)",
+                        bytes));
+      net.shm_segment_bytes = bytes;
     } else if (key == "udp_buffer_bytes") {
       net.udp_buffer_bytes =
           internal::udp_buffer_bytes("network.udp_buffer_bytes", kv.second.as<std::string>());
@@ -168,6 +177,11 @@ NetworkConfig NetworkConfig::for_host(const YAML::Node& system, const std::strin
     net.discovery_servers = default_servers;
   }
   return net;
+}
+
+std::uint32_t shm_segment_bytes_for(const NetworkConfig& network, bool publishes_cues) {
+  return network.shm_segment_bytes.value_or(publishes_cues ? kCueShmSegmentBytes
+                                                           : kQuietShmSegmentBytes);
 }
 
 }  // namespace oscar

@@ -86,7 +86,7 @@ dds::DomainParticipantQos participant_qos(const std::string& name, const Network
   transport.user_transports.push_back(udp);
   if (net.shared_memory) {
     auto shm = std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>();
-    shm->segment_size(net.shm_segment_bytes);
+    shm->segment_size(shm_segment_bytes_for(net, true));
     // Fast DDS opens a port while holding the participant's lock on all sending, and waits up to
     // a third of this for the port's listener to show it is alive (1 s by default: a sender
     // stalled for up to 333 ms, heartbeats included, whenever it first sent to a quiet port;
