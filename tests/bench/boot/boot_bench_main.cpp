@@ -43,6 +43,7 @@ struct Options {
   bool security = false;
   std::string lease = "1s";
   int timeout_s = 120;
+  std::uint32_t shm_segment_bytes = 0;  ///< network.shm_segment_bytes; 0: unset
 };
 
 // The test hosts of a run (none for one host): h1 runs boot and the registry, h2..hH are reached
@@ -108,7 +109,12 @@ class InNetns {
 std::string system_yaml(const Options& o, const Hosts& hosts) {
   std::string yaml = fmt::format("system: bench_boot\nlease: {}\n", o.lease);
   yaml += hosts.yaml(o);
-  if (o.discovery_server) yaml += "network: { discovery: server }\n";
+  std::vector<std::string> network;
+  if (o.discovery_server) network.push_back("discovery: server");
+  if (o.shm_segment_bytes != 0) {
+    network.push_back(fmt::format("shm_segment_bytes: {}", o.shm_segment_bytes));
+  }
+  if (!network.empty()) yaml += fmt::format("network: {{ {} }}\n", fmt::join(network, ", "));
   yaml += "modules:\n";
   for (int i = 0; i < o.modules; ++i) {
     const bool source = i % 2 == 0;
@@ -214,6 +220,10 @@ int main(int argc, char** argv) {
   app.add_option("--lease", o.lease, "the system's lease (a duration, e.g. 300ms, 2s)");
   app.add_option("--timeout", o.timeout_s, "seconds boot waits for every module")
       ->check(CLI::PositiveNumber);
+  app.add_option("--shm-segment-bytes", o.shm_segment_bytes,
+                 "every participant's shared-memory segment (network.shm_segment_bytes; default: "
+                 "by what each sends)")
+      ->check(CLI::Range(65536, 1 << 30));
   app.add_flag("--json", json, "print one JSON line");
   OSCAR_PARSE_COMMAND_LINE(app, argc, argv);
   if (o.ssh && o.hosts < 2) {
@@ -247,10 +257,11 @@ int main(int argc, char** argv) {
           "{\"hosts\":%d,\"modules\":%d,\"ssh\":%s,\"discovery\":\"%s\",\"security\":%s,\"boot_ms_"
           "p50\":%.0f,"
           "\"boot_ms_max\":%.0f,\"restart_ms_p50\":%.0f,\"runs\":%d,"
-          "\"machine_cpu_s_until_running_p50\":%.1f,\"cores\":%ld}\n",
+          "\"machine_cpu_s_until_running_p50\":%.1f,\"cores\":%ld,\"shm_segment_bytes\":%u}\n",
           o.hosts, o.modules, o.ssh ? "true" : "false", discovery, o.security ? "true" : "false",
           percentile(f.boot_ms, 0.5), percentile(f.boot_ms, 1.0), percentile(f.restart_ms, 0.5),
-          o.runs, percentile(f.machine_cpu_s, 0.5), sysconf(_SC_NPROCESSORS_ONLN));
+          o.runs, percentile(f.machine_cpu_s, 0.5), sysconf(_SC_NPROCESSORS_ONLN),
+          o.shm_segment_bytes);
     } else {
       std::printf(
           "oscar bench boot: %d modules on %d host%s%s, %s discovery%s, lease %s, %d runs\n",
