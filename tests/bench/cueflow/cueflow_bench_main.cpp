@@ -115,7 +115,8 @@ int main(int argc, char** argv) {
   double throughput_s = 0;
   app.add_option("--throughput", throughput_s,
                  "instead of latency: the highest rate without loss over this many seconds per "
-                 "trial (multicore and local), OSCAR beside raw Fast DDS, and its CPU")
+                 "trial (multicore, local, local_zero_copy), OSCAR beside raw Fast DDS (raw "
+                 "iceoryx for local_zero_copy), and its CPU")
       ->check(CLI::PositiveNumber);
   bool security = false;
   app.add_flag("--security", security,
