@@ -156,6 +156,14 @@ TEST_F(HostRoudi, AKilledRouDiIsStartedAgainAndSaysWhatThatMeansForJoinedProcess
 // started since looks: it ends with kKernelFailureExit, saying why, and the registry starts it
 // again (on the new RouDi).
 TEST_F(HostRoudi, AModuleWhoseRouDiWasReplacedEndsSoThatTheRegistryStartsItAgain) {
+  // Chunks for the source's ring of 16 (the fixture's 8 would run out and iceoryx would log an
+  // error per cue).
+  std::ofstream(file_) << fmt::format(R"(system: zc
+domain: {}
+zero_copy: {{ chunks: 32 }}
+modules: [ {{ name: src, kernels: [ {{ type: bench_source, name: src }} ] }} ]
+)",
+                                      test::test_domain());
   auto& monitor = start_monitor();
   ASSERT_TRUE(eventually([&] { return monitor_said("RouDi runs"); })) << monitor.output();
   auto module = test::run_module(
