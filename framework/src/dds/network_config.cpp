@@ -85,9 +85,8 @@ NetworkConfig NetworkConfig::from_yaml(const YAML::Node& node, NetworkConfig bas
       // transport (silently, for us) with a segment smaller than one message.
       if (bytes < 65536)
         throw std::invalid_argument(
-            fmt::format("network.shm_segment_bytes: {} is smaller than 65536 (Fast DDS's largest "
-                        "message through "
-                        "shared memory must fit)",
+            fmt::format("network.shm_segment_bytes: {} is smaller than 65536 (Fast DDS's "
+                        "largest message through shared memory must fit)",
                         bytes));
       net.shm_segment_bytes = bytes;
     } else if (key == "udp_buffer_bytes") {
