@@ -342,10 +342,13 @@ void Module::kernel_failed(Slot& slot, std::string failure) {
 }
 
 void Module::end_for_restart(std::string reason) {
+  {
+    std::lock_guard lock(mutex_);
+    if (!exit_reason_.empty()) return;  // the first reason is the one to tell
+    exit_reason_ = reason;
+  }
   log_->error("stopping the module: {}", reason);  // not under mutex_: it writes to DDS
   std::lock_guard lock(mutex_);
-  if (!exit_reason_.empty()) return;  // the first reason is the one to tell
-  exit_reason_ = std::move(reason);
   stop_requested_ = true;
   stopped_.notify_all();
 }
