@@ -242,11 +242,13 @@ void Module::start(int domain) {
     for (auto& s : slots_) s->next_due = now;
     suspended_ = spec_.start_suspended;
   }
-  processing_ = std::thread([this] { processing_loop(); });
-  if (dds_) dds_->start_config();
+  // Told before the processing thread runs: it may change a mode at once (a kernel failing in
+  // on_activate() is deactivated), and "started" must not come after that.
   std::vector<std::string> modes;
   for (auto& s : slots_) modes.push_back(s->instance->name() + ": " + s->mode.describe());
   report(fmt::format("started ({})", fmt::join(modes, ", ")));
+  processing_ = std::thread([this] { processing_loop(); });
+  if (dds_) dds_->start_config();
 }
 
 void Module::wait() {
