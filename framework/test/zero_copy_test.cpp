@@ -5,6 +5,8 @@
 #include <signal.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -16,6 +18,7 @@
 #include <gtest/gtest.h>
 #include <spdlog/sinks/ostream_sink.h>
 #include <spdlog/spdlog.h>
+#include <iceoryx_hoofs/error_handling/error_handling.hpp>
 
 #include "oscar/cue_types.hpp"
 #include "private_tmp.hpp"
@@ -170,6 +173,39 @@ TEST(CuePath, EachFactRulesZeroCopyOutWithItsOwnReason) {
   no_roudi.roudi_running = false;
   EXPECT_NE(choose_cue_path(no_roudi).reason.find("no RouDi"), std::string::npos);
   EXPECT_EQ(choose_cue_path(no_roudi).path, CuePath::kSerialized);
+}
+
+// iceoryx 2.0 aborts on a severe error of its own, e.g. a port request that a RouDi killed
+// meanwhile leaves unanswered. With end_process_on_iceoryx_error the process says which error and
+// ends with the exit code asked for (a module's: the registry starts it again); a moderate error
+// is said and the process goes on.
+TEST(IceoryxErrors, ASevereOneEndsTheProcessWithTheCodeAskedForAModerateOneGoesOn) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  const auto install = [] {
+    end_process_on_iceoryx_error(7, [](const std::string& what, bool ending) {
+      std::fprintf(stderr, "%s: %s\n", ending ? "ending" : "going on", what.c_str());
+    });
+  };
+  EXPECT_EXIT(
+      {
+        install();
+        iox::errorHandler(iox::Error::kPOSH__RUNTIME_ROUDI_REQUEST_PUBLISHER_INVALID_RESPONSE,
+                          nullptr, iox::ErrorLevel::SEVERE);
+        std::abort();  // what iceoryx's own handler does
+      },
+      testing::ExitedWithCode(7),
+      "ending: iceoryx reports POSH__RUNTIME_ROUDI_REQUEST_PUBLISHER_INVALID_RESPONSE, a severe "
+      "error it cannot go on from");
+  EXPECT_EXIT(
+      {
+        install();
+        iox::errorHandler(iox::Error::kPOPO__CHUNK_LOCKING_ERROR, nullptr,
+                          iox::ErrorLevel::MODERATE);
+        std::fprintf(stderr, "went on\n");
+        std::exit(0);
+      },
+      testing::ExitedWithCode(0),
+      "going on: iceoryx reports POPO__CHUNK_LOCKING_ERROR and goes on\nwent on");
 }
 
 TEST_F(ZeroCopy, WithoutRouDiAPeerSaysSoInsteadOfWaiting) {

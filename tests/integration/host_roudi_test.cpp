@@ -173,6 +173,13 @@ modules: [ {{ name: src, kernels: [ {{ type: bench_source, name: src }} ] }} ]
            std::string::npos;
   };
   ASSERT_TRUE(eventually(joined)) << module->output();
+  // Its output is offered once a peer reads its cues; killed before, RouDi would leave the
+  // module's port request unanswered (IceoryxErrors tests that end).
+  auto reader =
+      peer({"sub", "PlainBool", fmt::format("{}/oscar/cue/src/out", test::test_domain()), "0", "1"},
+           "reader");
+  ASSERT_TRUE(eventually([&] { return reader.output().find("received") != std::string::npos; }))
+      << reader.output() << module->output();
   const auto first = roudis();
   ASSERT_EQ(first.size(), 1u);
   ::kill(static_cast<pid_t>(first.front()), SIGKILL);

@@ -296,6 +296,14 @@ void Module::Dds::join_zero_copy() {
   }
   if (!plain) return;
   try {
+    // iceoryx would abort the module (in a port request a RouDi killed meanwhile leaves
+    // unanswered).
+    zero_copy::end_process_on_iceoryx_error(
+        kKernelFailureExit, [log = module_.log_](const std::string& what, bool ending) {
+          if (!ending) return log->warn("{}", what);
+          log->error("{}; the registry starts it again on the host's RouDi", what);
+          log->flush();
+        });
     // A runtime name of its own per process: a restarted module must not look like the old one.
     if (const auto why =
             zero_copy::join_roudi(fmt::format("{}-{}", module_.spec_.name, getpid()))) {

@@ -5,12 +5,18 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <mutex>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <iceoryx_hoofs/cxx/generic_raii.hpp>
+#include <iceoryx_hoofs/error_handling/error_handling.hpp>
 #include <iceoryx_posh/runtime/posh_runtime.hpp>
 #include <iceoryx_posh/runtime/service_discovery.hpp>
 
@@ -83,6 +89,33 @@ std::optional<std::string> join_roudi(const std::string& name) {
       iox::RuntimeName_t(iox::cxx::TruncateToCapacity, name.c_str()));
   joined = true;
   return std::nullopt;
+}
+
+void end_process_on_iceoryx_error(int exit_code,
+                                  std::function<void(const std::string&, bool ending)> say) {
+  static std::mutex mutex;
+  static std::optional<iox::cxx::GenericRAII> handler;  // puts iceoryx's own back at exit
+  std::lock_guard lock(mutex);
+  handler.reset();
+  handler.emplace(iox::ErrorHandler::setTemporaryErrorHandler(
+      [exit_code, say = std::move(say)](const iox::Error error,
+                                        const std::function<void()>& callback,
+                                        const iox::ErrorLevel level) {
+        if (callback) callback();
+        const char* name = iox::ErrorHandler::toString(error);
+        if (level == iox::ErrorLevel::MODERATE) {
+          say(fmt::format("iceoryx reports {} and goes on", name), false);
+          return;
+        }
+        // The caller cannot go on (a severe error hands it a null port): end before it does.
+        say(fmt::format(
+                "iceoryx reports {}, a {} error it cannot go on from (most often the RouDi "
+                "this process joined no longer answers): the process ends with exit code {}",
+                name, level == iox::ErrorLevel::FATAL ? "fatal" : "severe", exit_code),
+            true);
+        std::fflush(nullptr);
+        std::_Exit(exit_code);
+      }));
 }
 
 RoudiWatch::RoudiWatch(std::function<void(const std::string& why)> gone,

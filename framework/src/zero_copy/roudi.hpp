@@ -21,6 +21,14 @@ bool roudi_running();
 /// @return nothing when registered, else why not (no RouDi, iox-roudi not installed).
 std::optional<std::string> join_roudi(const std::string& name);
 
+/// iceoryx 2.0 aborts the process on a fatal or severe error of its own (most often: the RouDi this
+/// process joined no longer answers a request for a publisher or subscriber). From this call on,
+/// such an error is told through `say` (ending: true), naming it, and ends the process at once with
+/// `exit_code`; a moderate one is told (ending: false) and the process goes on. A later call
+/// replaces the earlier.
+void end_process_on_iceoryx_error(int exit_code,
+                                  std::function<void(const std::string& what, bool ending)> say);
+
 /// Watches that the RouDi this process joined is still the host's. A RouDi started after the
 /// joined one died makes a management segment of its own (`/dev/shm/iceoryx_mgmt`, a new file),
 /// and iceoryx 2.0 cannot move a process over: it would publish and wait where no process started
