@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <regex>
 #include <sstream>
 #include <thread>
@@ -23,6 +24,7 @@
 #include "oscar/cue_types.hpp"
 #include "private_tmp.hpp"
 #include "process.hpp"
+#include "zero_copy/chunk_identity.hpp"
 #include "zero_copy/cue_path.hpp"
 #include "zero_copy/mempools.hpp"
 #include "zero_copy/plain_cue.hpp"
@@ -115,6 +117,16 @@ TEST(PlainCues, APlainImageHoldsTheSeedBenchmarksImageInItself) {
   const auto* pixels = reinterpret_cast<const char*>(image.image().data());
   EXPECT_GE(pixels, begin);
   EXPECT_LE(pixels + 442368, begin + sizeof image);
+}
+
+// A copy is told from a chunk: an address in none of iceoryx's segments has no identity (iceoryx
+// itself calls it segment 0, "a regular pointer").
+TEST(ChunkIdentity, MemoryOutsideSharedMemoryIsNoChunk) {
+  const auto heap = std::make_shared<oscar::PlainGvImage>();
+  const oscar::PlainBool stack;
+  EXPECT_FALSE(identify_chunk(heap.get()));
+  EXPECT_FALSE(identify_chunk(&stack));
+  EXPECT_FALSE(identify_chunk(nullptr));
 }
 
 TEST(Mempools, AChunkHoldsTheCueAndIceoryxsHeaderInMultiplesOfEight) {

@@ -8,7 +8,8 @@ namespace oscar::zero_copy {
 std::optional<ChunkIdentity> identify_chunk(const void* payload) {
   using iox::rp::BaseRelativePointer;
   const auto segment = BaseRelativePointer::searchId(const_cast<void*>(payload));
-  if (segment == BaseRelativePointer::NULL_POINTER_ID) return std::nullopt;
+  // iceoryx 2.0 answers 0 ("a regular pointer") for an address in none of its segments.
+  if (segment == 0 || segment == BaseRelativePointer::NULL_POINTER_ID) return std::nullopt;
   ChunkIdentity identity;
   identity.segment = segment;
   identity.offset = BaseRelativePointer::getOffset(segment, payload);
