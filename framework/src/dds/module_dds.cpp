@@ -157,6 +157,7 @@ class Module::Dds::CueReader final : public dds::DataReaderListener {
     }
     return received_.load();
   }
+  bool received() const { return received_.load(); }
   dds::DataReader* reader_ = nullptr;
 
  private:
@@ -340,6 +341,10 @@ std::optional<std::string> Module::Dds::feed_zero_copy(InputPort& input, const s
     const auto facts = zero_copy::connection_facts(source, input.type(), offered);
     // Logs why, for a serialized path.
     if (zero_copy::choose_cue_path(facts).path != zero_copy::CuePath::kZeroCopy) {
+      if (facts.type_is_plain && !facts.producer_on_this_host) {
+        std::lock_guard lock(queue_mutex_);
+        awaiting_offer_[&input] = {.source = source};  // a producer started later may offer it
+      }
       return std::nullopt;
     }
     feed = std::make_shared<zero_copy::ChunkFeed>(topic, input, input.type());
@@ -546,10 +551,118 @@ void Module::Dds::subscribe_discovered() {
   }
 }
 
+#if OSCAR_ZERO_COPY
+namespace {
+// The seq of the newest cue an input got; nothing before its first.
+std::optional<std::uint64_t> newest_seq(const InputPort& input) {
+  const auto entry = input.buffer().latest();
+  if (!entry) return std::nullopt;
+  return input.type().header.read(entry->cue.get()).seq();
+}
+}  // namespace
+#endif
+
+// On the configuration thread, every offer_poll(). Each input goes through three steps, one per
+// call at most: its DDS reader got a cue and RouDi lists the source (a held feed subscribes);
+// the reader's cues meet the feed's first (a cue published before the feed subscribed may still
+// be on its way through DDS: a lost packet waits for the writer's heartbeat); then the reader
+// is retired and the feed starts after the newest cue the input got.
+void Module::Dds::switch_to_offered() {
+#if OSCAR_ZERO_COPY
+  // Past this, the switch goes on without the cues DDS still owes, and says which.
+  constexpr auto kMeetBound = std::chrono::seconds(5);
+  std::map<InputPort*, AwaitingOffer> awaiting;
+  {
+    std::lock_guard lock(queue_mutex_);
+    awaiting = awaiting_offer_;
+  }
+  const auto keep = [&](InputPort* input, const AwaitingOffer& a) {
+    std::lock_guard lock(queue_mutex_);
+    if (const auto it = awaiting_offer_.find(input);
+        it != awaiting_offer_.end() && it->second.source == a.source) {
+      it->second = a;
+    }
+  };
+  const auto settled = [&](InputPort* input) {
+    std::lock_guard lock(queue_mutex_);
+    awaiting_offer_.erase(input);
+  };
+  const auto now = std::chrono::steady_clock::now();
+  for (auto& [input, a] : awaiting) {
+    try {
+      if (!a.feed) {
+        {
+          // Its producer runs once its cues come: then RouDi is asked whether it offers them.
+          std::lock_guard lock(readers_mutex_);
+          const auto it = readers_.find(input);
+          if (it == readers_.end() || !it->second->received()) continue;
+        }
+        const auto topic = zero_copy::zero_copy_topic(domain_, topics::cue(a.source));
+        if (!zero_copy::offered_on_this_host(topic, input->type().name)) continue;
+        a.feed = std::make_shared<zero_copy::ChunkFeed>(topic, *input, input->type(), true);
+        a.give_up = now + kMeetBound;
+        keep(input, a);
+        continue;
+      }
+      const auto first = a.feed->first_held();
+      const auto last = newest_seq(*input);
+      const bool met = first && last && *last + 1 >= *first;
+      if (!met && now < a.give_up) continue;
+      if (!a.feed->subscribed()) {  // RouDi did not connect it: from the start next round
+        a.feed.reset();
+        keep(input, a);
+        continue;
+      }
+      std::unique_ptr<CueReader> reader;
+      {
+        std::lock_guard lock(readers_mutex_);
+        if (const auto it = readers_.find(input); it != readers_.end()) {
+          reader = std::move(it->second);
+          readers_.erase(it);
+        }
+      }
+      if (reader) reader->retire();
+      const auto through = newest_seq(*input);
+      a.feed->hand_over(through);
+      {
+        std::lock_guard lock(readers_mutex_);
+        feeds_[input] = a.feed;
+      }
+      if (reader) participant_.subscriber().delete_datareader(reader->reader_);
+      settled(input);
+      module_.log_->info(
+          "input {}/{}: {} is offered in shared memory on this host now: its cues come zero-copy "
+          "from here on",
+          input->kernel(), input->name(), a.source);
+      if (!met && first && through && *first > *through + 1) {
+        module_.log_->warn(
+            "input {}/{}: cues {} to {} of {} came neither through DDS within {} s nor through "
+            "shared memory",
+            input->kernel(), input->name(), *through + 1, *first - 1, a.source,
+            std::chrono::duration_cast<std::chrono::seconds>(kMeetBound).count());
+      }
+    } catch (const std::exception& e) {
+      settled(input);
+      module_.log_->warn("input {}/{}: its cues stay on DDS: {}", input->kernel(), input->name(),
+                         e.what());
+    }
+  }
+#endif
+}
+
+std::chrono::milliseconds Module::Dds::offer_poll() const {
+  // Under queue_mutex_. A switch under way is looked at often: its feed holds the cues meanwhile.
+  const bool switching = std::any_of(awaiting_offer_.begin(), awaiting_offer_.end(),
+                                     [](const auto& a) { return a.second.feed != nullptr; });
+  return std::chrono::milliseconds(switching ? 5 : 250);
+}
+
 void Module::Dds::disconnect_input(InputPort& input) {
+  decltype(awaiting_offer_)::node_type switching;  // its held feed ends outside the lock
   {
     std::lock_guard lock(queue_mutex_);
     awaiting_type_.erase(&input);
+    switching = awaiting_offer_.extract(&input);
   }
   std::unique_ptr<CueReader> old;
   std::shared_ptr<internal::DdsPullSource> old_pull;  // the input reads elsewhere by now
@@ -663,13 +776,13 @@ void Module::Dds::report_drops() {
 void Module::Dds::serve_config() {
   std::unique_lock lock(queue_mutex_);
   const auto ready = [&] { return !serving_ || !queue_.empty() || !refollow_.empty(); };
+  auto next_offer_poll = std::chrono::steady_clock::now();  // switch_to_offered()
   while (true) {
-    // Discovery is polled for raw inputs whose source has not shown up yet; dropped commands
-    // are reported within a second.
-    queue_cv_.wait_for(
-        lock,
-        awaiting_type_.empty() ? std::chrono::milliseconds(1000) : std::chrono::milliseconds(50),
-        ready);
+    // Discovery is polled for raw inputs whose source has not shown up yet, RouDi for plain
+    // inputs whose source it does not list yet; dropped commands are reported within a second.
+    auto poll = std::chrono::milliseconds(awaiting_type_.empty() ? 1000 : 50);
+    if (!awaiting_offer_.empty()) poll = std::min(poll, offer_poll());
+    queue_cv_.wait_for(lock, poll, ready);
     if (!serving_) return;
     lock.unlock();
     report_drops();
@@ -677,6 +790,12 @@ void Module::Dds::serve_config() {
     if (!awaiting_type_.empty()) {
       lock.unlock();
       subscribe_discovered();
+      lock.lock();
+    }
+    if (!awaiting_offer_.empty() && std::chrono::steady_clock::now() >= next_offer_poll) {
+      next_offer_poll = std::chrono::steady_clock::now() + offer_poll();
+      lock.unlock();
+      switch_to_offered();
       lock.lock();
     }
     if (!refollow_.empty()) {

@@ -30,6 +30,10 @@
 #include "oscar/topics.hpp"
 #include "reply_memory.hpp"
 
+namespace oscar::zero_copy {
+class ChunkFeed;
+}
+
 namespace oscar {
 
 class Module::Dds {
@@ -95,6 +99,12 @@ class Module::Dds {
                         std::optional<std::chrono::milliseconds> switch_wait,
                         std::chrono::steady_clock::time_point until);
   void subscribe_discovered();
+  /// Push inputs of a plain type that read through DDS only because no process of this host
+  /// offered their producer's chunks when they were wired go zero-copy once one does: a held
+  /// feed subscribes, the DDS reader is retired and the feed starts after its last cue.
+  void switch_to_offered();
+  /// How often switch_to_offered() runs (under queue_mutex_).
+  std::chrono::milliseconds offer_poll() const;
   void follow_producer(InputPort& input, const std::string& source, const OutputOptions& offered);
   void refollow(const Refollow& r);
   void serve_config();
@@ -149,6 +159,14 @@ class Module::Dds {
   std::uint64_t queue_full_drops_ = 0;     // under queue_mutex_; reported and reset
   std::deque<Refollow> refollow_;          // served by the configuration thread, like queue_
   std::map<InputPort*, std::string> awaiting_type_;  // raw inputs whose source is not seen yet
+  /// Inputs read through DDS until their source is offered on this host (switch_to_offered()),
+  /// under queue_mutex_; `feed` is held while the switch is under way.
+  struct AwaitingOffer {
+    std::string source;
+    std::shared_ptr<zero_copy::ChunkFeed> feed{};
+    std::chrono::steady_clock::time_point give_up{};
+  };
+  std::map<InputPort*, AwaitingOffer> awaiting_offer_;
   internal::ReplyMemory last_replies_;  // the configuration thread's: answers repeated commands
   bool serving_ = false;
   std::thread config_thread_;
