@@ -242,13 +242,22 @@ void Module::start(int domain) {
     for (auto& s : slots_) s->next_due = now;
     suspended_ = spec_.start_suspended;
   }
-  // Told before the processing thread runs: it may change a mode at once (a kernel failing in
-  // on_activate() is deactivated), and "started" must not come after that.
+  // The modes as started, read before the processing thread runs: it may change one at once (a
+  // kernel failing in on_activate() is deactivated), and that transition must stay the last.
   std::vector<std::string> modes;
   for (auto& s : slots_) modes.push_back(s->instance->name() + ": " + s->mode.describe());
-  report(fmt::format("started ({})", fmt::join(modes, ", ")));
+  const auto started = fmt::format("started ({})", fmt::join(modes, ", "));
+  {
+    std::lock_guard lock(mutex_);
+    last_transition_ = started;
+  }
   processing_ = std::thread([this] { processing_loop(); });
-  if (dds_) dds_->start_config();
+  if (dds_) dds_->start_config();  // from here the log goes out over DDS too
+  log_->info("{}", started);
+  if (dds_) {
+    dds_->publish_state(state());
+    dds_->publish_wishes();
+  }
 }
 
 void Module::wait() {
