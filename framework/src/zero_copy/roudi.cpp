@@ -143,6 +143,9 @@ void RoudiWatch::watch() {
     struct stat now {};
     const bool there = ::stat(segment.c_str(), &now) == 0;
     if (there && now.st_ino == joined_inode_) continue;
+    // A new RouDi makes its segment before it listens: a process started again before that
+    // would find no RouDi and stay on DDS.
+    if (there && !roudi_running()) continue;
     lock.unlock();
     gone_(there ? fmt::format("the RouDi it joined is gone and another runs ({} is a new segment): "
                               "its zero-copy cues would reach no process started since",

@@ -33,7 +33,8 @@ void end_process_on_iceoryx_error(int exit_code,
 /// joined one died makes a management segment of its own (`/dev/shm/iceoryx_mgmt`, a new file),
 /// and iceoryx 2.0 cannot move a process over: it would publish and wait where no process started
 /// since looks. Calls `gone` once, on the watch's thread, when the segment this process mapped is
-/// no longer the one of that name. A RouDi killed and not replaced leaves its segment: the
+/// no longer the one of that name (and the new RouDi listens, so that a process started again
+/// joins it), or when that name is gone. A RouDi killed and not replaced leaves its segment: the
 /// processes that joined it go on reaching each other, and nothing is called.
 class RoudiWatch {
  public:
