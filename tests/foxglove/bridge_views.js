@@ -1,5 +1,5 @@
 // The Foxglove bridge's side channels, checked with Foxglove's own client and published schemas
-// (@foxglove/schemas): images as foxglove.RawImage and foxglove.CompressedImage (JPEG), robot states as foxglove.SceneUpdate, the
+// (@foxglove/schemas): images (also plain ones) as foxglove.RawImage and foxglove.CompressedImage (JPEG), robot states as foxglove.SceneUpdate, the
 // system graph as JSON — each decoded the way Foxglove decodes a `json` channel, from the
 // advertised JSON schema alone (JSON.parse, then every field the schema marks
 // contentEncoding "base64" to bytes). The bridge's schemas for Foxglove's types are its own;
@@ -11,6 +11,7 @@ const { mismatch, undeclared, publishedDrift, foxgloveParserRefuses } = require(
 
 const CAM = "oscar/cue/cam/out", CAM_SIDE = "foxglove/cam/out", CAM_JPEG = "foxglove/cam/out/compressed";
 const ROBOT_SIDE = "foxglove/r7/state", GRAPH = "foxglove/system/graph";
+const PLAIN = "oscar/cue/pcam/out", PLAIN_SIDE = "foxglove/pcam/out";
 
 // A `json` channel's message as Foxglove reads it, using only its schema.
 function decodeJson(schema, value) {
@@ -99,6 +100,32 @@ async function checkCompressedImages(a, { check, until, sleep, figures, lastGrap
         `once unsubscribed, JPEG conversion stops: ${converted} made for the ${jpegs.length} received, ${sideCounter(lastGraph(), CAM_JPEG)} later`);
 }
 
+// A plain image (the zero-copy form, 768 x 576 bytes of which byte_count are the image): raw,
+// decoded with Foxglove's OMG IDL reader from the advertised schema alone; as a RawImage, its
+// first byte_count pixels.
+async function checkPlainImages(a, { check, until, imageComplete }) {
+  const raw = a.channels.get(PLAIN), side = a.channels.get(PLAIN_SIDE);
+  if (!check(raw && raw.schemaName === "oscar::PlainGvImage" && side && side.schemaName === "foxglove.RawImage",
+             `${PLAIN} (oscar::PlainGvImage) and ${PLAIN_SIDE} (foxglove.RawImage) are advertised`)) return;
+  const rawSub = a.subscribe(PLAIN), sideSub = subscribeJson(a, PLAIN_SIDE);
+  await until(() => a.received.get(rawSub).length >= 3 && a.received.get(sideSub).length >= 3, 10000);
+  a.client.unsubscribe(rawSub);
+  a.client.unsubscribe(sideSub);
+  const raws = a.received.get(rawSub), sides = a.received.get(sideSub);
+  const rawRight = (m) => m.msg && !m.msg.error && m.msg.dx === 320 && m.msg.dy === 240 &&
+    m.msg.byte_count === 320 * 240 && m.msg.image.length === 768 * 576 && m.msg.header.seq > 0n &&
+    imageComplete({ msg: { dx: 320, dy: 240, image: m.msg.image.subarray(0, m.msg.byte_count) } });
+  check(raws.length >= 3 && raws.every(rawRight),
+        `${raws.length} plain images decode raw with only their schema: 320 x 240, byte_count ${320 * 240} of a ` +
+        `${768 * 576}-byte array, the pixel pattern intact`);
+  const sideRight = (m) => m.msg && !m.msg.error && m.msg.width === 320 && m.msg.height === 240 &&
+    m.msg.encoding === "mono8" && m.msg.frame_id === "pcam" && m.msg.data instanceof Uint8Array &&
+    imageComplete({ msg: { dx: 320, dy: 240, image: m.msg.data } });
+  check(sides.length >= 3 && sides.every(sideRight),
+        `${sides.length} plain images as RawImages: 320 x 240 mono8, frame pcam, all ${320 * 240} pixels intact` +
+        (sides.find((m) => !sideRight(m)) ? ` (first bad: ${JSON.stringify(sides.find((m) => !sideRight(m)).msg).slice(0, 200)})` : ""));
+}
+
 function sideCounter(graph, topic) {
   const s = ((graph && graph.side_channels) || []).find((x) => x.topic === topic);
   return s ? s.converted : undefined;
@@ -129,7 +156,7 @@ async function checkSideChannels(a, { check, until, sleep, figures, imageComplet
   check(!graph.error, `the graph conforms to its schema ${graph.error || ""}`);
   const modules = (graph.modules || []).map((m) => `${m.name}:${m.status}`).sort().join(" ");
   check(graph.system === "viewed" && graph.state === "running" &&
-        modules === "camera:running robot:running sources:running",
+        modules === "camera:running plain_camera:running robot:running sources:running",
         `the graph lists the booted modules with their states: ${graph.system} ${graph.state}, ${modules}`);
   const sig = (graph.modules || []).flatMap((m) => m.kernels).find((k) => k.name === "sig") || {};
   check(sig.type === "bench_source" && sig.mode === "continuous" && sig.cycle_ms === 20,
@@ -169,6 +196,7 @@ async function checkSideChannels(a, { check, until, sleep, figures, imageComplet
   check(stopped >= images.length && later === stopped && a.received.get(camSub).length > 0,
         `once unsubscribed, conversion stops: ${stopped} converted for the ${images.length} received, ${later} two seconds later, the raw topic still read`);
   a.client.unsubscribe(camSub);
+  await checkPlainImages(a, { check, until, imageComplete });
   if (expectJpeg) {
     await checkCompressedImages(a, { check, until, sleep, figures, lastGraph });
   } else {

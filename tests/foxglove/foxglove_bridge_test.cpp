@@ -184,6 +184,9 @@ modules:
   - name: camera
     kernels: [ { type: bench_source, name: cam, params: { type: GvImage, dx: 640, dy: 480 } } ]
     mode: deactivated
+  - name: plain_camera
+    kernels: [ { type: bench_source, name: pcam, params: { type: PlainGvImage, dx: 320, dy: 240 } } ]
+    mode: deactivated
   - name: robot
     kernels: [ { type: robot_sim, name: r7, params: { start_x: 3, start_y: 4, radius: 0.3 } } ]
     mode: deactivated
@@ -191,6 +194,7 @@ modules:
   system.running();
   for (const auto& [module, kernel, mode] : {std::tuple{"sources", "sig", "continuous:20ms"},
                                              {"camera", "cam", "continuous:50ms"},
+                                             {"plain_camera", "pcam", "continuous:100ms"},
                                              {"robot", "r7", "continuous:100ms"}}) {
     const auto reply = system.configure(module, CMD_ACTIVATE, {kernel, mode});
     ASSERT_TRUE(reply.ok()) << kernel << ": " << reply.error();

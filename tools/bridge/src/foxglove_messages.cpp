@@ -29,13 +29,13 @@ json yawed_pose(double x, double y, double z, double yaw) {
            {{"x", 0.0}, {"y", 0.0}, {"z", std::sin(yaw / 2)}, {"w", std::cos(yaw / 2)}}}};
 }
 
-bool fills(long width, long height, const std::vector<std::uint8_t>& pixels) {
+bool fills(long width, long height, std::span<const std::uint8_t> pixels) {
   return width > 0 && height > 0 && pixels.size() == static_cast<std::size_t>(width * height);
 }
 
 std::optional<std::string> mono8(const CueHeader& header, std::string frame_id, long width,
                                  long height, const std::string& encoding,
-                                 const std::vector<std::uint8_t>& pixels) {
+                                 std::span<const std::uint8_t> pixels) {
   if (!fills(width, height, pixels)) return std::nullopt;
   return json{{"timestamp", time_of(header)},
               {"frame_id", std::move(frame_id)},
@@ -48,7 +48,7 @@ std::optional<std::string> mono8(const CueHeader& header, std::string frame_id, 
 }
 
 std::optional<std::string> jpeg(const CueHeader& header, std::string frame_id, long width,
-                                long height, const std::vector<std::uint8_t>& pixels, int quality) {
+                                long height, std::span<const std::uint8_t> pixels, int quality) {
   if (!fills(width, height, pixels)) return std::nullopt;
   return json{{"timestamp", time_of(header)},
               {"frame_id", std::move(frame_id)},
@@ -61,6 +61,12 @@ std::optional<std::string> jpeg(const CueHeader& header, std::string frame_id, l
 std::string kernel_of(const CueHeader& header) {
   const auto& source = header.source();
   return source.substr(0, source.find('/'));
+}
+
+// A plain image's pixels: its first byte_count bytes; nullopt if byte_count exceeds its array.
+std::optional<std::span<const std::uint8_t>> pixels_of(const PlainGvImage& image) {
+  if (image.byte_count() > image.image().size()) return std::nullopt;
+  return std::span<const std::uint8_t>(image.image()).first(image.byte_count());
 }
 }  // namespace
 
@@ -92,6 +98,20 @@ std::optional<std::string> raw_image_json(const GvImage& image) {
 std::optional<std::string> compressed_image_json(const GvImage& image, int quality) {
   return jpeg(image.header(), kernel_of(image.header()), image.dx(), image.dy(), image.image(),
               quality);
+}
+
+std::optional<std::string> raw_image_json(const PlainGvImage& image) {
+  const auto pixels = pixels_of(image);
+  if (!pixels) return std::nullopt;
+  const auto header = CueHeaderForm<PlainCueHeader>::read(image.header());
+  return mono8(header, kernel_of(header), image.dx(), image.dy(), "mono8", *pixels);
+}
+
+std::optional<std::string> compressed_image_json(const PlainGvImage& image, int quality) {
+  const auto pixels = pixels_of(image);
+  if (!pixels) return std::nullopt;
+  const auto header = CueHeaderForm<PlainCueHeader>::read(image.header());
+  return jpeg(header, kernel_of(header), image.dx(), image.dy(), *pixels, quality);
 }
 
 std::optional<std::string> compressed_image_json(const CameraImage& image, int quality) {

@@ -10,6 +10,7 @@
 
 #include <oscar/cue_types.hpp>
 #include <oscar/perception_types.hpp>
+#include <oscar/plain_cue_types.hpp>
 #include <oscar/swarm_types.hpp>
 
 namespace oscar::bridge {
@@ -22,6 +23,9 @@ std::string base64(std::span<const std::uint8_t> bytes);
 std::optional<std::string> raw_image_json(const GvImage& image);
 /// The same of a camera image (frame_id: its camera_id; encoding as it says, mono8).
 std::optional<std::string> raw_image_json(const CameraImage& image);
+/// The same of a plain grey-value image (its first byte_count bytes of pixels); nullopt also if
+/// byte_count is more than the image holds.
+std::optional<std::string> raw_image_json(const PlainGvImage& image);
 
 /// A foxglove.CompressedImage (format "jpeg", greyscale) of a grey-value image at JPEG
 /// `quality` (1..100); frame_id as its RawImage. nullopt if the pixels do not fill dx x dy.
@@ -29,6 +33,8 @@ std::optional<std::string> raw_image_json(const CameraImage& image);
 std::optional<std::string> compressed_image_json(const GvImage& image, int quality);
 /// The same of a mono8 camera image (frame_id: its camera_id).
 std::optional<std::string> compressed_image_json(const CameraImage& image, int quality);
+/// The same of a plain grey-value image.
+std::optional<std::string> compressed_image_json(const PlainGvImage& image, int quality);
 
 /// A foxglove.PoseInFrame of the fused target pose, frame "world"; nullopt if it is not valid.
 std::optional<std::string> pose_in_frame_json(const LandmarkPose& pose);

@@ -3,8 +3,9 @@
 namespace oscar::bridge {
 
 bool is_image_schema(const std::string& schema_name) {
-  return schema_name == "oscar::GvImage" || schema_name == "oscar::CameraImage" ||
-         schema_name == "foxglove.RawImage" || schema_name == "foxglove.CompressedImage";
+  return schema_name == "oscar::GvImage" || schema_name == "oscar::PlainGvImage" ||
+         schema_name == "oscar::CameraImage" || schema_name == "foxglove.RawImage" ||
+         schema_name == "foxglove.CompressedImage";
 }
 
 ImageThrottle::ImageThrottle(double images_per_second) {

@@ -92,6 +92,36 @@ TEST(FoxgloveMessages, AnImageWhosePixelsDoNotFillItIsNotDrawn) {
   EXPECT_FALSE(raw_image_json(image));
 }
 
+// A plain image (the zero-copy form, docs/zero_copy.md) holds 768 x 576 pixels; its byte_count
+// says how many of them are the image.
+TEST(FoxgloveMessages, APlainImageIsARawImageOfItsFirstByteCountPixels) {
+  auto image = std::make_unique<PlainGvImage>();  // 442 KB: not on the stack
+  CueHeaderForm<PlainCueHeader>::complete(image->header(), 7, "cam_p/out",
+                                          1'700'000'000'000'000'005ull);
+  image->dx(4);
+  image->dy(2);
+  image->byte_count(8);
+  for (std::size_t i = 0; i < image->image().size(); ++i) {
+    image->image()[i] = static_cast<std::uint8_t>(i < 8 ? 30 + i : 255);
+  }
+  const auto m = json::parse(*raw_image_json(*image));
+  EXPECT_EQ(off_schema("foxglove.RawImage", m), "");
+  EXPECT_EQ(m["width"], 4);
+  EXPECT_EQ(m["height"], 2);
+  EXPECT_EQ(m["step"], 4);
+  EXPECT_EQ(m["frame_id"], "cam_p");
+  EXPECT_EQ(m["timestamp"], json::parse(R"({"sec":1700000000,"nsec":5})"));
+  EXPECT_EQ(from_base64(m["data"]), (std::vector<std::uint8_t>{30, 31, 32, 33, 34, 35, 36, 37}))
+      << "the pixels after byte_count are not the image's";
+
+  image->byte_count(9);
+  EXPECT_FALSE(raw_image_json(*image)) << "9 bytes do not make 4 x 2 pixels";
+  image->dx(768);
+  image->dy(577);
+  image->byte_count(768 * 577);
+  EXPECT_FALSE(raw_image_json(*image)) << "a byte_count beyond the image's array";
+}
+
 TEST(FoxgloveMessages, ACameraImageNamesItsCameraAsFrame) {
   CameraImage image;
   image.header(header(5, "cam_b/frame"));

@@ -42,6 +42,7 @@ TEST(ImageThrottle, WithoutALimitEverythingPassesAndForgetStartsAfresh) {
 
 TEST(ImageThrottle, KnowsTheImageSchemas) {
   EXPECT_TRUE(is_image_schema("oscar::GvImage"));
+  EXPECT_TRUE(is_image_schema("oscar::PlainGvImage"));
   EXPECT_TRUE(is_image_schema("foxglove.RawImage"));
   EXPECT_FALSE(is_image_schema("oscar::Bool"));
   EXPECT_FALSE(is_image_schema("foxglove.SceneUpdate"));

@@ -8,6 +8,7 @@
 #include "oscar/cue_types.hpp"
 #include "oscar/idl_type_info.hpp"
 #include "oscar/perception_types.hpp"
+#include "oscar/plain_cue_types.hpp"
 
 namespace oscar::bridge {
 namespace {
@@ -33,7 +34,7 @@ TEST(SideChannels, DrawableCuesAndTheSystemStateHaveSomeInFoxglovesSchemas) {
   EXPECT_EQ(side_channels_for("oscar/cue/cam_a/image", "oscar::GvImage").size(),
             jpeg_available() ? 2u : 1u);
   if (jpeg_available()) {
-    for (const auto* type : {"oscar::GvImage", "oscar::CameraImage"}) {
+    for (const auto* type : {"oscar::GvImage", "oscar::PlainGvImage", "oscar::CameraImage"}) {
       const auto jpeg = side("oscar/cue/cam_a/frame", type, "foxglove.CompressedImage");
       ASSERT_TRUE(jpeg) << type;
       EXPECT_EQ(jpeg->topic, "foxglove/cam_a/frame/compressed");
@@ -41,6 +42,7 @@ TEST(SideChannels, DrawableCuesAndTheSystemStateHaveSomeInFoxglovesSchemas) {
       EXPECT_EQ(json::parse(jpeg->schema)["title"], "foxglove.CompressedImage");
     }
   }
+  EXPECT_TRUE(side("oscar/cue/cam_p/out", "oscar::PlainGvImage", "foxglove.RawImage"));
   EXPECT_TRUE(side("oscar/cue/pose/pose", "oscar::LandmarkPose", "foxglove.PoseInFrame"));
   EXPECT_TRUE(side("oscar/cue/r10/state", "oscar::RobotState", "foxglove.SceneUpdate"));
   const auto graph = side("oscar/system/state", "oscar::SystemState", "oscar.SystemGraph");
@@ -64,6 +66,29 @@ TEST(SideChannels, ConvertsASampleFromItsRawCdr) {
   LandmarkPose invalid;
   EXPECT_FALSE(convert_sample("oscar::LandmarkPose", "foxglove.PoseInFrame",
                               idl_type_info<LandmarkPose>().serialize(&invalid)));
+}
+
+// A plain image travels over DDS as its whole array (768 x 576 bytes) whatever its size.
+TEST(SideChannels, ConvertsAPlainImageFromItsRawCdr) {
+  auto image = std::make_unique<PlainGvImage>();
+  set_source(image->header(), "cam_p/out");
+  image->dx(2);
+  image->dy(1);
+  image->byte_count(2);
+  image->image()[0] = 10;
+  image->image()[1] = 20;
+  const auto cdr = idl_type_info<PlainGvImage>().serialize(image.get());
+  EXPECT_GT(cdr.size(), image->image().size());
+  const auto m = json::parse(*convert_sample("oscar::PlainGvImage", "foxglove.RawImage", cdr));
+  EXPECT_EQ(m["width"], 2);
+  EXPECT_EQ(m["frame_id"], "cam_p");
+  EXPECT_EQ(m["data"], "ChQ=");
+  if (jpeg_available()) {
+    const auto jpeg =
+        json::parse(*convert_sample("oscar::PlainGvImage", "foxglove.CompressedImage", cdr));
+    EXPECT_EQ(jpeg["format"], "jpeg");
+    EXPECT_EQ(jpeg["frame_id"], "cam_p");
+  }
 }
 
 TEST(SideChannels, ConvertsAnImageToAJpegAtTheQualityAsked) {
