@@ -10,6 +10,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -54,6 +55,66 @@ kernels:
 
 std::string zero_copy_topic_of(const std::string& address) {
   return zero_copy::zero_copy_topic(test::test_domain(), "oscar/cue/" + address);
+}
+
+// The Bools an input's ring got, in order, each with whether it lay in shared memory; take_new()
+// must be called more often than the ring fills.
+class FlagArrivals {
+ public:
+  struct Arrival {
+    std::uint64_t index, seq;
+    bool in_shared_memory;
+  };
+  explicit FlagArrivals(const RingBuffer& ring) : ring_(ring) {}
+  void take_new() {
+    for (const auto& e : ring_.latest(ring_.depth())) {
+      if (!all_.empty() && e.index <= all_.back().index) continue;
+      all_.push_back({e.index, cue_type_info<PlainBool>().header.read(e.cue.get()).seq(),
+                      zero_copy::identify_chunk(e.cue.get()).has_value()});
+    }
+  }
+  std::size_t through_dds() const { return first_zero_copy() - all_.begin(); }
+  std::size_t zero_copy() const {
+    return std::count_if(all_.begin(), all_.end(),
+                         [](const Arrival& a) { return a.in_shared_memory; });
+  }
+  // Through DDS first, then only zero-copy; across the switch and after it each cue once and
+  // none lost (DDS alone may lose one under load: its writer keeps the last 64).
+  void expect_one_switch_losing_nothing() const {
+    const auto first = first_zero_copy();
+    ASSERT_NE(first, all_.begin()) << "no cue came through DDS";
+    ASSERT_NE(first, all_.end()) << "no cue came zero-copy";
+    EXPECT_TRUE(
+        std::all_of(first, all_.end(), [](const Arrival& a) { return a.in_shared_memory; }));
+    for (auto a = first; a != all_.end(); ++a) {
+      const auto& before = *(a - 1);
+      if (a->index == before.index + 1) {
+        EXPECT_EQ(a->seq, before.seq + 1) << "arrival " << a->index;
+      }
+    }
+  }
+
+ private:
+  std::vector<Arrival>::const_iterator first_zero_copy() const {
+    return std::find_if(all_.begin(), all_.end(),
+                        [](const Arrival& a) { return a.in_shared_memory; });
+  }
+  const RingBuffer& ring_;
+  std::vector<Arrival> all_;
+};
+
+void expect_each_flag_once(test::PlainSink& sink) {
+  const auto flags = sink.flags();
+  for (std::size_t i = 1; i < flags.size(); ++i) {
+    EXPECT_GT(flags[i].header.seq(), flags[i - 1].header.seq()) << "none twice";
+  }
+}
+
+std::unique_ptr<test::Process> plain_source_process() {
+  return test::run_module(
+      "plain_src",
+      {"--plugin", test::build_dir() + "/lib/oscar/test_plugins/liboscar_kernel_test_plain.so",
+       "-k", "test_plain_source:src", "-m", "continuous:20ms"});
 }
 
 // One RouDi for the test process, which joins it once and for good (iceoryx 2.0 cannot join
@@ -146,13 +207,7 @@ TEST_F(ZeroCopyWiring, ASinkReadsTheSourcesImagesInTheChunksTheSourceFilledThem)
 // The source in an oscar-run child: every image the sink gets lies in shared memory, whole, in
 // order; after a kill -9 of the source, another one's images come the same way.
 TEST_F(ZeroCopyWiring, ImagesCrossProcessesInPlaceAndAgainFromARestartedSource) {
-  const auto start_source = [] {
-    return test::run_module(
-        "plain_src",
-        {"--plugin", test::build_dir() + "/lib/oscar/test_plugins/liboscar_kernel_test_plain.so",
-         "-k", "test_plain_source:src", "-m", "continuous:20ms"});
-  };
-  auto src = start_source();
+  auto src = plain_source_process();
   ASSERT_TRUE(eventually(
       [] {
         return zero_copy::join_roudi("zero_copy_flow_test") == std::nullopt &&
@@ -184,7 +239,7 @@ TEST_F(ZeroCopyWiring, ImagesCrossProcessesInPlaceAndAgainFromARestartedSource) 
   ::kill(src->pid(), SIGKILL);
   src->wait(10s);
   const auto before = k.images().size();
-  auto again = start_source();
+  auto again = plain_source_process();
   ASSERT_TRUE(eventually(
       [&] {
         check_new();
@@ -208,58 +263,64 @@ TEST_F(ZeroCopyWiring, AnInputWhoseProducerStartsLaterGoesZeroCopyAndGetsEachCue
   spdlog::default_logger()->sinks().push_back(capture);
   auto sink = module(kSink);
   auto& k = dynamic_cast<test::PlainSink&>(sink->kernel("sink").kernel());
-  auto& ring = sink->kernel("sink").ports().find_input("flag")->buffer();
-  struct Arrival {
-    std::uint64_t index, seq;
-    bool in_shared_memory;
-  };
-  std::vector<Arrival> arrivals;  // as the ring got them
-  const auto check_new = [&] {
-    for (const auto& e : ring.latest(ring.depth())) {
-      if (!arrivals.empty() && e.index <= arrivals.back().index) continue;
-      arrivals.push_back({e.index, cue_type_info<PlainBool>().header.read(e.cue.get()).seq(),
-                          zero_copy::identify_chunk(e.cue.get()).has_value()});
-    }
-  };
-  const auto zero_copy_arrivals = [&] {
-    return std::count_if(arrivals.begin(), arrivals.end(),
-                         [](const Arrival& a) { return a.in_shared_memory; });
-  };
-  auto src = test::run_module(
-      "plain_src",
-      {"--plugin", test::build_dir() + "/lib/oscar/test_plugins/liboscar_kernel_test_plain.so",
-       "-k", "test_plain_source:src", "-m", "continuous:20ms"});
+  FlagArrivals arrivals(sink->kernel("sink").ports().find_input("flag")->buffer());
+  auto src = plain_source_process();
   ASSERT_TRUE(eventually(
       [&] {
-        check_new();
-        return zero_copy_arrivals() >= 50;
+        arrivals.take_new();
+        return arrivals.zero_copy() >= 50;
       },
       60s))
       << src->output() << said.str();
   sink->stop();
   std::erase(spdlog::default_logger()->sinks(), capture);
-  // Through DDS first (the switch waits for the producer's first cue), then only zero-copy.
-  const auto first_zero_copy = std::find_if(arrivals.begin(), arrivals.end(),
-                                            [](const Arrival& a) { return a.in_shared_memory; });
-  ASSERT_NE(first_zero_copy, arrivals.begin()) << "no cue came through DDS";
-  EXPECT_TRUE(std::all_of(first_zero_copy, arrivals.end(),
-                          [](const Arrival& a) { return a.in_shared_memory; }));
-  // Across the switch and after it, each cue once and none lost (DDS alone may lose one under
-  // load: its writer keeps the last 64).
-  for (auto a = first_zero_copy; a != arrivals.end(); ++a) {
-    const auto& before = *(a - 1);
-    if (a->index == before.index + 1) {
-      EXPECT_EQ(a->seq, before.seq + 1) << "arrival " << a->index;
-    }
-  }
+  // Through DDS first: the switch waits for the producer's first cue.
+  arrivals.expect_one_switch_losing_nothing();
   EXPECT_THAT(said.str(), HasSubstr("cues of src/flag go serialized, not zero-copy: no process of "
                                     "this host offers it in shared memory"));
-  const auto flags = k.flags();
-  for (std::size_t i = 1; i < flags.size(); ++i) {
-    EXPECT_GT(flags[i].header.seq(), flags[i - 1].header.seq()) << "none twice";
-  }
-  std::cout << "flags through DDS " << (first_zero_copy - arrivals.begin()) << ", then zero-copy "
-            << zero_copy_arrivals() << '\n';
+  expect_each_flag_once(k);
+  std::cout << "flags through DDS " << arrivals.through_dds() << ", then zero-copy "
+            << arrivals.zero_copy() << '\n';
+}
+
+// Modules that found no RouDi when they started (the host's monitor starts it; a module may come
+// first) join it once it runs: the producer in an oscar-run child offers its plain outputs from
+// then on, and the consumer in this process switches its input to them, losing nothing. No
+// fixture: RouDi starts in the middle of the test.
+TEST(ZeroCopyLateRoudi, ModulesStartedBeforeRoudiJoinItOnceItRunsAndTheirCuesGoZeroCopy) {
+  if (!test::kNoPrivateTmp.empty())
+    GTEST_SKIP() << "needs a private mount namespace (root): " << test::kNoPrivateTmp;
+  ASSERT_FALSE(zero_copy::roudi_running()) << "this process's own /tmp holds no RouDi";
+  std::optional<Roudi> roudi;  // ends after the modules that joined it
+  auto src = plain_source_process();
+  auto sink = module(kSink);
+  auto& k = dynamic_cast<test::PlainSink&>(sink->kernel("sink").kernel());
+  FlagArrivals arrivals(sink->kernel("sink").ports().find_input("flag")->buffer());
+  ASSERT_TRUE(eventually(
+      [&] {
+        arrivals.take_new();
+        return arrivals.through_dds() >= 10;
+      },
+      60s))
+      << src->output();
+  EXPECT_EQ(arrivals.zero_copy(), 0u);
+  roudi.emplace();
+  ASSERT_TRUE(eventually(
+      [&] {
+        arrivals.take_new();
+        return arrivals.zero_copy() >= 50;
+      },
+      60s))
+      << src->output() << roudi->output();
+  sink->stop();
+  arrivals.expect_one_switch_losing_nothing();
+  expect_each_flag_once(k);
+  const auto said = src->output();
+  EXPECT_THAT(said, HasSubstr("its plain cues go through DDS only: no RouDi runs on this host"));
+  EXPECT_THAT(said, HasSubstr("joined this host's RouDi, which runs now: 2 plain output(s) offered "
+                              "in shared memory from here on"));
+  std::cout << "flags through DDS " << arrivals.through_dds() << ", then zero-copy "
+            << arrivals.zero_copy() << '\n';
 }
 
 // With RouDi joined, an input whose cues cannot come zero-copy reads through DDS and says why.

@@ -266,23 +266,26 @@ void Module::Dds::wire_wishes(std::vector<std::unique_ptr<Slot>>& slots) {
 void Module::Dds::wire_outputs(std::vector<std::unique_ptr<Slot>>& slots) {
   for (auto& s : slots) {
     for (auto& out : s->instance->ports().outputs) {
-#if OSCAR_ZERO_COPY
-      // Before its writer: a consumer that discovers the writer finds the chunks offered.
-      if (zero_copy_ && out->type().memory.plain) {
-        try {
-          out->set_chunks(std::make_shared<zero_copy::OutputChunks>(
-              zero_copy::zero_copy_topic(domain_, topics::cue(out->address())), out->type()));
-          chunked_outputs_.push_back(out.get());
-        } catch (const std::exception& e) {
-          module_.log_->warn("output {}: its cues go through DDS only: {}", out->address(),
-                             e.what());
-        }
-      }
-#endif
+      offer_chunks(*out);  // before its writer: a consumer that discovers it finds them offered
       writers_.push_back(std::make_unique<OutputWriter>(participant_, *out));
       pull_servers_.push_back(std::make_unique<internal::DdsPullServer>(participant_, *out));
     }
   }
+}
+
+bool Module::Dds::offer_chunks(OutputPort& out) {
+#if OSCAR_ZERO_COPY
+  if (!zero_copy_ || !out.type().memory.plain) return false;
+  try {
+    out.set_chunks(std::make_shared<zero_copy::OutputChunks>(
+        zero_copy::zero_copy_topic(domain_, topics::cue(out.address())), out.type()));
+    chunked_outputs_.push_back(&out);
+    return true;
+  } catch (const std::exception& e) {
+    module_.log_->warn("output {}: its cues go through DDS only: {}", out.address(), e.what());
+  }
+#endif
+  return false;
 }
 
 void Module::Dds::join_zero_copy() {
@@ -296,6 +299,15 @@ void Module::Dds::join_zero_copy() {
     }
   }
   if (!plain) return;
+  if (const auto why = join_roudi()) {
+    module_.log_->info("its plain cues go through DDS only: {}{}", *why,
+                       roudi_later_ ? "; it joins RouDi once one runs" : "");
+  }
+#endif
+}
+
+std::optional<std::string> Module::Dds::join_roudi() {
+#if OSCAR_ZERO_COPY
   try {
     // iceoryx would abort the module (in a port request a RouDi killed meanwhile leaves
     // unanswered).
@@ -306,18 +318,52 @@ void Module::Dds::join_zero_copy() {
           log->flush();
         });
     // A runtime name of its own per process: a restarted module must not look like the old one.
-    if (const auto why =
-            zero_copy::join_roudi(fmt::format("{}-{}", module_.spec_.name, getpid()))) {
-      module_.log_->info("its plain cues go through DDS only: {}", *why);
-      return;
+    if (auto why = zero_copy::join_roudi(fmt::format("{}-{}", module_.spec_.name, getpid()))) {
+      roudi_later_ = true;
+      return why;
     }
     zero_copy_ = true;
     roudi_watch_ = std::make_shared<zero_copy::RoudiWatch>([this](const std::string& why) {
       module_.end_for_restart(why + "; the registry starts it again on the host's RouDi");
     });
+    return std::nullopt;
   } catch (const std::exception& e) {
-    module_.log_->warn("its plain cues go through DDS only: {}", e.what());
+    return e.what();
   }
+#else
+  return "this build has no zero-copy path";
+#endif
+}
+
+// On the configuration thread, every second while roudi_later_.
+void Module::Dds::join_roudi_later() {
+#if OSCAR_ZERO_COPY
+  if (!zero_copy::roudi_running()) return;
+  roudi_later_ = false;
+  if (const auto why = join_roudi()) {
+    module_.log_->warn("its plain cues stay on DDS: {}", *why);
+    return;
+  }
+  std::size_t outputs = 0;
+  for (const auto& s : module_.slots_) {
+    for (const auto& out : s->instance->ports().outputs) outputs += offer_chunks(*out) ? 1 : 0;
+  }
+  std::map<InputPort*, std::string> on_dds;  // plain push inputs: switch_to_offered() takes them
+  {
+    std::lock_guard lock(readers_mutex_);
+    for (const auto& [input, reader] : readers_) {
+      if (!input->takes_any_type() && input->type().memory.plain) on_dds[input] = reader->source();
+    }
+  }
+  {
+    std::lock_guard lock(queue_mutex_);
+    for (const auto& [input, source] : on_dds)
+      awaiting_offer_.try_emplace(input, AwaitingOffer{source});
+  }
+  module_.log_->info(
+      "joined this host's RouDi, which runs now: {} plain output(s) offered in shared memory from "
+      "here on, {} plain input(s) go zero-copy once their producers offer",
+      outputs, on_dds.size());
 #endif
 }
 
@@ -777,6 +823,7 @@ void Module::Dds::serve_config() {
   std::unique_lock lock(queue_mutex_);
   const auto ready = [&] { return !serving_ || !queue_.empty() || !refollow_.empty(); };
   auto next_offer_poll = std::chrono::steady_clock::now();  // switch_to_offered()
+  auto next_roudi_poll = std::chrono::steady_clock::now();  // join_roudi_later()
   while (true) {
     // Discovery is polled for raw inputs whose source has not shown up yet, RouDi for plain
     // inputs whose source it does not list yet; dropped commands are reported within a second.
@@ -790,6 +837,12 @@ void Module::Dds::serve_config() {
     if (!awaiting_type_.empty()) {
       lock.unlock();
       subscribe_discovered();
+      lock.lock();
+    }
+    if (roudi_later_ && std::chrono::steady_clock::now() >= next_roudi_poll) {
+      next_roudi_poll = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+      lock.unlock();
+      join_roudi_later();
       lock.lock();
     }
     if (!awaiting_offer_.empty() && std::chrono::steady_clock::now() >= next_offer_poll) {

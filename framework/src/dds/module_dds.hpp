@@ -76,8 +76,15 @@ class Module::Dds {
     OutputOptions offered;
   };
   /// The zero-copy path (docs/zero_copy.md): a module with ports of a plain cue type joins this
-  /// host's RouDi, if one runs.
+  /// host's RouDi, if one runs, else once one does (join_roudi_later()).
   void join_zero_copy();
+  /// Joins this host's RouDi; why not if it cannot (roudi_later_ is set if none runs yet).
+  std::optional<std::string> join_roudi();
+  /// If RouDi runs now: joins it, offers the plain outputs' chunks and lets the plain push
+  /// inputs on DDS switch as their producers offer (switch_to_offered()).
+  void join_roudi_later();
+  /// Gives a plain output its chunks in shared memory, if the module joined RouDi; true if so.
+  bool offer_chunks(OutputPort& out);
   /// Feeds a push input of a plain type from its producer's chunks when this host's RouDi lists
   /// the producer's output (waiting a moment for that if discovery shows the producer's writer:
   /// `producer_seen`); "" then, nothing if its cues go through DDS (one line says why).
@@ -112,7 +119,8 @@ class Module::Dds {
 
   Module& module_;
   const int domain_;
-  bool zero_copy_ = false;                ///< joined this host's RouDi
+  bool zero_copy_ = false;    ///< joined this host's RouDi
+  bool roudi_later_ = false;  ///< has plain ports, found no RouDi: join_roudi_later() polls
   const DiscoveryScope discovery_scope_;  ///< discovery_scope_of(module_), before participant_
   DdsParticipant participant_;
   /// A plain client of discovery servers: it learns of a producer's writer only by reading the
