@@ -26,6 +26,7 @@
 #include "private_tmp.hpp"
 #include "process.hpp"
 #include "zero_copy/chunk_identity.hpp"
+#include "zero_copy/chunk_subscriber.hpp"
 #include "zero_copy/mempools.hpp"
 #include "zero_copy/roudi.hpp"
 
@@ -321,6 +322,93 @@ TEST(ZeroCopyLateRoudi, ModulesStartedBeforeRoudiJoinItOnceItRunsAndTheirCuesGoZ
                               "in shared memory from here on"));
   std::cout << "flags through DDS " << arrivals.through_dds() << ", then zero-copy "
             << arrivals.zero_copy() << '\n';
+}
+
+// Pull inputs of the producer in an oscar-run child: each answer is the producer's chunk, read in
+// place, and every query finds what the producer's ring would (the newest, at or before, first
+// at or after a time still to come, the newest n).
+TEST_F(ZeroCopyWiring, PullsAcrossProcessesAreAnsweredWithTheProducersChunksInPlace) {
+  auto src = plain_source_process();
+  ASSERT_TRUE(eventually(
+      [] {
+        return zero_copy::join_roudi("zero_copy_flow_test") == std::nullopt &&
+               zero_copy::offered_on_this_host(zero_copy_topic_of("src/image"),
+                                               "oscar::PlainGvImage");
+      },
+      30s))
+      << src->output();
+  auto sink = module(R"(
+name: plain_puller
+mode: deactivated
+kernels:
+  - type: test_plain_sink
+    name: sink
+    inputs: { flag: src/flag, image: { source: src/image, transfer: pull } }
+)");
+  auto& in = dynamic_cast<Input<PlainGvImage>&>(*sink->kernel("sink").ports().find_input("image"));
+  EXPECT_EQ(in.buffer().pushed(), 0u) << "a pull input receives nothing unasked";
+  const auto check = [](const Input<PlainGvImage>::Ptr& image) {
+    EXPECT_TRUE(zero_copy::identify_chunk(image.get())) << "the producer's chunk, in place";
+    EXPECT_TRUE(test::plain_image_complete(*image));
+    EXPECT_EQ(test::plain_image_frame(*image), image->header().seq());
+  };
+  Input<PlainGvImage>::Ptr now;
+  ASSERT_TRUE(eventually([&] { return (now = in.pull()) && now->header().seq() > 10; }, 30s))
+      << src->output();
+  check(now);
+  const auto t = generation_stamp(now->header());
+  const auto earlier = in.pull_at(t - 30'000'000);  // 1-2 cycles of 20 ms before
+  ASSERT_TRUE(earlier);
+  check(earlier);
+  EXPECT_LT(earlier->header().seq(), now->header().seq());
+  EXPECT_LE(generation_stamp(earlier->header()), t - 30'000'000);
+  const auto later = in.pull_at(t + 50'000'000, PullQuery::kAtOrAfter, 2s);  // still to come
+  ASSERT_TRUE(later) << "held until the producer published it";
+  check(later);
+  EXPECT_GE(generation_stamp(later->header()), t + 50'000'000);
+  const auto newest = in.pull_latest(4);
+  ASSERT_EQ(newest.size(), 4u) << "the producer's ring (depth 4) as the input's mirror holds it";
+  for (std::size_t i = 0; i < newest.size(); ++i) {
+    check(newest[i]);
+    if (i > 0) {
+      EXPECT_EQ(newest[i]->header().seq(), newest[i - 1]->header().seq() + 1);
+    }
+  }
+  EXPECT_GE(in.buffer().pushed(), 4u) << "the answers land in the input's ring too";
+}
+
+// A pull input wired after its producer went quiet still finds the producer's last cues: the
+// producer's publisher keeps them (up to 16) for a mirror that connects later.
+TEST_F(ZeroCopyWiring, APullInputWiredAfterItsProducerWentQuietFindsItsLastCues) {
+  auto src = test::run_module("src", {"-k", "bench_source:src", "-p", "src.type=PlainBool", "-p",
+                                      "src.count=10", "-m", "continuous:10ms"});
+  ASSERT_TRUE(eventually(
+      [&] {
+        return zero_copy::join_roudi("zero_copy_flow_test") == std::nullopt &&
+               zero_copy::offered_on_this_host(zero_copy_topic_of("src/out"), "oscar::PlainBool");
+      },
+      30s))
+      << src->output();
+  // Quiet: a subscriber that asks for no history gets nothing more.
+  zero_copy::ChunkSubscriber quiet(zero_copy_topic_of("src/out"), "oscar::PlainBool");
+  ASSERT_TRUE(eventually([&] { return quiet.subscribed(); }, 10s));
+  ASSERT_TRUE(eventually([&] { return quiet.take(500ms) == nullptr; }, 30s)) << src->output();
+  auto sink = module(R"(
+name: late_puller
+mode: deactivated
+kernels:
+  - type: test_plain_sink
+    name: sink
+    inputs: { flag: { source: src/out, transfer: pull }, image: src/image }
+)");
+  auto& in = dynamic_cast<Input<PlainBool>&>(*sink->kernel("sink").ports().find_input("flag"));
+  std::vector<Input<PlainBool>::Ptr> cues;
+  ASSERT_TRUE(eventually([&] { return (cues = in.pull_latest(16)).size() == 10; }, 10s))
+      << cues.size() << " cues";
+  for (std::size_t i = 0; i < cues.size(); ++i) {
+    EXPECT_EQ(cues[i]->header().seq(), i + 1);
+    EXPECT_TRUE(zero_copy::identify_chunk(cues[i].get())) << "in place";
+  }
 }
 
 // With RouDi joined, an input whose cues cannot come zero-copy reads through DDS and says why.

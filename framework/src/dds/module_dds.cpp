@@ -23,6 +23,8 @@
 
 #if OSCAR_ZERO_COPY
 #include "zero_copy/chunk_feed.hpp"
+#include "zero_copy/chunk_publisher.hpp"
+#include "zero_copy/chunk_pull_source.hpp"
 #include "zero_copy/cue_path.hpp"
 #include "zero_copy/output_chunks.hpp"
 #include "zero_copy/roudi.hpp"
@@ -277,8 +279,10 @@ bool Module::Dds::offer_chunks(OutputPort& out) {
 #if OSCAR_ZERO_COPY
   if (!zero_copy_ || !out.type().memory.plain) return false;
   try {
+    // The publisher keeps what the ring holds (up to iceoryx's 16) for pulls that start later.
     out.set_chunks(std::make_shared<zero_copy::OutputChunks>(
-        zero_copy::zero_copy_topic(domain_, topics::cue(out.address())), out.type()));
+        zero_copy::zero_copy_topic(domain_, topics::cue(out.address())), out.type(),
+        std::min(out.options().depth, zero_copy::kMaxChunkHistory)));
     chunked_outputs_.push_back(&out);
     return true;
   } catch (const std::exception& e) {
@@ -415,11 +419,62 @@ std::optional<std::string> Module::Dds::feed_zero_copy(InputPort& input, const s
 #endif
 }
 
+std::optional<std::string> Module::Dds::pull_zero_copy(
+    InputPort& input, const std::string& source, std::chrono::steady_clock::time_point until) {
+#if OSCAR_ZERO_COPY
+  if (!zero_copy_ || input.takes_any_type()) return std::nullopt;
+  const auto topic = zero_copy::zero_copy_topic(domain_, topics::cue(source));
+  std::shared_ptr<zero_copy::ChunkPullSource> puller;
+  try {
+    // As for a push input: the producer's writer first, then RouDi lists its chunks, which it
+    // offers before its writer (within RouDi's next discovery round).
+    bool offered = false;
+    if (input.type().memory.plain) {
+      while (!participant_.discovered_writer(topics::cue(source)) &&
+             std::chrono::steady_clock::now() < until) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      }
+      const auto listed = std::chrono::steady_clock::now() + std::chrono::milliseconds(300);
+      while (!(offered = zero_copy::offered_on_this_host(topic, input.type().name)) &&
+             std::chrono::steady_clock::now() < listed) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+    }
+    // Logs why, for a serialized path.
+    if (zero_copy::choose_cue_path(zero_copy::connection_facts(source, input.type(), offered))
+            .path != zero_copy::CuePath::kZeroCopy) {
+      return std::nullopt;
+    }
+    puller = std::make_shared<zero_copy::ChunkPullSource>(topic, source, input);
+  } catch (const std::exception& e) {
+    module_.log_->warn("input {}/{}: its pulls go to the producer over DDS: {}", input.kernel(),
+                       input.name(), e.what());
+    return std::nullopt;
+  }
+  input.set_pull_source(puller);  // make, then break: the old source goes with its last user
+  {
+    std::lock_guard lock(readers_mutex_);
+    pull_sources_[&input] = std::move(puller);
+  }
+  module_.log_->info(
+      "input {}/{}: pulls of {} are answered in this process from its chunks in shared memory "
+      "(zero-copy)",
+      input.kernel(), input.name(), source);
+  return std::string();
+#else
+  (void)input;
+  (void)source;
+  (void)until;
+  return std::nullopt;
+#endif
+}
+
 std::string Module::Dds::connect_input(InputPort& input, const std::string& source,
                                        std::optional<std::chrono::milliseconds> switch_wait) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(2000);
 
   if (input.transfer() != Transfer::kPush) {
+    if (auto pulled = pull_zero_copy(input, source, until)) return *pulled;
     auto puller = std::make_shared<internal::DdsPullSource>(
         participant_, input, source,
         fmt::format("{}/{}/{}@{}", module_.spec_.name, input.kernel(), input.name(), getpid()));
@@ -711,7 +766,7 @@ void Module::Dds::disconnect_input(InputPort& input) {
     switching = awaiting_offer_.extract(&input);
   }
   std::unique_ptr<CueReader> old;
-  std::shared_ptr<internal::DdsPullSource> old_pull;  // the input reads elsewhere by now
+  std::shared_ptr<PullSource> old_pull;  // the input reads elsewhere by now
   std::shared_ptr<void> old_feed;
   {
     std::lock_guard lock(readers_mutex_);

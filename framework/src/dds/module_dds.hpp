@@ -90,6 +90,12 @@ class Module::Dds {
   /// `producer_seen`); "" then, nothing if its cues go through DDS (one line says why).
   std::optional<std::string> feed_zero_copy(InputPort& input, const std::string& source,
                                             bool producer_seen);
+  /// Answers a pull or prefetch input of a plain type in this process from its producer's
+  /// chunks (zero_copy::ChunkPullSource) when this host's RouDi lists them (waiting for the
+  /// producer's writer up to `until`, as a push input does); "" then, nothing if its pulls go
+  /// to the producer over DDS (one line says why).
+  std::optional<std::string> pull_zero_copy(InputPort& input, const std::string& source,
+                                            std::chrono::steady_clock::time_point until);
   /// What the module's participant learns of from the discovery servers, if it uses them:
   /// only what shares a topic with it (docs/network.md), unless an input takes any type.
   static DiscoveryScope discovery_scope_of(const Module& module);
@@ -128,7 +134,7 @@ class Module::Dds {
   bool learns_only_shared_topics_ = false;
   std::vector<std::unique_ptr<OutputWriter>> writers_;
   std::vector<std::unique_ptr<internal::DdsPullServer>> pull_servers_;
-  std::map<InputPort*, std::shared_ptr<internal::DdsPullSource>> pull_sources_;
+  std::map<InputPort*, std::shared_ptr<PullSource>> pull_sources_;  ///< over DDS or zero-copy
   std::mutex readers_mutex_;
   std::map<InputPort*, std::unique_ptr<CueReader>> readers_;
   /// Push inputs fed by the zero-copy path (zero_copy::ChunkFeed, which only the zero-copy build

@@ -9,12 +9,26 @@
 namespace oscar::zero_copy {
 
 ChunkFeed::ChunkFeed(const std::string& topic, InputPort& input, const CueTypeInfo& type, bool held)
-    : input_(input),
+    : sink_([&input, &type](std::shared_ptr<const void> cue) {
+        input.deliver_from(type, std::move(cue));
+      }),
+      name_("input " + input.kernel() + "/" + input.name()),
       type_(type),
       topic_(topic),
       capacity_(std::clamp<std::size_t>(input.buffer().depth(), 1, 256)),
       chunks_(topic, type.name, capacity_),
       held_(held),
+      thread_([this](std::stop_token stop) { deliver(stop); }) {}
+
+ChunkFeed::ChunkFeed(const std::string& topic, const CueTypeInfo& type, std::size_t capacity,
+                     std::size_t history, Sink sink, std::string name)
+    : sink_(std::move(sink)),
+      name_(std::move(name)),
+      type_(type),
+      topic_(topic),
+      capacity_(std::clamp<std::size_t>(capacity, 1, 256)),
+      chunks_(topic, type.name, capacity_, history),
+      held_(false),
       thread_([this](std::stop_token stop) { deliver(stop); }) {}
 
 ChunkFeed::~ChunkFeed() {
@@ -52,7 +66,7 @@ void ChunkFeed::deliver_one(std::shared_ptr<const void> cue) {
     if (seq <= *delivered_through_ && *delivered_through_ - seq < capacity_) return;
     delivered_through_.reset();
   }
-  input_.deliver_from(type_, std::move(cue));
+  sink_(std::move(cue));
 }
 
 void ChunkFeed::deliver(std::stop_token stop) {
@@ -66,7 +80,7 @@ void ChunkFeed::deliver(std::stop_token stop) {
       }
     } catch (const std::exception& e) {
       // The input holds too many chunks (iceoryx's limit): its ring gives them back as it goes.
-      spdlog::error("input {}/{}: {}: {}", input_.kernel(), input_.name(), topic_, e.what());
+      spdlog::error("{}: {}: {}", name_, topic_, e.what());
       std::this_thread::sleep_for(kWait);
     }
   }

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -14,16 +15,22 @@
 
 namespace oscar::zero_copy {
 
-/// Subscribes to an output's chunks on this host and delivers each to `input` where it lies, on a
-/// thread of its own: the input's ring buffer holds the producer's chunks. Needs join_roudi()
-/// first.
+/// Subscribes to an output's chunks on this host and delivers each where it lies, on a thread of
+/// its own: to a push input, whose ring buffer then holds the producer's chunks, or to any sink.
+/// Needs join_roudi() first.
 class ChunkFeed {
  public:
+  using Sink = std::function<void(std::shared_ptr<const void> cue)>;
+
   /// `topic`: the iceoryx topic of the producer's output (zero_copy_topic()); `type`: its cue
   /// type. Up to the input's depth of chunks wait to be delivered. A `held` feed delivers nothing
   /// until hand_over(): it takes over from a DDS reader of the same output.
   /// @throws std::invalid_argument for a topic iceoryx cannot take.
   ChunkFeed(const std::string& topic, InputPort& input, const CueTypeInfo& type, bool held = false);
+  /// Delivers to `sink` instead, up to `capacity` chunks waiting, first up to `history` the
+  /// producer published before (ChunkSubscriber); `name` says whose feed it is in the log.
+  ChunkFeed(const std::string& topic, const CueTypeInfo& type, std::size_t capacity,
+            std::size_t history, Sink sink, std::string name);
   /// Delivers nothing more; returns once a delivery under way is done.
   ~ChunkFeed();
   ChunkFeed(const ChunkFeed&) = delete;
@@ -44,7 +51,8 @@ class ChunkFeed {
   void deliver_one(std::shared_ptr<const void> cue);
   std::uint64_t seq_of(const void* cue) const;
 
-  InputPort& input_;
+  const Sink sink_;
+  const std::string name_;  // "input <kernel>/<name>" or the like, for the log
   const CueTypeInfo& type_;
   std::string topic_;
   const std::size_t capacity_;

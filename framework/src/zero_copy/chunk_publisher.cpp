@@ -1,5 +1,8 @@
 #include "zero_copy/chunk_publisher.hpp"
 
+#include <stdexcept>
+
+#include <fmt/format.h>
 #include <iceoryx_posh/popo/untyped_publisher.hpp>
 
 #include "zero_copy/service.hpp"
@@ -7,13 +10,29 @@
 
 namespace oscar::zero_copy {
 
+static_assert(kMaxChunkHistory == iox::MAX_PUBLISHER_HISTORY);
+
+namespace {
+iox::popo::PublisherOptions options_for(std::size_t history) {
+  if (history > kMaxChunkHistory)
+    throw std::invalid_argument(
+        fmt::format("zero-copy publisher history {}: at most {}", history, kMaxChunkHistory));
+  iox::popo::PublisherOptions options;
+  options.historyCapacity = history;
+  return options;
+}
+}  // namespace
+
 struct ChunkPublisher::Impl {
-  explicit Impl(const iox::capro::ServiceDescription& service) : publisher(service) {}
+  Impl(const iox::capro::ServiceDescription& service, const iox::popo::PublisherOptions& options)
+      : publisher(service, options) {}
   iox::popo::UntypedPublisher publisher;
 };
 
-ChunkPublisher::ChunkPublisher(const std::string& topic, const std::string& type_name)
-    : impl_(std::make_unique<Impl>(internal::service_for(topic, type_name))) {}
+ChunkPublisher::ChunkPublisher(const std::string& topic, const std::string& type_name,
+                               std::size_t history)
+    : impl_(std::make_unique<Impl>(internal::service_for(topic, type_name), options_for(history))) {
+}
 
 ChunkPublisher::~ChunkPublisher() = default;
 

@@ -11,11 +11,18 @@
 
 namespace oscar::zero_copy {
 
+/// The most chunks a publisher keeps for subscribers that ask for its history (iceoryx 2.0's
+/// MAX_PUBLISHER_HISTORY).
+inline constexpr std::size_t kMaxChunkHistory = 16;
+
 /// An iceoryx publisher of untyped chunks for one topic. Needs join_roudi() first.
 class ChunkPublisher {
  public:
-  /// @throws std::invalid_argument if the topic or type name does not fit a service description.
-  ChunkPublisher(const std::string& topic, const std::string& type_name);
+  /// Keeps the last `history` chunks it published (at most kMaxChunkHistory) for subscribers
+  /// that ask for them when they connect.
+  /// @throws std::invalid_argument if the topic or type name does not fit a service description,
+  ///         or `history` is above kMaxChunkHistory.
+  ChunkPublisher(const std::string& topic, const std::string& type_name, std::size_t history = 0);
   ~ChunkPublisher();
   ChunkPublisher(const ChunkPublisher&) = delete;
   ChunkPublisher& operator=(const ChunkPublisher&) = delete;

@@ -13,12 +13,13 @@
 namespace oscar::zero_copy {
 
 namespace {
-iox::popo::SubscriberOptions options_for(std::size_t queue_capacity) {
+iox::popo::SubscriberOptions options_for(std::size_t queue_capacity, std::size_t history) {
   if (queue_capacity == 0 || queue_capacity > iox::MAX_SUBSCRIBER_QUEUE_CAPACITY)
     throw std::invalid_argument(fmt::format("zero-copy queue capacity {}: 1 to {}", queue_capacity,
                                             iox::MAX_SUBSCRIBER_QUEUE_CAPACITY));
   iox::popo::SubscriberOptions options;
   options.queueCapacity = queue_capacity;
+  options.historyRequest = history;
   return options;
 }
 }  // namespace
@@ -40,9 +41,9 @@ struct ChunkSubscriber::State {
 };
 
 ChunkSubscriber::ChunkSubscriber(const std::string& topic, const std::string& type_name,
-                                 std::size_t queue_capacity)
+                                 std::size_t queue_capacity, std::size_t history)
     : state_(std::make_shared<State>(internal::service_for(topic, type_name),
-                                     options_for(queue_capacity))) {}
+                                     options_for(queue_capacity, history))) {}
 
 ChunkSubscriber::~ChunkSubscriber() = default;
 

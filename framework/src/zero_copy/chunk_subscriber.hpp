@@ -14,10 +14,11 @@ namespace oscar::zero_copy {
 /// An iceoryx subscriber of untyped chunks for one topic. Needs join_roudi() first.
 class ChunkSubscriber {
  public:
-  /// Keeps up to `queue_capacity` received chunks not yet taken (the oldest go first).
+  /// Keeps up to `queue_capacity` received chunks not yet taken (the oldest go first). Asks each
+  /// publisher it connects to for up to `history` chunks it published before (those it keeps).
   /// @throws std::invalid_argument if the topic or type name does not fit a service description.
   ChunkSubscriber(const std::string& topic, const std::string& type_name,
-                  std::size_t queue_capacity = 16);
+                  std::size_t queue_capacity = 16, std::size_t history = 0);
   ~ChunkSubscriber();
   ChunkSubscriber(const ChunkSubscriber&) = delete;
   ChunkSubscriber& operator=(const ChunkSubscriber&) = delete;

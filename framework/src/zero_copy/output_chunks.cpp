@@ -12,7 +12,8 @@
 namespace oscar::zero_copy {
 
 struct OutputChunks::Publisher {
-  Publisher(const std::string& topic, const std::string& type_name) : chunks(topic, type_name) {}
+  Publisher(const std::string& topic, const std::string& type_name, std::size_t history)
+      : chunks(topic, type_name, history) {}
   // iceoryx's publisher is not thread-safe; a loan dropped in publish() gives its chunk back
   // under the same lock.
   std::recursive_mutex mutex;
@@ -30,8 +31,8 @@ struct OutputChunks::ReturnLoan {
   }
 };
 
-OutputChunks::OutputChunks(const std::string& topic, const CueTypeInfo& type)
-    : publisher_(std::make_shared<Publisher>(topic, type.name)),
+OutputChunks::OutputChunks(const std::string& topic, const CueTypeInfo& type, std::size_t history)
+    : publisher_(std::make_shared<Publisher>(topic, type.name, history)),
       own_(topic, type.name, 2),
       type_(type),
       topic_(topic) {

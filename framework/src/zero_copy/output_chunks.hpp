@@ -17,9 +17,10 @@ class OutputChunks final : public CueChunks {
  public:
   /// `topic`: the iceoryx topic (zero_copy_topic()). The output's ring holds its depth in chunks:
   /// RouDi's pools must have them. Waits up to a second for RouDi to connect the output's own
-  /// subscriber.
+  /// subscriber. Its publisher keeps the last `history` chunks (those the ring holds anyway) for
+  /// a consumer's pulls that start then (ChunkPullSource).
   /// @throws std::invalid_argument for a type that is not plain, or a topic iceoryx cannot take.
-  OutputChunks(const std::string& topic, const CueTypeInfo& type);
+  OutputChunks(const std::string& topic, const CueTypeInfo& type, std::size_t history = 0);
   ~OutputChunks() override;
 
   std::shared_ptr<void> loan() override;
