@@ -377,6 +377,35 @@ kernels:
   EXPECT_GE(in.buffer().pushed(), 4u) << "the answers land in the input's ring too";
 }
 
+// A pull input wired before its producer runs asks over DDS; once the producer, started later,
+// offers its chunks, the input's pulls are answered from them in place.
+TEST_F(ZeroCopyWiring, APullInputWhoseProducerStartsLaterReadsItsChunksOnceOffered) {
+  auto sink = module(R"(
+name: early_puller
+mode: deactivated
+kernels:
+  - type: test_plain_sink
+    name: sink
+    inputs: { flag: src/flag, image: { source: src/image, transfer: pull } }
+)");
+  auto& in = dynamic_cast<Input<PlainGvImage>&>(*sink->kernel("sink").ports().find_input("image"));
+  auto src = plain_source_process();
+  Input<PlainGvImage>::Ptr image;
+  ASSERT_TRUE(eventually([&] { return (image = in.pull(200ms)) != nullptr; }, 30s))
+      << src->output();
+  ASSERT_TRUE(eventually(
+      [&] {
+        image = in.pull(200ms);
+        return image && zero_copy::identify_chunk(image.get());
+      },
+      30s))
+      << "answered in place once the producer offers its chunks";
+  EXPECT_TRUE(test::plain_image_complete(*image));
+  const auto newest = in.pull_latest(4);
+  ASSERT_EQ(newest.size(), 4u);
+  for (const auto& cue : newest) EXPECT_TRUE(zero_copy::identify_chunk(cue.get()));
+}
+
 // A pull input wired after its producer went quiet still finds the producer's last cues: the
 // producer's publisher keeps them (up to 16) for a mirror that connects later.
 TEST_F(ZeroCopyWiring, APullInputWiredAfterItsProducerWentQuietFindsItsLastCues) {

@@ -248,7 +248,7 @@ Module::Dds::~Dds() {
       participant_.subscriber().delete_datareader(reader->reader_);
     readers_.clear();
   }
-  for (auto& [input, source] : pull_sources_) input->set_pull_source(nullptr);
+  for (auto& [input, pulls] : pull_sources_) input->set_pull_source(nullptr);
   pull_sources_.clear();
   pull_servers_.clear();
   for (auto& w : writers_) participant_.publisher().delete_datawriter(w->writer_);
@@ -358,6 +358,9 @@ void Module::Dds::join_roudi_later() {
     for (const auto& [input, reader] : readers_) {
       if (!input->takes_any_type() && input->type().memory.plain) on_dds[input] = reader->source();
     }
+    for (const auto& [input, pulls] : pull_sources_) {
+      if (!input->takes_any_type() && input->type().memory.plain) on_dds[input] = pulls.from;
+    }
   }
   {
     std::lock_guard lock(queue_mutex_);
@@ -440,12 +443,21 @@ std::optional<std::string> Module::Dds::pull_zero_copy(
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
       }
     }
+    const auto facts = zero_copy::connection_facts(source, input.type(), offered);
     // Logs why, for a serialized path.
-    if (zero_copy::choose_cue_path(zero_copy::connection_facts(source, input.type(), offered))
-            .path != zero_copy::CuePath::kZeroCopy) {
+    if (zero_copy::choose_cue_path(facts).path != zero_copy::CuePath::kZeroCopy) {
+      if (facts.type_is_plain && !facts.producer_on_this_host) {
+        std::lock_guard lock(queue_mutex_);
+        awaiting_offer_[&input] = {.source = source};  // a producer started later may offer it
+      }
       return std::nullopt;
     }
     puller = std::make_shared<zero_copy::ChunkPullSource>(topic, source, input);
+    // A pull before RouDi connected the mirror would find it empty.
+    const auto connected = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+    while (!puller->subscribed() && std::chrono::steady_clock::now() < connected) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
   } catch (const std::exception& e) {
     module_.log_->warn("input {}/{}: its pulls go to the producer over DDS: {}", input.kernel(),
                        input.name(), e.what());
@@ -454,7 +466,7 @@ std::optional<std::string> Module::Dds::pull_zero_copy(
   input.set_pull_source(puller);  // make, then break: the old source goes with its last user
   {
     std::lock_guard lock(readers_mutex_);
-    pull_sources_[&input] = std::move(puller);
+    pull_sources_[&input] = {std::move(puller), source};
   }
   module_.log_->info(
       "input {}/{}: pulls of {} are answered in this process from its chunks in shared memory "
@@ -486,7 +498,7 @@ std::string Module::Dds::connect_input(InputPort& input, const std::string& sour
     }
     input.set_pull_source(puller);  // make, then break: the old source goes with its last user
     std::lock_guard lock(readers_mutex_);
-    pull_sources_[&input] = std::move(puller);
+    pull_sources_[&input] = {std::move(puller), source};
     return note;
   }
   // The reader follows the class the producer declared, which its writer offers: discovery shows
@@ -691,6 +703,10 @@ void Module::Dds::switch_to_offered() {
   const auto now = std::chrono::steady_clock::now();
   for (auto& [input, a] : awaiting) {
     try {
+      if (input->transfer() != Transfer::kPush) {
+        switch_pulls_to_offered(*input, a);
+        continue;
+      }
       if (!a.feed) {
         {
           // Its producer runs once its cues come: then RouDi is asked whether it offers them.
@@ -751,10 +767,51 @@ void Module::Dds::switch_to_offered() {
 #endif
 }
 
+// Part of switch_to_offered(), for a pull or prefetch input: once RouDi lists the source, a
+// mirror of its chunks subscribes; once RouDi connected it, it answers the input's pulls and the
+// DDS pull source goes with its last user.
+void Module::Dds::switch_pulls_to_offered(InputPort& input, AwaitingOffer& a) {
+#if OSCAR_ZERO_COPY
+  const auto update = [&](bool settled) {
+    std::lock_guard lock(queue_mutex_);
+    if (const auto it = awaiting_offer_.find(&input);
+        it != awaiting_offer_.end() && it->second.source == a.source) {
+      if (settled) {
+        awaiting_offer_.erase(it);
+      } else {
+        it->second = a;
+      }
+    }
+  };
+  if (!a.pulls) {
+    const auto topic = zero_copy::zero_copy_topic(domain_, topics::cue(a.source));
+    if (!zero_copy::offered_on_this_host(topic, input.type().name)) return;
+    a.pulls = std::make_shared<zero_copy::ChunkPullSource>(topic, a.source, input);
+    update(false);
+    return;
+  }
+  if (!a.pulls->subscribed()) return;
+  input.set_pull_source(a.pulls);
+  {
+    std::lock_guard lock(readers_mutex_);
+    pull_sources_[&input] = {a.pulls, a.source};
+  }
+  update(true);
+  module_.log_->info(
+      "input {}/{}: {} is offered in shared memory on this host now: its pulls are answered in "
+      "this process from its chunks from here on",
+      input.kernel(), input.name(), a.source);
+#else
+  (void)input;
+  (void)a;
+#endif
+}
+
 std::chrono::milliseconds Module::Dds::offer_poll() const {
   // Under queue_mutex_. A switch under way is looked at often: its feed holds the cues meanwhile.
-  const bool switching = std::any_of(awaiting_offer_.begin(), awaiting_offer_.end(),
-                                     [](const auto& a) { return a.second.feed != nullptr; });
+  const bool switching =
+      std::any_of(awaiting_offer_.begin(), awaiting_offer_.end(),
+                  [](const auto& a) { return a.second.feed != nullptr || a.second.pulls; });
   return std::chrono::milliseconds(switching ? 5 : 250);
 }
 
@@ -779,7 +836,7 @@ void Module::Dds::disconnect_input(InputPort& input) {
       readers_.erase(it);
     }
     if (auto it = pull_sources_.find(&input); it != pull_sources_.end()) {
-      old_pull = std::move(it->second);
+      old_pull = std::move(it->second.source);
       pull_sources_.erase(it);
     }
   }

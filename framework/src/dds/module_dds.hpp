@@ -32,7 +32,8 @@
 
 namespace oscar::zero_copy {
 class ChunkFeed;
-}
+class ChunkPullSource;
+}  // namespace oscar::zero_copy
 
 namespace oscar {
 
@@ -112,10 +113,13 @@ class Module::Dds {
                         std::optional<std::chrono::milliseconds> switch_wait,
                         std::chrono::steady_clock::time_point until);
   void subscribe_discovered();
-  /// Push inputs of a plain type that read through DDS only because no process of this host
-  /// offered their producer's chunks when they were wired go zero-copy once one does: a held
-  /// feed subscribes, the DDS reader is retired and the feed starts after its last cue.
+  /// Inputs of a plain type that read through DDS only because no process of this host offered
+  /// their producer's chunks when they were wired go zero-copy once one does. A push input: a
+  /// held feed subscribes, the DDS reader is retired and the feed starts after its last cue. A
+  /// pull input: switch_pulls_to_offered().
   void switch_to_offered();
+  struct AwaitingOffer;
+  void switch_pulls_to_offered(InputPort& input, AwaitingOffer& a);
   /// How often switch_to_offered() runs (under queue_mutex_).
   std::chrono::milliseconds offer_poll() const;
   void follow_producer(InputPort& input, const std::string& source, const OutputOptions& offered);
@@ -134,7 +138,12 @@ class Module::Dds {
   bool learns_only_shared_topics_ = false;
   std::vector<std::unique_ptr<OutputWriter>> writers_;
   std::vector<std::unique_ptr<internal::DdsPullServer>> pull_servers_;
-  std::map<InputPort*, std::shared_ptr<PullSource>> pull_sources_;  ///< over DDS or zero-copy
+  /// The pull and prefetch inputs' sources, over DDS or zero-copy, and where they pull from.
+  struct PullWiring {
+    std::shared_ptr<PullSource> source;
+    std::string from;
+  };
+  std::map<InputPort*, PullWiring> pull_sources_;
   std::mutex readers_mutex_;
   std::map<InputPort*, std::unique_ptr<CueReader>> readers_;
   /// Push inputs fed by the zero-copy path (zero_copy::ChunkFeed, which only the zero-copy build
@@ -177,8 +186,9 @@ class Module::Dds {
   /// under queue_mutex_; `feed` is held while the switch is under way.
   struct AwaitingOffer {
     std::string source;
-    std::shared_ptr<zero_copy::ChunkFeed> feed{};
+    std::shared_ptr<zero_copy::ChunkFeed> feed{};  ///< a push input's, held
     std::chrono::steady_clock::time_point give_up{};
+    std::shared_ptr<zero_copy::ChunkPullSource> pulls{};  ///< a pull input's, until connected
   };
   std::map<InputPort*, AwaitingOffer> awaiting_offer_;
   internal::ReplyMemory last_replies_;  // the configuration thread's: answers repeated commands
