@@ -38,7 +38,7 @@ const char* const kUsage =
     "  security init|check|list SYSTEM.yaml\n"
     "                        the system's DDS Security keystore (--keystore DIR)\n"
     "  bench <what> ...      benchmarks: cueflow, restart, boot, applets, swarm, record,\n"
-    "                        replay, landmarks, bridge, stalls, discovery\n"
+    "                        replay, landmarks, bridge, stalls, discovery, pull\n"
     "\n"
     "`oscar <command> --help` shows a command's options.\n";
 
@@ -61,7 +61,8 @@ int main(int argc, char** argv) {
     if (argc < 3) {
       std::fputs(
           "usage: oscar bench "
-          "<cueflow|restart|boot|applets|swarm|record|replay|landmarks|bridge|stalls|discovery> "
+          "<cueflow|restart|boot|applets|swarm|record|replay|landmarks|bridge|stalls|discovery|"
+          "pull> "
           "[args...]\n",
           stderr);
       return 2;
