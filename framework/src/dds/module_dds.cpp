@@ -374,6 +374,34 @@ void Module::Dds::join_roudi_later() {
 #endif
 }
 
+#if OSCAR_ZERO_COPY
+bool Module::Dds::chunks_offered(InputPort& input, const std::string& source,
+                                 std::chrono::steady_clock::time_point until) {
+  const auto topic = zero_copy::zero_copy_topic(domain_, topics::cue(source));
+  bool offered = false;
+  if (input.type().memory.plain) {
+    std::optional<std::chrono::steady_clock::time_point> writer_seen;
+    while (!(offered = zero_copy::offered_on_this_host(topic, input.type().name))) {
+      const auto now = std::chrono::steady_clock::now();
+      if (!writer_seen && participant_.discovered_writer(topics::cue(source))) writer_seen = now;
+      // An output offers its chunks before it makes its writer; RouDi lists them within its next
+      // discovery round.
+      if (now >= until && !(writer_seen && now < *writer_seen + std::chrono::milliseconds(300)))
+        break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  }
+  const auto facts = zero_copy::connection_facts(source, input.type(), offered);
+  // Logs why, for a serialized path.
+  if (zero_copy::choose_cue_path(facts).path == zero_copy::CuePath::kZeroCopy) return true;
+  if (facts.type_is_plain && !facts.producer_on_this_host) {
+    std::lock_guard lock(queue_mutex_);
+    awaiting_offer_[&input] = {.source = source};  // a producer started later may offer it
+  }
+  return false;
+}
+#endif
+
 std::optional<std::string> Module::Dds::feed_zero_copy(InputPort& input, const std::string& source,
                                                        bool producer_seen) {
 #if OSCAR_ZERO_COPY
@@ -381,25 +409,12 @@ std::optional<std::string> Module::Dds::feed_zero_copy(InputPort& input, const s
   const auto topic = zero_copy::zero_copy_topic(domain_, topics::cue(source));
   std::shared_ptr<zero_copy::ChunkFeed> feed;
   try {
-    // RouDi lists a new publisher within its next discovery round.
+    // Its producer's writer was looked for already (a plain client of discovery servers may
+    // know it only from asking them): RouDi's next discovery round if it was seen.
     const auto until =
         std::chrono::steady_clock::now() +
         (producer_seen ? std::chrono::milliseconds(300) : std::chrono::milliseconds(0));
-    bool offered = false;
-    while (input.type().memory.plain &&
-           !(offered = zero_copy::offered_on_this_host(topic, input.type().name)) &&
-           std::chrono::steady_clock::now() < until) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    const auto facts = zero_copy::connection_facts(source, input.type(), offered);
-    // Logs why, for a serialized path.
-    if (zero_copy::choose_cue_path(facts).path != zero_copy::CuePath::kZeroCopy) {
-      if (facts.type_is_plain && !facts.producer_on_this_host) {
-        std::lock_guard lock(queue_mutex_);
-        awaiting_offer_[&input] = {.source = source};  // a producer started later may offer it
-      }
-      return std::nullopt;
-    }
+    if (!chunks_offered(input, source, until)) return std::nullopt;
     feed = std::make_shared<zero_copy::ChunkFeed>(topic, input, input.type());
   } catch (const std::exception& e) {
     module_.log_->warn("input {}/{}: its cues go through DDS: {}", input.kernel(), input.name(),
@@ -429,29 +444,7 @@ std::optional<std::string> Module::Dds::pull_zero_copy(
   const auto topic = zero_copy::zero_copy_topic(domain_, topics::cue(source));
   std::shared_ptr<zero_copy::ChunkPullSource> puller;
   try {
-    // As for a push input: the producer's writer first, then RouDi lists its chunks, which it
-    // offers before its writer (within RouDi's next discovery round).
-    bool offered = false;
-    if (input.type().memory.plain) {
-      while (!participant_.discovered_writer(topics::cue(source)) &&
-             std::chrono::steady_clock::now() < until) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(2));
-      }
-      const auto listed = std::chrono::steady_clock::now() + std::chrono::milliseconds(300);
-      while (!(offered = zero_copy::offered_on_this_host(topic, input.type().name)) &&
-             std::chrono::steady_clock::now() < listed) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-      }
-    }
-    const auto facts = zero_copy::connection_facts(source, input.type(), offered);
-    // Logs why, for a serialized path.
-    if (zero_copy::choose_cue_path(facts).path != zero_copy::CuePath::kZeroCopy) {
-      if (facts.type_is_plain && !facts.producer_on_this_host) {
-        std::lock_guard lock(queue_mutex_);
-        awaiting_offer_[&input] = {.source = source};  // a producer started later may offer it
-      }
-      return std::nullopt;
-    }
+    if (!chunks_offered(input, source, until)) return std::nullopt;
     puller = std::make_shared<zero_copy::ChunkPullSource>(topic, source, input);
     // A pull before RouDi connected the mirror would find it empty.
     const auto connected = std::chrono::steady_clock::now() + std::chrono::seconds(1);

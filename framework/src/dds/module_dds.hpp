@@ -87,14 +87,19 @@ class Module::Dds {
   /// Gives a plain output its chunks in shared memory, if the module joined RouDi; true if so.
   bool offer_chunks(OutputPort& out);
   /// Feeds a push input of a plain type from its producer's chunks when this host's RouDi lists
-  /// the producer's output (waiting a moment for that if discovery shows the producer's writer:
-  /// `producer_seen`); "" then, nothing if its cues go through DDS (one line says why).
+  /// the producer's output (chunks_offered(), waiting a moment if the producer's writer was
+  /// seen: `producer_seen`); "" then, nothing if its cues go through DDS (one line says why).
   std::optional<std::string> feed_zero_copy(InputPort& input, const std::string& source,
                                             bool producer_seen);
+  /// Whether this host's RouDi lists the chunks of `source` for `input`, a plain input: waits up
+  /// to `until` for them, and up to 300 ms (RouDi's next discovery round) after the producer's
+  /// writer shows. Says why not in one line, and keeps an input whose producer may offer them
+  /// later for switch_to_offered().
+  bool chunks_offered(InputPort& input, const std::string& source,
+                      std::chrono::steady_clock::time_point until);
   /// Answers a pull or prefetch input of a plain type in this process from its producer's
-  /// chunks (zero_copy::ChunkPullSource) when this host's RouDi lists them (waiting for the
-  /// producer's writer up to `until`, as a push input does); "" then, nothing if its pulls go
-  /// to the producer over DDS (one line says why).
+  /// chunks (zero_copy::ChunkPullSource) when this host's RouDi lists them (chunks_offered(),
+  /// up to `until`); "" then, nothing if its pulls go to the producer over DDS.
   std::optional<std::string> pull_zero_copy(InputPort& input, const std::string& source,
                                             std::chrono::steady_clock::time_point until);
   /// What the module's participant learns of from the discovery servers, if it uses them:
