@@ -54,6 +54,16 @@ kernels:
   - { type: test_plain_sink, name: sink, inputs: { flag: src/flag, image: src/image } }
 )";
 
+// Its images pulled, its Bools pushed.
+const std::string kImagePuller = R"(
+name: puller
+mode: deactivated
+kernels:
+  - type: test_plain_sink
+    name: sink
+    inputs: { flag: src/flag, image: { source: src/image, transfer: pull } }
+)";
+
 std::string zero_copy_topic_of(const std::string& address) {
   return zero_copy::zero_copy_topic(test::test_domain(), "oscar/cue/" + address);
 }
@@ -116,6 +126,13 @@ std::unique_ptr<test::Process> plain_source_process() {
       "plain_src",
       {"--plugin", test::build_dir() + "/lib/oscar/test_plugins/liboscar_kernel_test_plain.so",
        "-k", "test_plain_source:src", "-m", "continuous:20ms"});
+}
+
+// Whether a process of this host offers the chunks of output `address` (the test process joins
+// RouDi to ask).
+bool offered_here(const std::string& address, const std::string& type) {
+  return zero_copy::join_roudi("zero_copy_flow_test") == std::nullopt &&
+         zero_copy::offered_on_this_host(zero_copy_topic_of(address), type);
 }
 
 // One RouDi for the test process, which joins it once and for good (iceoryx 2.0 cannot join
@@ -209,13 +226,7 @@ TEST_F(ZeroCopyWiring, ASinkReadsTheSourcesImagesInTheChunksTheSourceFilledThem)
 // order; after a kill -9 of the source, another one's images come the same way.
 TEST_F(ZeroCopyWiring, ImagesCrossProcessesInPlaceAndAgainFromARestartedSource) {
   auto src = plain_source_process();
-  ASSERT_TRUE(eventually(
-      [] {
-        return zero_copy::join_roudi("zero_copy_flow_test") == std::nullopt &&
-               zero_copy::offered_on_this_host(zero_copy_topic_of("src/image"),
-                                               "oscar::PlainGvImage");
-      },
-      30s))
+  ASSERT_TRUE(eventually([] { return offered_here("src/image", "oscar::PlainGvImage"); }, 30s))
       << src->output();
   auto sink = module(kSink);
   auto& k = dynamic_cast<test::PlainSink&>(sink->kernel("sink").kernel());
@@ -329,22 +340,9 @@ TEST(ZeroCopyLateRoudi, ModulesStartedBeforeRoudiJoinItOnceItRunsAndTheirCuesGoZ
 // at or after a time still to come, the newest n).
 TEST_F(ZeroCopyWiring, PullsAcrossProcessesAreAnsweredWithTheProducersChunksInPlace) {
   auto src = plain_source_process();
-  ASSERT_TRUE(eventually(
-      [] {
-        return zero_copy::join_roudi("zero_copy_flow_test") == std::nullopt &&
-               zero_copy::offered_on_this_host(zero_copy_topic_of("src/image"),
-                                               "oscar::PlainGvImage");
-      },
-      30s))
+  ASSERT_TRUE(eventually([] { return offered_here("src/image", "oscar::PlainGvImage"); }, 30s))
       << src->output();
-  auto sink = module(R"(
-name: plain_puller
-mode: deactivated
-kernels:
-  - type: test_plain_sink
-    name: sink
-    inputs: { flag: src/flag, image: { source: src/image, transfer: pull } }
-)");
+  auto sink = module(kImagePuller);
   auto& in = dynamic_cast<Input<PlainGvImage>&>(*sink->kernel("sink").ports().find_input("image"));
   EXPECT_EQ(in.buffer().pushed(), 0u) << "a pull input receives nothing unasked";
   const auto check = [](const Input<PlainGvImage>::Ptr& image) {
@@ -380,14 +378,7 @@ kernels:
 // A pull input wired before its producer runs asks over DDS; once the producer, started later,
 // offers its chunks, the input's pulls are answered from them in place.
 TEST_F(ZeroCopyWiring, APullInputWhoseProducerStartsLaterReadsItsChunksOnceOffered) {
-  auto sink = module(R"(
-name: early_puller
-mode: deactivated
-kernels:
-  - type: test_plain_sink
-    name: sink
-    inputs: { flag: src/flag, image: { source: src/image, transfer: pull } }
-)");
+  auto sink = module(kImagePuller);
   auto& in = dynamic_cast<Input<PlainGvImage>&>(*sink->kernel("sink").ports().find_input("image"));
   auto src = plain_source_process();
   Input<PlainGvImage>::Ptr image;
@@ -411,12 +402,7 @@ kernels:
 TEST_F(ZeroCopyWiring, APullInputWiredAfterItsProducerWentQuietFindsItsLastCues) {
   auto src = test::run_module("src", {"-k", "bench_source:src", "-p", "src.type=PlainBool", "-p",
                                       "src.count=10", "-m", "continuous:10ms"});
-  ASSERT_TRUE(eventually(
-      [&] {
-        return zero_copy::join_roudi("zero_copy_flow_test") == std::nullopt &&
-               zero_copy::offered_on_this_host(zero_copy_topic_of("src/out"), "oscar::PlainBool");
-      },
-      30s))
+  ASSERT_TRUE(eventually([] { return offered_here("src/out", "oscar::PlainBool"); }, 30s))
       << src->output();
   // Quiet: a subscriber that asks for no history gets nothing more.
   zero_copy::ChunkSubscriber quiet(zero_copy_topic_of("src/out"), "oscar::PlainBool");
