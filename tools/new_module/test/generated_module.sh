@@ -79,9 +79,16 @@ grep -q '^--- oscar/cue/fuse/out (oscar::Bool)' <<<"$out" || fail "no sample of 
 grep -q '  source: "fuse/out"' <<<"$out" || fail "no header source"
 grep -Eq '  stamps: \[[0-9]+, [0-9]+(, [0-9]+)?\]' <<<"$out" || fail "no fused stamps"
 grep -Eq '^value: (true|false)$' <<<"$out" || fail "no value"
-ps_out="$("$bin/oscar-ps" -d "$domain")" || fail "oscar ps: $ps_out"
+# The registry counts a module running once its state arrives; its cues may come first (the state
+# writer is made after the cue writers, and discovery matches it later), so ps is asked again.
+for attempt in 1 2 3 4 5 6 7 8 9 10; do
+  ps_out="$("$bin/oscar-ps" -d "$domain")" || fail "oscar ps: $ps_out"
+  grep -Eq '^fuser +localhost +[0-9]+ +1 +running' <<<"$ps_out" && break
+  sleep 1
+done
 echo "$ps_out"
-grep -Eq '^fuser +localhost +[0-9]+ +1 +running' <<<"$ps_out" || fail "fuser not running in oscar ps"
+grep -Eq '^fuser +localhost +[0-9]+ +1 +running' <<<"$ps_out" ||
+  fail "fuser not running in oscar ps after 10 tries a second apart"
 sleep 1
 kill -INT "$recorder"
 wait "$recorder" || fail "oscar record exited with $?: $(cat record.log)"
