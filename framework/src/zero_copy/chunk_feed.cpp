@@ -9,26 +9,22 @@
 namespace oscar::zero_copy {
 
 ChunkFeed::ChunkFeed(const std::string& topic, InputPort& input, const CueTypeInfo& type, bool held)
-    : sink_([&input, &type](std::shared_ptr<const void> cue) {
-        input.deliver_from(type, std::move(cue));
-      }),
-      name_("input " + input.kernel() + "/" + input.name()),
-      type_(type),
-      topic_(topic),
-      capacity_(std::clamp<std::size_t>(input.buffer().depth(), 1, 256)),
-      chunks_(topic, type.name, capacity_),
-      held_(held),
-      thread_([this](std::stop_token stop) { deliver(stop); }) {}
+    : ChunkFeed(
+          topic, type, input.buffer().depth(), 0,
+          [&input, &type](std::shared_ptr<const void> cue) {
+            input.deliver_from(type, std::move(cue));
+          },
+          "input " + input.kernel() + "/" + input.name(), held) {}
 
 ChunkFeed::ChunkFeed(const std::string& topic, const CueTypeInfo& type, std::size_t capacity,
-                     std::size_t history, Sink sink, std::string name)
+                     std::size_t history, Sink sink, std::string name, bool held)
     : sink_(std::move(sink)),
       name_(std::move(name)),
       type_(type),
       topic_(topic),
       capacity_(std::clamp<std::size_t>(capacity, 1, 256)),
       chunks_(topic, type.name, capacity_, history),
-      held_(false),
+      held_(held),
       thread_([this](std::stop_token stop) { deliver(stop); }) {}
 
 ChunkFeed::~ChunkFeed() {

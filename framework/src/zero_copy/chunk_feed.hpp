@@ -30,7 +30,7 @@ class ChunkFeed {
   /// Delivers to `sink` instead, up to `capacity` chunks waiting, first up to `history` the
   /// producer published before (ChunkSubscriber); `name` says whose feed it is in the log.
   ChunkFeed(const std::string& topic, const CueTypeInfo& type, std::size_t capacity,
-            std::size_t history, Sink sink, std::string name);
+            std::size_t history, Sink sink, std::string name, bool held = false);
   /// Delivers nothing more; returns once a delivery under way is done.
   ~ChunkFeed();
   ChunkFeed(const ChunkFeed&) = delete;
