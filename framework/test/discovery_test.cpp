@@ -195,7 +195,7 @@ TEST(DiscoveryServers, AModulesParticipantIsAPlainClientAndOnlyIt) {
 
 bool sees(const DdsParticipant& p, const std::string& name) {
   const auto all = p.discovered_participants();
-  return std::find(all.begin(), all.end(), name) != all.end();
+  return std::any_of(all.begin(), all.end(), [&](const auto& d) { return d.name == name; });
 }
 
 // A plain client is told of the participants whose endpoints share a topic with its own, and of

@@ -30,6 +30,7 @@
 #include "oscar/registry/host_check.hpp"
 #include "oscar/registry/launch_command.hpp"
 #include "oscar/registry/log_printer.hpp"
+#include "oscar/registry/registry.hpp"
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/registry/run_command.hpp"
 #include "oscar/registry/running_systems.hpp"
@@ -131,36 +132,23 @@ std::string booting_progress(const oscar::SystemState& s) {
   return fmt::format("system booting: {} of {} modules running", running, s.modules().size());
 }
 
-// How long discovery gets to show what already runs on the domain. On the development machine a
-// new participant saw the first of a running five-module system's eight participants after
-// 2-23 ms and all of them after 18-191 ms (docs/boot.md); one is enough to refuse.
-constexpr std::chrono::milliseconds kDiscoveryWindow{400};
+std::string final_line(const std::string& text) {
+  const auto end = text.find_last_not_of('\n');
+  if (end == std::string::npos) return {};
+  const auto newline = text.rfind('\n', end);
+  const auto begin = newline == std::string::npos ? 0 : newline + 1;
+  return text.substr(begin, end + 1 - begin);
+}
 
-// Refuses to boot onto a domain where processes of a system already run (a registry, monitors
-// or modules, also ones a killed boot left behind): both systems would run every module and
-// one's shutdown would stop the other.
-void check_domain_free(oscar::DdsParticipant& participant, oscar::RegistryClient& registry) {
-  std::this_thread::sleep_for(kDiscoveryWindow);
-  const auto members_seen = [&] {
-    std::set<std::string> members;
-    for (const auto& name : participant.discovered_participants()) {
-      if (oscar::is_system_member(name)) members.insert(name);
-    }
-    return members;
-  };
-  if (members_seen().empty()) return;
-  // Refused. The other registry's state names the system: it may come a while after the first
-  // participant seen (a loaded machine), and the refusal is worth the wait.
-  const auto state =
-      registry.wait_for([](const auto&) { return true; }, std::chrono::milliseconds(3000));
-  const auto members = members_seen();
-  throw std::runtime_error(fmt::format(
-      "domain {} is in use by {}: {}; stop it (oscar shutdown -d {}) or boot on another domain "
-      "(--domain N)",
-      participant.domain(),
-      state ? fmt::format("the running system '{}' ({})", state->system(), state->state())
-            : std::string("processes of another system"),
-      fmt::join(members, ", "), participant.domain()));
+// Refuses to boot onto a domain where processes of another system already run (a registry,
+// monitors or modules, also ones a killed boot left behind): both systems would run every module
+// and one's shutdown would stop the other. A loaded machine may answer later than the window:
+// the registry looks on until it starts the first module (Registry::domain_free).
+void check_domain_free(const oscar::DdsParticipant& participant) {
+  std::this_thread::sleep_for(oscar::kDiscoveryWindow);
+  if (const auto others = oscar::other_systems_on_domain(participant); !others.empty()) {
+    throw std::runtime_error(oscar::domain_in_use(participant.domain(), others));
+  }
 }
 
 // Ctrl-C (SIGINT) and SIGTERM, counted: the first stops the system in order, the second aborts.
@@ -302,11 +290,20 @@ int main(int argc, char** argv) {
     // Boot outlives its participant only by a moment: the port semaphores Fast DDS leaves when it
     // ends are removed by the next boot, with whatever else ended processes left.
     oscar::remove_files_of_dead_processes(system.domain);
+    // Every process of this boot says so in discovery (its children inherit the variable), which
+    // tells them from another system's on the same domain.
+    char host_name[256] = "";
+    gethostname(host_name, sizeof host_name - 1);
+    const auto instance = fmt::format("{}@{}:{}:{}", system.name, host_name, getpid(),
+                                      std::chrono::duration_cast<std::chrono::milliseconds>(
+                                          std::chrono::system_clock::now().time_since_epoch())
+                                          .count());
+    setenv(oscar::kSystemInstanceEnv, instance.c_str(), 1);
     oscar::DdsParticipant participant(system.domain, "oscar-boot",
                                       system.network_for(local.name, oscar::security_files::kBoot));
     std::mutex last_line_mutex;  // DDS may call back from its UDP and shared-memory threads
     std::string last_line;
-    bool booted = false;  // states before are another system's, which check_domain_free names
+    bool booted = false;  // states before are another system's
     oscar::RegistryClient registry(participant, "boot", [&](const oscar::SystemState& s) {
       auto line = s.state() == "booting"
                       ? booting_progress(s)
@@ -317,7 +314,7 @@ int main(int argc, char** argv) {
         last_line = std::move(line);
       }
     });
-    check_domain_free(participant, registry);
+    check_domain_free(participant);
     // A new boot numbers cues from 1 again; only restarts within it continue the numbering.
     std::error_code ec;
     for (const auto& e : std::filesystem::recursive_directory_iterator(log_dir, ec)) {
@@ -382,9 +379,13 @@ int main(int argc, char** argv) {
       const auto& host_file = remote ? remote_file : file;
       std::vector<std::string> monitor{oscar::sibling_program("oscar-monitor"), "--system",
                                        host_file};
-      if (remote && !keystore.empty()) {
-        // ssh passes no environment: the keystore (at the same path there) is said explicitly.
-        monitor.insert(monitor.begin(), {"env", "OSCAR_KEYSTORE=" + keystore});
+      if (remote) {
+        // ssh passes no environment: the system instance and the keystore (at the same path
+        // there) are said explicitly.
+        std::vector<std::string> env{"env",
+                                     fmt::format("{}={}", oscar::kSystemInstanceEnv, instance)};
+        if (!keystore.empty()) env.push_back("OSCAR_KEYSTORE=" + keystore);
+        monitor.insert(monitor.begin(), env.begin(), env.end());
       }
       monitor.insert(monitor.end(),
                      {"--host", h.name, "--domain", dom, "--log-dir", log_dir + "/" + h.name});
@@ -398,6 +399,7 @@ int main(int argc, char** argv) {
     bool registry_gone = false;
     bool registry_ended_orderly = false;  // exit code 0, asked by someone other than boot
     bool registry_given_up = false;       // it died too often
+    std::string domain_in_use;            // the registry found another system: what it said
     oscar::internal::RestartBudget registry_restarts;
     bool shutting_down = false;
     // A registry killed or crashed while the system runs is started again: the modules go on
@@ -438,7 +440,12 @@ int main(int argc, char** argv) {
           children.start(x.module, x.incarnation + 1, it->second);
         }
         if (x.module == "registry") {
-          if (x.exit_code != 0 && !shutting_down && restart_registry(x)) continue;
+          if (x.exit_code == oscar::kDomainInUseExit && !shutting_down) {
+            domain_in_use = final_line(x.last_output);  // "oscar-registry: domain 7 is in use..."
+            if (domain_in_use.empty()) domain_in_use = "registry " + x.describe();
+          } else if (x.exit_code != 0 && !shutting_down && restart_registry(x)) {
+            continue;
+          }
           registry_given_up = x.exit_code != 0 && !shutting_down;
           registry_gone = true;
           registry_ended_orderly = x.exit_code == 0;
@@ -451,6 +458,14 @@ int main(int argc, char** argv) {
     const bool running =
         wait_until([&] { return state_is("running") || state_is("stopped") || registry_exited(); },
                    seconds(timeout_s), stop, log);
+    if (!domain_in_use.empty()) {
+      // Boot's own look found nothing; the registry's, later, did (a loaded machine). No module
+      // was started: the monitors are stopped and the other system is left alone.
+      log.note("boot", fmt::format("refused: {}", domain_in_use), oscar::LOG_ERROR);
+      children.stop_all(std::chrono::milliseconds(5000));
+      log.flush(true);
+      return 2;
+    }
     if (stop.count() > 0) {
       log.note("boot", "Ctrl-C during boot: stopping what has started", oscar::LOG_WARN);
     } else if (!running) {

@@ -10,6 +10,7 @@
 
 #include "oscar/registry/launch_command.hpp"
 #include "oscar/registry/registry.hpp"
+#include "oscar/registry/running_systems.hpp"
 #include "oscar/time.hpp"
 #include "registry_io.hpp"
 #include "registry_tracked.hpp"
@@ -28,6 +29,7 @@ constexpr int kStartingPerHost = 8;
 void Registry::launch(Tracked& m, unsigned incarnation) {
   const auto& host = m.spec->spec.host;
   const auto& mon = monitors_[host];
+  launched_any_ = true;
   m.incarnation = incarnation;
   m.launched_by = mon.pid;
   m.suspended = false;
@@ -43,8 +45,20 @@ void Registry::launch(Tracked& m, unsigned incarnation) {
 // Launches what is due: at boot every module whose monitor is up, producers before their
 // consumers, later the restarts whose backoff has passed (once the failed process is gone and
 // its host's monitor answers).
+bool Registry::domain_free(Clock::time_point now) const {
+  if (launched_any_ || recovering_) return true;
+  if (now - recovery_since_ < kDiscoveryWindow) return false;
+  if (const auto others = other_systems_on_domain(participant_); !others.empty()) {
+    throw DomainInUse(domain_in_use(system_.domain, others));
+  }
+  return true;
+}
+
 void Registry::tick() {
   const auto now = Clock::now();
+  // Boot looked for another system before it started the registry; on a loaded machine that
+  // system's processes may answer later, so the registry looks on until it starts the first.
+  if (!domain_free(now)) return;
   std::map<std::string, int> starting;  // per host
   for (const auto& m : modules_) {
     if (m->status == "starting") ++starting[m->spec->spec.host];

@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
     auto system = oscar::SystemSpec::load(file);
     if (domain >= 0) system.override_domain(domain);
     if (host.empty()) host = system.local_host().name;
+    int code = 0;
     {
       // With discovery servers, the registry learns only of the participants it shares a topic
       // with (every module, monitor and tool shares its configuration or registry topics), not
@@ -47,14 +48,19 @@ int main(int argc, char** argv) {
         sigwait(&signals, &sig);
         registry.stop();
       });
-      registry.run();
+      try {
+        registry.run();
+      } catch (const oscar::DomainInUse& e) {
+        std::fprintf(stderr, "oscar-registry: %s\n", e.what());
+        code = oscar::kDomainInUseExit;
+      }
       pthread_kill(signal_waiter.native_handle(), SIGTERM);
       signal_waiter.join();
     }
     // Its participant is gone: what it and the system's ended processes left goes too (the
     // monitors do the same; whoever exits last leaves nothing behind).
     oscar::remove_files_of_dead_processes(system.domain);
-    return 0;
+    return code;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "oscar-registry: %s\n", e.what());
     return 2;

@@ -9,11 +9,16 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
+
+#include "oscar/dds_participant.hpp"
+#include "oscar/network.hpp"
 
 namespace oscar {
 namespace {
@@ -70,6 +75,21 @@ std::optional<RunningSystem> live_record(const fs::path& path) {
   return std::nullopt;
 }
 
+// Whose a discovered member is: "the system 'busy' (boot pid 1234 on host1)" from its instance
+// (boot_main.cpp makes it "<system>@<host>:<boot pid>:<start ms>").
+std::string whose(const std::string& instance) {
+  if (instance.empty()) return "processes started by hand";
+  const auto at = instance.rfind('@');
+  const auto pid_at = instance.find(':', at);
+  const auto ms_at = instance.find(':', pid_at + 1);
+  if (at == std::string::npos || pid_at == std::string::npos || ms_at == std::string::npos) {
+    return fmt::format("the system instance '{}'", instance);
+  }
+  return fmt::format("the system '{}' (boot pid {} on {})", instance.substr(0, at),
+                     instance.substr(pid_at + 1, ms_at - pid_at - 1),
+                     instance.substr(at + 1, pid_at - at - 1));
+}
+
 }  // namespace
 
 std::string RunningSystem::describe() const {
@@ -107,6 +127,28 @@ bool is_system_member(const std::string& participant_name) {
          participant_name.starts_with("oscar:");
 }
 
+std::string other_systems_on_domain(const DdsParticipant& participant) {
+  const auto own = system_instance_from_env();
+  std::map<std::string, std::set<std::string>> others;  // by instance
+  for (const auto& p : participant.discovered_participants()) {
+    if (is_system_member(p.name) && p.system_instance != own) {
+      others[p.system_instance].insert(p.name);
+    }
+  }
+  std::vector<std::string> parts;
+  for (const auto& [instance, names] : others) {
+    parts.push_back(fmt::format("{}: {}", whose(instance), fmt::join(names, ", ")));
+  }
+  return fmt::format("{}", fmt::join(parts, "; "));
+}
+
+std::string domain_in_use(int domain, const std::string& others) {
+  return fmt::format(
+      "domain {} is in use by {}; stop it (oscar shutdown -d {}) or boot on another domain "
+      "(--domain N)",
+      domain, others, domain);
+}
+
 RunningSystemRecord::RunningSystemRecord(const RunningSystem& system)
     : path_(record_path(system.domain)) {
   std::error_code ec;
@@ -138,10 +180,8 @@ RunningSystemRecord::RunningSystemRecord(const RunningSystem& system)
       throw std::runtime_error(fmt::format("cannot write {}: {}", path_, std::strerror(errno)));
     }
     if (auto other = live_record(path_)) {
-      throw std::runtime_error(fmt::format(
-          "domain {} is in use by the running system {}; stop it (oscar shutdown -d {}) or boot "
-          "on another domain (--domain N)",
-          system.domain, other->describe(), system.domain));
+      throw std::runtime_error(
+          domain_in_use(system.domain, "the running system " + other->describe()));
     }
   }
   throw std::runtime_error(fmt::format("cannot take {}: another boot keeps writing it", path_));

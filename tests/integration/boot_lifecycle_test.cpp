@@ -97,7 +97,7 @@ TEST(Boot, RefusesADomainWhereASystemRunsAndLeavesThatSystemAlone) {
   {
     ScopedEnv elsewhere("OSCAR_SYSTEMS_DIR", test::temp_path("no_records"));
     EXPECT_EQ(boot_again("intruder2", output), 2) << output;
-    EXPECT_THAT(output, HasSubstr("is in use by the running system 'busy' (running)"));
+    EXPECT_THAT(output, HasSubstr("is in use by the system 'busy' (boot pid"));
     EXPECT_THAT(output, HasSubstr("oscar-registry"));
     EXPECT_THAT(output, HasSubstr("oscar:src"));
   }
@@ -108,6 +108,28 @@ TEST(Boot, RefusesADomainWhereASystemRunsAndLeavesThatSystemAlone) {
   EXPECT_EQ(first.shut_down(), 0) << first.boot_output();
   EXPECT_THAT(first.boot_output(), ::testing::Not(HasSubstr(" error ")))
       << "Ctrl-C's orderly shutdown is no error";
+}
+
+// Boot looks for another system for a moment before it starts its registry; on a loaded machine
+// that system may answer later. The registry looks on until it would start its first module:
+// this one has no monitor, so it looks until it finds the running system.
+TEST(Boot, ARegistryLooksForAnotherSystemUntilItStartsItsFirstModule) {
+  BootedSystem first("looked_for", two_sources("looked_for"));
+  const auto before = first.running();
+  const auto file = test::temp_path("late_intruder") + ".yaml";
+  std::ofstream(file) << two_sources("late_intruder");
+  test::Process registry({test::bin("oscar-registry"), "--system", file, "--domain",
+                          std::to_string(test::test_domain())},
+                         test::temp_path("late_intruder_registry.log"));
+  EXPECT_EQ(registry.wait(30s), 3) << registry.output();
+  EXPECT_THAT(registry.output(),
+              HasSubstr(fmt::format("domain {} is in use by the system 'looked_for' (boot pid",
+                                    test::test_domain())));
+  EXPECT_THAT(registry.output(), HasSubstr("oscar:src"));
+  const auto after = first.running();
+  EXPECT_EQ(pids(after), pids(before)) << "the running system's modules were touched";
+  for (const auto& m : after.modules()) EXPECT_EQ(m.incarnation(), 1u) << m.name();
+  EXPECT_EQ(first.shut_down(), 0) << first.boot_output();
 }
 
 TEST(Boot, ExitsWhenTheSystemIsShutDownFromAnotherTerminal) {

@@ -69,9 +69,14 @@ class DdsParticipant {
   };
   /// Every topic with a remote writer, by name (what `oscar record` subscribes to).
   std::map<std::string, DiscoveredWriter> discovered_writers() const;
-  /// The names of the other participants on the domain that discovery sees now (a module's is
-  /// "oscar:<module>").
-  std::vector<std::string> discovered_participants() const;
+  /// Another participant on the domain, as discovery sees it.
+  struct DiscoveredParticipant {
+    std::string name;  ///< a module's is "oscar:<module>"
+    /// The booted system its process belongs to ($OSCAR_SYSTEM_INSTANCE there); "" if none.
+    std::string system_instance;
+  };
+  /// The other participants on the domain that discovery sees now.
+  std::vector<DiscoveredParticipant> discovered_participants() const;
   /// The modules hosted by the process of `writer`, as discovery shows them: all participants
   /// of one process share the first 8 bytes of their GUID prefix (host and process); a module's
   /// participant is named "oscar:<module>", and every participant made in a process that hosts a

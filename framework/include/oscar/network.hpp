@@ -102,6 +102,14 @@ std::uint32_t discovery_server_port(int domain, int index);
 /// The domain id from $OSCAR_DOMAIN, else `fallback`.
 int domain_from_env(int fallback);
 
+/// The environment variable `oscar boot` sets for every process of the system it boots: one
+/// value per boot ("<system>@<host>:<boot pid>:<start ms>"), which each DdsParticipant shows
+/// discovery (DdsParticipant::DiscoveredParticipant::system_instance).
+inline constexpr const char* kSystemInstanceEnv = "OSCAR_SYSTEM_INSTANCE";
+
+/// $OSCAR_SYSTEM_INSTANCE, "" if unset: the booted system this process belongs to.
+std::string system_instance_from_env();
+
 /// Sets Fast DDS's own log level from $OSCAR_DDS_LOG: `error` (Fast DDS's default), `warning`
 /// or `info` (the latter only in Fast DDS debug builds). Every DdsParticipant applies it.
 /// @throws std::invalid_argument for any other value.

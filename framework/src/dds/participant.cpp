@@ -48,6 +48,7 @@ bool udp_port_free(const std::string& address, std::uint32_t port) {
 }
 
 constexpr const char* kModulesProperty = "oscar.modules";
+constexpr const char* kSystemInstanceProperty = "oscar.system_instance";
 
 std::mutex hosted_mutex;
 std::vector<std::string> hosted_modules;  // modules of system files this process hosts
@@ -64,6 +65,9 @@ dds::DomainParticipantQos participant_qos(const std::string& name, const Network
   if (const auto modules = hosted(); !modules.empty()) {
     qos.properties().properties().emplace_back(
         kModulesProperty, fmt::format("{}", fmt::join(modules, ",")), true);  // propagated
+  }
+  if (auto instance = system_instance_from_env(); !instance.empty()) {
+    qos.properties().properties().emplace_back(kSystemInstanceProperty, std::move(instance), true);
   }
   if (net.security) {
     for (auto& [property, value] :
@@ -136,6 +140,11 @@ int domain_from_env(int fallback) {
   return static_cast<int>(d);
 }
 
+std::string system_instance_from_env() {
+  const char* env = std::getenv(kSystemInstanceEnv);
+  return env ? env : "";
+}
+
 void dds_log_level_from_env() {
   using eprosima::fastdds::dds::Log;
   const char* env = std::getenv("OSCAR_DDS_LOG");
@@ -163,6 +172,7 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
       p.name = info.info.m_participantName.to_string();
       if (p.name.starts_with("oscar:")) p.modules.push_back(p.name.substr(6));
       for (const auto& property : info.info.m_properties) {
+        if (property.first() == kSystemInstanceProperty) p.system_instance = property.second();
         if (property.first() != kModulesProperty) continue;
         std::istringstream names(property.second());
         for (std::string m; std::getline(names, m, ',');) p.modules.push_back(m);
@@ -172,11 +182,11 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
       participants_.erase(info.info.m_guid.guidPrefix);
     }
   }
-  std::vector<std::string> participants() const {
+  std::vector<DiscoveredParticipant> participants() const {
     std::lock_guard lock(mutex_);
-    std::vector<std::string> names;
-    for (const auto& [prefix, p] : participants_) names.push_back(p.name);
-    return names;
+    std::vector<DiscoveredParticipant> out;
+    for (const auto& [prefix, p] : participants_) out.push_back({p.name, p.system_instance});
+    return out;
   }
   std::vector<std::string> modules_in_process_of(
       const eprosima::fastrtps::rtps::GUID_t& writer) const {
@@ -256,6 +266,7 @@ class DdsParticipant::Listener final : public dds::DomainParticipantListener {
   struct Participant {
     std::string name;
     std::vector<std::string> modules;  // the modules its process hosts, as it says
+    std::string system_instance;
   };
   std::map<eprosima::fastrtps::rtps::GuidPrefix_t, Participant> participants_;
 };
@@ -374,7 +385,7 @@ void internal::note_hosted_module(const std::string& module) {
   }
 }
 
-std::vector<std::string> DdsParticipant::discovered_participants() const {
+std::vector<DdsParticipant::DiscoveredParticipant> DdsParticipant::discovered_participants() const {
   return listener_->participants();
 }
 

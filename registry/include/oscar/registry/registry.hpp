@@ -25,6 +25,13 @@
 
 namespace oscar {
 
+/// What Registry::run() throws when it finds another system's processes on its domain before it
+/// started any module; oscar-registry then exits with kDomainInUseExit, which boot reports.
+struct DomainInUse : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+inline constexpr int kDomainInUseExit = 3;
+
 class Registry {
  public:
   /// Joins the system's domain on `participant`; acquires no processes until run().
@@ -41,6 +48,8 @@ class Registry {
 
   /// Boots the system and keeps it running until a shutdown request (or stop()); then stops the
   /// modules in reverse order and tells the monitors to exit.
+  /// @throws DomainInUse if another system's processes show on the domain before the first
+  ///         module would start (see other_systems_members()).
   void run();
   /// Asks run() to shut the system down and return (thread-safe).
   void stop();
@@ -67,6 +76,9 @@ class Registry {
   /// none of this system's (boot, an operator's tool) may restart modules and shut it down.
   void on_request(const RegistryRequest& request, const std::vector<std::string>& writer);
   void tick();
+  /// Until the first module starts at boot: false while the registry's participant is younger
+  /// than kDiscoveryWindow; then true, or DomainInUse if another system shows on the domain.
+  bool domain_free(Clock::time_point now) const;
   /// Runs the queued events, each without holding `lock` (on mutex_).
   void run_events(std::unique_lock<std::mutex>& lock);
 
@@ -122,6 +134,7 @@ class Registry {
   int adopted_ = 0;                 // modules found running when recovering
   int started_in_recovery_ = 0;     // modules no monitor ran when recovering
   bool shutting_down_ = false;
+  bool launched_any_ = false;
   Clock::time_point last_publish_{};
 
   std::mutex mutex_;

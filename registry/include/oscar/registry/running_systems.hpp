@@ -7,11 +7,15 @@
 
 #include <sys/types.h>
 
+#include <chrono>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
 namespace oscar {
+
+class DdsParticipant;
 
 struct RunningSystem {
   int domain = 0;
@@ -40,6 +44,25 @@ std::optional<RunningSystem> running_system(int domain);
 /// ("oscar-registry"), a monitor ("oscar-monitor:<host>") or a module ("oscar:<module>"). Tools
 /// and boot have names of their own ("oscar-ps", "oscar-boot", ...).
 bool is_system_member(const std::string& participant_name);
+
+/// The processes of other systems that `participant` sees on its domain now, by system, for an
+/// error: "the system 'busy' (boot pid 1234 on host1): oscar-registry, oscar:src; processes
+/// started by hand: oscar:cam"; "" if none. They are the members (is_system_member) that belong
+/// to another booted system than this process ($OSCAR_SYSTEM_INSTANCE, which boot sets for every
+/// process it starts). A process started by hand belongs to none: to a booted system it is
+/// another system's, and the other way round.
+std::string other_systems_on_domain(const DdsParticipant& participant);
+
+/// "domain 7 is in use by <others>; stop it (oscar shutdown -d 7) or boot on another domain
+/// (--domain N)", with `others` from other_systems_on_domain().
+std::string domain_in_use(int domain, const std::string& others);
+
+/// How long a new participant looks for another system's processes before its system starts
+/// any. On the development machine a new participant saw the first of a running five-module
+/// system's eight participants after 2-23 ms and all of them after 18-191 ms (docs/boot.md); one
+/// is enough to refuse. Boot looks this long before it starts the registry, and the registry
+/// (its participant this old at least) once more before the first module.
+inline constexpr std::chrono::milliseconds kDiscoveryWindow{400};
 
 /// Holds the record of one booted system while it lives (boot keeps one for its run).
 class RunningSystemRecord {
