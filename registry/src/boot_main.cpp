@@ -301,14 +301,19 @@ int main(int argc, char** argv) {
     setenv(oscar::kSystemInstanceEnv, instance.c_str(), 1);
     oscar::DdsParticipant participant(system.domain, "oscar-boot",
                                       system.network_for(local.name, oscar::security_files::kBoot));
-    std::mutex last_line_mutex;  // DDS may call back from its UDP and shared-memory threads
+    std::mutex state_mutex;  // DDS may call back from its UDP and shared-memory threads
     std::string last_line;
     bool booted = false;  // states before are another system's
+    // This system's newest state: another registry on the domain (one that refuses to start
+    // anything, having found this system) publishes its own system's.
+    std::optional<oscar::SystemState> state;
     oscar::RegistryClient registry(participant, "boot", [&](const oscar::SystemState& s) {
+      if (s.system() != system.name) return;
       auto line = s.state() == "booting"
                       ? booting_progress(s)
                       : fmt::format("system {}: {}{}", s.state(), s.message(), summary(s));
-      std::lock_guard lock(last_line_mutex);
+      std::lock_guard lock(state_mutex);
+      state = s;
       if (booted && line != last_line) {
         log.note("registry", line, s.state() == "suspended" ? oscar::LOG_WARN : oscar::LOG_INFO);
         last_line = std::move(line);
@@ -338,7 +343,7 @@ int main(int argc, char** argv) {
                                    keystore));
     }
     {
-      std::lock_guard lock(last_line_mutex);
+      std::lock_guard lock(state_mutex);
       booted = true;
     }
     // Records are ordered by their host's corrected time once its monitor has measured its
@@ -392,9 +397,13 @@ int main(int argc, char** argv) {
       if (remote) monitor.push_back("--over-ssh");
       children.start("monitor-" + h.name, 1, oscar::on_host(h, monitor));
     }
-    const auto state_is = [&](const char* state) {
-      const auto s = registry.latest();
-      return s && s->state() == state;
+    const auto latest = [&] {
+      std::lock_guard lock(state_mutex);
+      return state;
+    };
+    const auto state_is = [&](const char* name) {
+      const auto s = latest();
+      return s && s->state() == name;
     };
     bool registry_gone = false;
     bool registry_ended_orderly = false;  // exit code 0, asked by someone other than boot
@@ -469,7 +478,7 @@ int main(int argc, char** argv) {
     if (stop.count() > 0) {
       log.note("boot", "Ctrl-C during boot: stopping what has started", oscar::LOG_WARN);
     } else if (!running) {
-      const auto last = registry.latest();
+      const auto last = latest();
       log.note("boot",
                fmt::format("not every module was announced within {} s: {} (their output is in "
                            "{})",
