@@ -146,9 +146,9 @@ std::string final_line(const std::string& text) {
 // the registry looks on until it starts the first module (Registry::domain_free).
 void check_domain_free(const oscar::DdsParticipant& participant) {
   std::this_thread::sleep_for(oscar::kDiscoveryWindow);
-  if (const auto others = oscar::other_systems_on_domain(participant); !others.empty()) {
-    throw std::runtime_error(oscar::domain_in_use(participant.domain(), others));
-  }
+  if (oscar::other_systems_on_domain(participant).empty()) return;
+  throw std::runtime_error(
+      oscar::domain_in_use(participant.domain(), oscar::other_systems_in_full(participant)));
 }
 
 // Ctrl-C (SIGINT) and SIGTERM, counted: the first stops the system in order, the second aborts.

@@ -48,8 +48,8 @@ void Registry::launch(Tracked& m, unsigned incarnation) {
 bool Registry::domain_free(Clock::time_point now) const {
   if (launched_any_ || recovering_) return true;
   if (now - recovery_since_ < kDiscoveryWindow) return false;
-  if (const auto others = other_systems_on_domain(participant_); !others.empty()) {
-    throw DomainInUse(domain_in_use(system_.domain, others));
+  if (!other_systems_on_domain(participant_).empty()) {
+    throw DomainInUse(domain_in_use(system_.domain, other_systems_in_full(participant_)));
   }
   return true;
 }

@@ -12,6 +12,7 @@
 #include <map>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -140,6 +141,15 @@ std::string other_systems_on_domain(const DdsParticipant& participant) {
     parts.push_back(fmt::format("{}: {}", whose(instance), fmt::join(names, ", ")));
   }
   return fmt::format("{}", fmt::join(parts, "; "));
+}
+
+std::string other_systems_in_full(const DdsParticipant& participant) {
+  auto others = other_systems_on_domain(participant);
+  for (int i = 0; i < 60 && others.find("oscar-registry") == std::string::npos; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    others = other_systems_on_domain(participant);
+  }
+  return others;
 }
 
 std::string domain_in_use(int domain, const std::string& others) {

@@ -53,6 +53,11 @@ bool is_system_member(const std::string& participant_name);
 /// another system's, and the other way round.
 std::string other_systems_on_domain(const DdsParticipant& participant);
 
+/// other_systems_on_domain() for a refusal, once it names a registry (up to 3 s): the other
+/// system's registry may show a while after its first process (a loaded machine), and the
+/// refusal is worth the wait for a list that names the system's core.
+std::string other_systems_in_full(const DdsParticipant& participant);
+
 /// "domain 7 is in use by <others>; stop it (oscar shutdown -d 7) or boot on another domain
 /// (--domain N)", with `others` from other_systems_on_domain().
 std::string domain_in_use(int domain, const std::string& others);
