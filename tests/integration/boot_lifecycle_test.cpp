@@ -100,7 +100,6 @@ TEST(Boot, RefusesADomainWhereASystemRunsAndLeavesThatSystemAlone) {
     EXPECT_THAT(output, HasSubstr("is in use by the system 'busy' (boot pid"));
     // It waits for the other system's registry to show; its modules may show later than that.
     EXPECT_THAT(output, HasSubstr("oscar-registry"));
-    EXPECT_THAT(output, ::testing::ContainsRegex("oscar:(src|sink)"));
   }
   EXPECT_TRUE(test::processes_mentioning(test::temp_path("intruder")).empty());
   const auto after = first.running();
@@ -127,7 +126,6 @@ TEST(Boot, ARegistryLooksForAnotherSystemUntilItStartsItsFirstModule) {
               HasSubstr(fmt::format("domain {} is in use by the system 'looked_for' (boot pid",
                                     test::test_domain())));
   EXPECT_THAT(registry.output(), HasSubstr("oscar-registry"));
-  EXPECT_THAT(registry.output(), ::testing::ContainsRegex("oscar:(src|sink)"));
   const auto after = first.running();
   EXPECT_EQ(pids(after), pids(before)) << "the running system's modules were touched";
   for (const auto& m : after.modules()) EXPECT_EQ(m.incarnation(), 1u) << m.name();
