@@ -49,7 +49,7 @@ class Registry {
   /// Boots the system and keeps it running until a shutdown request (or stop()); then stops the
   /// modules in reverse order and tells the monitors to exit.
   /// @throws DomainInUse if another system's processes show on the domain before the first
-  ///         module would start (see other_systems_members()).
+  ///         module would start (see other_systems_on_domain()).
   void run();
   /// Asks run() to shut the system down and return (thread-safe).
   void stop();
