@@ -33,6 +33,7 @@
 #include "oscar/registry/system_spec.hpp"
 #include "oscar/security_files.hpp"
 #include "oscar/shared_memory.hpp"
+#include "oscar/test_domain.hpp"
 #include "oscar/testing/eventually.hpp"
 
 namespace oscar::testing {
@@ -197,16 +198,21 @@ class CueCounter final : public eprosima::fastdds::dds::DataReaderListener {
 
 }  // namespace
 
-FreeDomain::FreeDomain() {
+FreeDomain::FreeDomain(int first) {
+  if (first < 1 || first > kLastDomain) {
+    throw std::invalid_argument(
+        fmt::format("oscar::testing::FreeDomain({}): a domain is 1 to {}", first, kLastDomain));
+  }
   const auto locks = domain_locks();
   std::error_code ec;
   fs::create_directories(locks, ec);
   fs::permissions(locks, fs::perms::all, ec);  // every user's tests share it
   std::set<int> booted;
   for (const auto& s : running_systems()) booted.insert(s.domain);
-  // From the top down: systems and tools use low domains (0 when told nothing, the examples 42
-  // to 44), and OSCAR's own older tests 1 to 200 by their pid.
-  for (int domain = kLastDomain; domain >= 1; --domain) {
+  // From the top down by default: systems and tools use low domains (0 when told nothing, the
+  // examples 42 to 44).
+  for (int i = 0; i < kLastDomain; ++i) {
+    const int domain = (first - 1 - i + kLastDomain) % kLastDomain + 1;  // first, down, wrapping
     if (booted.count(domain)) continue;
     const auto path = fmt::format("{}/domain-{}.lock", locks, domain);
     const int fd = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
@@ -535,3 +541,12 @@ void use_programs_beside_this_one() {
 }
 
 }  // namespace oscar::testing
+
+namespace oscar {
+
+int process_test_domain(int first) {
+  static const testing::FreeDomain domain(first);
+  return domain.domain();
+}
+
+}  // namespace oscar

@@ -191,5 +191,27 @@ TEST(FreeDomain, SkipsDomainsThatAreHeldOrBooted) {
   std::filesystem::remove_all(dir);
 }
 
+// A test that starts from a point of its own takes the first free domain from there down, and
+// wraps to 232 below 1.
+TEST(FreeDomain, StartsWhereItIsToldAndWraps) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("oscar_free_from_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir / "locks");
+  setenv("OSCAR_SYSTEMS_DIR", dir.c_str(), 1);
+  setenv("OSCAR_TEST_DOMAINS_DIR", (dir / "locks").c_str(), 1);
+  {
+    FreeDomain a(100), b(100), c(1), d(1);
+    EXPECT_EQ(a.domain(), 100);
+    EXPECT_EQ(b.domain(), 99);
+    EXPECT_EQ(c.domain(), 1);
+    EXPECT_EQ(d.domain(), 232);
+    EXPECT_THROW(FreeDomain(0), std::invalid_argument);
+    EXPECT_THROW(FreeDomain(233), std::invalid_argument);
+  }
+  unsetenv("OSCAR_SYSTEMS_DIR");
+  unsetenv("OSCAR_TEST_DOMAINS_DIR");
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace oscar::testing

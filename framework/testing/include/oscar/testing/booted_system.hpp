@@ -47,8 +47,11 @@ void use_programs_beside_this_one();
 /// and tools use low domains.
 class FreeDomain {
  public:
+  /// The highest free domain, or the first free one from `first` down (then from 232 down):
+  /// tests that start from a point of their own (e.g. of their pid) rarely get the domain the
+  /// test before them had, where a process it left behind may still be ending.
   /// @throws std::runtime_error if every domain from 1 to 232 is taken.
-  FreeDomain();
+  explicit FreeDomain(int first = 232);
   ~FreeDomain();
   FreeDomain(const FreeDomain&) = delete;
   FreeDomain& operator=(const FreeDomain&) = delete;
