@@ -15,6 +15,7 @@
 
 #include "dds/participant_identity.hpp"  // framework/src
 #include "oscar/dds_participant.hpp"
+#include "process.hpp"  // tests/common
 
 namespace oscar {
 namespace {
@@ -53,7 +54,7 @@ class Discovery : public eprosima::fastdds::dds::DomainParticipantListener {
 // A participant in a child process, killed with SIGKILL: the announcement made in its name makes
 // the others remove it as one that left (REMOVED), not drop it when its lease ends (DROPPED).
 TEST(DeadParticipants, TheDepartureOfAKilledParticipantIsAnnouncedInItsName) {
-  const int domain = 100 + getpid() % 50;
+  const int domain = oscar::test::test_domain();
   int go[2], ready[2];
   ASSERT_EQ(pipe(go), 0);
   ASSERT_EQ(pipe(ready), 0);

@@ -19,6 +19,7 @@
 #include "oscar/testing/eventually.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
+#include "process.hpp"  // tests/common
 
 namespace oscar {
 namespace {
@@ -62,7 +63,7 @@ TEST(StaticPeers, MaxParticipantsPerHostLimitsTheIdsProbed) {
 }
 
 TEST(StaticPeers, OnItsOwnAddressAnnounceOnlyToTheIdsClaimedThere) {
-  const int domain = 150 + getpid() % 50;
+  const int domain = oscar::test::test_domain();
   const internal::ParticipantIdClaim five(domain, "127.0.0.1", 5), nine(domain, "127.0.0.1", 9);
   ASSERT_TRUE(five && nine);
   NetworkConfig net;  // interfaces and peers: 127.0.0.1

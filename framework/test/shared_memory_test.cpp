@@ -18,6 +18,7 @@
 
 #include "dds/participant_identity.hpp"  // framework/src
 #include "oscar/dds_participant.hpp"
+#include "process.hpp"  // tests/common
 
 namespace oscar {
 namespace {
@@ -344,7 +345,7 @@ TEST_F(PortSegment, OnlyPortSegmentsAreLookedAt) {
 }
 
 TEST(ParticipantIdentity, AnIdIsClaimedOnceUntilReleased) {
-  const int domain = 150 + getpid() % 50;
+  const int domain = oscar::test::test_domain();
   const auto file = fs::path("/dev/shm") / fmt::format("oscar_participant_d{}_127.0.0.1_3", domain);
   {
     internal::ParticipantIdClaim first(domain, "127.0.0.1", 3);
@@ -360,7 +361,7 @@ TEST(ParticipantIdentity, AnIdIsClaimedOnceUntilReleased) {
 
 // What a killed holder leaves: a lock file nobody holds. The next claim takes it over.
 TEST(ParticipantIdentity, TheIdOfAKilledProcessIsFreeAgain) {
-  const int domain = 150 + getpid() % 50;
+  const int domain = oscar::test::test_domain();
   const auto file = fs::path("/dev/shm") / fmt::format("oscar_participant_d{}_127.0.0.1_4", domain);
   std::ofstream(file) << "";
   {
@@ -393,7 +394,7 @@ TEST(ParticipantIdentity, AParticipantListensOnItsOwnSharedMemoryPort) {
     return n;
   };
   const int before = ours();
-  DdsParticipant p(150 + getpid() % 50, "own-port");
+  DdsParticipant p(oscar::test::test_domain(), "own-port");
   EXPECT_EQ(ours(), before + 1);
 }
 

@@ -16,6 +16,7 @@
 
 #include "oscar/testing/eventually.hpp"
 #include "oscar/topic_io.hpp"
+#include "process.hpp"  // tests/common
 
 namespace oscar {
 namespace {
@@ -30,7 +31,7 @@ void expect_both_sides_match(DdsParticipant& p, const TopicSpec<T, PubSubType>& 
 }
 
 TEST(Topics, TheWriterAndReaderOfEveryCatalogueTopicMatch) {
-  DdsParticipant p(150 + getpid() % 50, "test:topics");
+  DdsParticipant p(oscar::test::test_domain(), "test:topics");
   expect_both_sides_match(p, topics::config("m"));
   expect_both_sides_match(p, topics::config_reply("m"));
   expect_both_sides_match(p, topics::log());
@@ -93,7 +94,7 @@ TEST(Topics, EveryCatalogueTopicHasANameOfItsOwn) {
 // A module's first log lines are written before boot's reader has discovered it (its process
 // has just started): they must still reach boot's merged log.
 TEST(Topics, ALogReaderThatMatchesLateGetsTheLinesWrittenBefore) {
-  DdsParticipant p(150 + getpid() % 50, "test:topics");
+  DdsParticipant p(oscar::test::test_domain(), "test:topics");
   TopicWriter<LogRecord, LogRecordPubSubType> writer(p, topics::log());
   for (int i = 0; i < 3; ++i) {
     LogRecord r;
@@ -133,13 +134,13 @@ void expect_a_late_reader_gets_the_reply(DdsParticipant& p, const TopicSpec<T, P
 }
 
 TEST(Topics, AReplyWrittenBeforeTheRequesterMatchedReachesIt) {
-  DdsParticipant p(150 + getpid() % 50, "test:topics");
+  DdsParticipant p(oscar::test::test_domain(), "test:topics");
   expect_a_late_reader_gets_the_reply(p, topics::config_reply("m"));
   expect_a_late_reader_gets_the_reply(p, topics::registry_reply());
 }
 
 TEST(Topics, ASwarmReplyWrittenBeforeTheRequesterMatchedReachesIt) {
-  DdsParticipant p(150 + getpid() % 50, "test:topics");
+  DdsParticipant p(oscar::test::test_domain(), "test:topics");
   TopicWriter<SwarmReply, SwarmReplyPubSubType> writer(p, topics::swarm_reply());
   SwarmReply reply;
   reply.request(42);

@@ -14,6 +14,7 @@
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
 #include "test_kernels.hpp"
+#include "process.hpp"  // tests/common
 
 namespace oscar {
 namespace {
@@ -102,7 +103,7 @@ ConfigCommand configure(CommandKind kind, const std::string& kernel) {
 }
 
 TEST(Wishes, TheModuleSendsWhatItsActiveKernelsAskAndHearsWhatThePlanGrants) {
-  const int domain = 150 + getpid() % 50;
+  const int domain = oscar::test::test_domain();
   DdsParticipant p(domain, "test:coordinator");
   CoordinatorSide coordinator(p);
   Module m(ModuleSpec::from_yaml(YAML::Load(R"(

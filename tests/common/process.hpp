@@ -19,6 +19,8 @@
 #include <thread>
 #include <vector>
 
+#include "oscar/test_domain.hpp"
+
 namespace oscar::test {
 
 inline std::string build_dir() {
@@ -93,8 +95,11 @@ class Process {
   std::optional<int> status_;
 };
 
-/// A DDS domain of this test process's own (tests on one machine do not hear each other).
-inline int test_domain() { return 1 + static_cast<int>(getpid() % 200); }
+/// A DDS domain of this test process's own, held for as long as the process lives: tests run
+/// in parallel (ctest -j) never share one, and none of them takes a booted system's. It is the
+/// first free one from a point of the pid down, so consecutive tests rarely reuse a domain where
+/// a process of the one before may still be ending.
+inline int test_domain() { return process_test_domain(1 + static_cast<int>(getpid() % 200)); }
 
 /// "<temporary folder>/<name>_<pid>": a path of this test process's own.
 inline std::string temp_path(const std::string& name) {

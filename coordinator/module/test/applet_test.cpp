@@ -12,6 +12,7 @@
 #include <oscar/cue_types.hpp>
 
 #include "oscar/coordinator/applet_system.hpp"
+#include "process.hpp"  // tests/common
 
 namespace oscar::coordinator {
 namespace {
@@ -117,7 +118,7 @@ class Watcher final : public Applet {
 
 TEST(Applet, ReadsTheNewestCueOfAModulesOutput) {
   RecordingGateway gateway;
-  DdsParticipant participant(150 + getpid() % 50, "test:applet-cues");
+  DdsParticipant participant(oscar::test::test_domain(), "test:applet-cues");
   AppletSetup setup("w", {}, gateway, &participant);
   Watcher watcher(setup);
   const auto& feed = watcher.watch();

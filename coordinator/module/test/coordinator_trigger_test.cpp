@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "oscar/coordinator/coordinator.hpp"
+#include "process.hpp"  // tests/common
 
 namespace oscar::coordinator {
 namespace {
@@ -42,7 +43,7 @@ coordinator:
 
 TEST(Coordinator, AnAppletsTriggerIsRefusedNamingTheHolderUnlessItHoldsTheService) {
   const auto system = SystemSpec::parse(YAML::Load(kSystem), "s.yaml");
-  DdsParticipant participant(150 + getpid() % 50, "test:coordinator");
+  DdsParticipant participant(oscar::test::test_domain(), "test:coordinator");
   Coordinator c(system, participant, {});
   c.start();
 

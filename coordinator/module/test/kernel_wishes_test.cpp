@@ -9,6 +9,7 @@
 
 #include "oscar/coordinator/coordinator.hpp"
 #include "oscar/testing/eventually.hpp"
+#include "process.hpp"  // tests/common
 
 namespace oscar::coordinator {
 namespace {
@@ -51,7 +52,7 @@ class Wishes : public ::testing::Test {
  protected:
   Wishes()
       : system_(SystemSpec::parse(YAML::Load(kSystem), "s.yaml")),
-        participant_(150 + getpid() % 50, "test:wishes"),
+        participant_(oscar::test::test_domain(), "test:wishes"),
         coordinator_(system_, participant_, {}),
         module_(participant_, topics::sched_wishes()) {
     coordinator_.start();
