@@ -58,10 +58,12 @@ function(oscar_add_executable)
   oscar_warnings(${A_NAME})
 endfunction()
 
-# oscar_add_test(NAME <name> SOURCES ... [LIBS ...] [LABELS ...] [TIMEOUT s])
-# One GoogleTest executable per folder, each test registered with gtest_discover_tests.
+# oscar_add_test(NAME <name> SOURCES ... [LIBS ...] [LABELS ...] [TIMEOUT s] [SERIAL test...])
+# One GoogleTest executable per folder, each test registered with gtest_discover_tests. Tests run
+# in parallel (ctest -j) on domains of their own (test_domain()); the SERIAL ones run alone,
+# for what they look at is the whole machine (e.g. every system booted on it).
 function(oscar_add_test)
-  cmake_parse_arguments(A "" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(A "" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS;SERIAL" ${ARGN})
   if(NOT OSCAR_BUILD_TESTS)
     return()
   endif()
@@ -85,5 +87,12 @@ function(oscar_add_test)
        "  set_tests_properties(\${${A_NAME}_TESTS} PROPERTIES LABELS \"${A_LABELS}\"\n"
        "    ENVIRONMENT \"OSCAR_BUILD_DIR=${PROJECT_BINARY_DIR};OSCAR_BIN_DIR=${PROJECT_BINARY_DIR}/bin\")\n"
        "endif()\n")
+  foreach(test ${A_SERIAL})
+    file(APPEND "${label_file}"
+         "list(FIND ${A_NAME}_TESTS \"${test}\" serial_index)\n"
+         "if(NOT serial_index EQUAL -1)\n"
+         "  set_tests_properties(\"${test}\" PROPERTIES RUN_SERIAL TRUE)\n"
+         "endif()\n")
+  endforeach()
   set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${label_file}")
 endfunction()
