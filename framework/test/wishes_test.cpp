@@ -13,8 +13,8 @@
 #include "oscar/testing/eventually.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
-#include "test_kernels.hpp"
 #include "process.hpp"  // tests/common
+#include "test_kernels.hpp"
 
 namespace oscar {
 namespace {
