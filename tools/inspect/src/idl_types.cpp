@@ -54,6 +54,11 @@ const std::map<std::string, std::size_t>& primitive_sizes() {
   return sizes;
 }
 
+// How deep modules, sequences and structs may nest: a text that comes over the network (a
+// module's announced types) must not make the parser, the decoder or the encoder recurse without
+// bound.
+constexpr std::size_t kMaxNesting = 32;
+
 class Parser {
  public:
   Parser(std::vector<std::string> tokens, std::map<std::string, std::vector<IdlMember>>& structs,
@@ -66,6 +71,7 @@ class Parser {
       if (word == "module") {
         const auto name = next();
         expect("{");
+        const Nested nested(*this);
         definitions(scope + name + "::");
         expect("}");
         expect(";");
@@ -123,6 +129,7 @@ class Parser {
     }
     if (word == "sequence") {
       expect("<");
+      const Nested nested(*this);
       auto element = std::make_shared<IdlType>(type_spec(scope));
       if (peek() == ",") {
         next();
@@ -149,6 +156,20 @@ class Parser {
       scope = colon == std::string::npos ? "" : scope.substr(0, colon + 2);
     }
   }
+  // One level deeper while it lives; more than kMaxNesting levels are refused.
+  struct Nested {
+    explicit Nested(Parser& p) : parser(p) {
+      if (++parser.depth_ > kMaxNesting) {
+        throw std::invalid_argument(
+            fmt::format("IDL: modules or sequences nest deeper than {} levels", kMaxNesting));
+      }
+    }
+    ~Nested() { --parser.depth_; }
+    Nested(const Nested&) = delete;
+    Nested& operator=(const Nested&) = delete;
+    Parser& parser;
+  };
+
   void skip_bound() {
     while (next() != ">") {
     }
@@ -169,6 +190,7 @@ class Parser {
 
   std::vector<std::string> t_;
   std::size_t at_ = 0;
+  std::size_t depth_ = 0;
   std::map<std::string, std::vector<IdlMember>>& structs_;
   std::map<std::string, std::vector<std::string>>& enums_;
 };
@@ -186,8 +208,77 @@ std::string utc_text(std::uint64_t ns) {
 
 namespace {}  // namespace
 
+namespace {
+
+bool same(const IdlType& a, const IdlType& b) {
+  if (a.kind != b.kind || a.name != b.name || a.array_size != b.array_size) return false;
+  if (!a.element || !b.element) return !a.element && !b.element;
+  return same(*a.element, *b.element);
+}
+
+bool same(const std::vector<IdlMember>& a, const std::vector<IdlMember>& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const auto& x, const auto& y) {
+    return x.name == y.name && same(x.type, y.type);
+  });
+}
+
+// How deep the struct `name` nests structs (1: none), through members, sequences and arrays.
+// @throws std::invalid_argument for a struct that contains itself or nests deeper than
+//         kMaxNesting.
+std::size_t nesting(const std::map<std::string, std::vector<IdlMember>>& structs,
+                    const std::string& name, std::vector<std::string>& chain,
+                    std::map<std::string, std::size_t>& known) {
+  if (const auto k = known.find(name); k != known.end()) return k->second;
+  chain.push_back(name);
+  if (std::find(chain.begin(), chain.end() - 1, name) != chain.end() - 1) {
+    throw std::invalid_argument(
+        fmt::format("IDL: struct '{}' contains itself ({}): recursive types are not supported",
+                    name, fmt::join(chain, " > ")));
+  }
+  const auto too_deep = [&] {
+    return std::invalid_argument(fmt::format("IDL: structs nest deeper than {} levels ({} > ...)",
+                                             kMaxNesting, chain.front()));
+  };
+  if (chain.size() > kMaxNesting) throw too_deep();
+  std::size_t depth = 1;
+  for (const auto& m : structs.at(name)) {
+    const IdlType* t = &m.type;
+    while (t->element) t = t->element.get();
+    if (t->kind == IdlType::Kind::kStruct && structs.count(t->name)) {
+      depth = std::max(depth, 1 + nesting(structs, t->name, chain, known));
+    }
+  }
+  if (chain.size() - 1 + depth > kMaxNesting) throw too_deep();
+  chain.pop_back();
+  return known[name] = depth;
+}
+
+}  // namespace
+
 void IdlTypes::add(const std::string& idl_text) {
-  Parser(tokenize(idl_text), structs_, enums_).definitions("");
+  // Parsed into copies and taken only whole: a text that fails changes nothing here.
+  auto structs = structs_;
+  auto enums = enums_;
+  Parser(tokenize(idl_text), structs, enums).definitions("");
+  for (const auto& [name, members] : structs_) {
+    if (!same(members, structs.at(name))) {
+      throw std::invalid_argument(
+          fmt::format("IDL: struct '{}' is declared here already, with other members", name));
+    }
+  }
+  for (const auto& [name, values] : enums_) {
+    if (values != enums.at(name)) {
+      throw std::invalid_argument(
+          fmt::format("IDL: enum '{}' is declared here already, with other enumerators", name));
+    }
+  }
+  std::map<std::string, std::size_t> known;
+  for (const auto& [name, members] : structs) {
+    std::vector<std::string> chain;
+    nesting(structs, name, chain, known);
+  }
+  structs_ = std::move(structs);
+  enums_ = std::move(enums);
 }
 
 bool IdlTypes::has(const std::string& name) const { return structs_.count(name) > 0; }

@@ -2,6 +2,7 @@
 
 #include <set>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -123,6 +124,36 @@ TEST(IdlTypes, ReportsTruncatedSamplesAndUnknownTypes) {
         t.add("module m { struct S { long a } ; };");
       },
       testing::ThrowsMessage<std::invalid_argument>(HasSubstr("IDL: expected ';', got '}'")));
+}
+
+// A module announces its types' IDL over the network (oscar/type_texts.hpp): a text that would
+// make decoding recurse without end, or that redeclares a type already known, is refused whole.
+TEST(IdlTypes, RefusesRecursionDeepNestingAndRedeclarationsAndKeepsWhatItHad) {
+  const auto refused = [](IdlTypes& t, const std::string& text, const std::string& why) {
+    EXPECT_THAT([&] { t.add(text); }, testing::ThrowsMessage<std::invalid_argument>(HasSubstr(why)))
+        << text;
+  };
+  IdlTypes t;
+  t.add("module acme { struct Leaf { long a; }; struct Arm { Leaf leaf; }; };");
+  refused(t, "module evil { struct A { A a; }; };",
+          "struct 'evil::A' contains itself (evil::A > evil::A)");
+  refused(t,
+          "module evil { struct B { long x; }; struct A { sequence<B> b; }; struct B { A a; }; };",
+          "recursive types are not supported");
+  std::string chain = "module deep { struct S0 { long a; };";
+  for (int i = 1; i <= 40; ++i) chain += fmt::format(" struct S{} {{ S{} s; }};", i, i - 1);
+  refused(t, chain + " };", "structs nest deeper than 32 levels");
+  std::string sequences = "module deep { struct S { ";
+  for (int i = 0; i < 40; ++i) sequences += "sequence<";
+  refused(t, sequences + "long" + std::string(40, '>') + " s; }; };",
+          "modules or sequences nest deeper than 32 levels");
+  refused(t, "module acme { struct Leaf { double a; }; };",
+          "struct 'acme::Leaf' is declared here already, with other members");
+  t.add("module acme { struct Leaf { long a; }; struct Other { Leaf l; }; };");  // the same again
+  EXPECT_TRUE(t.has("acme::Other"));
+  for (const auto* gone : {"evil::A", "evil::B", "deep::S0", "deep::S"}) EXPECT_FALSE(t.has(gone));
+  ASSERT_NE(t.members("acme::Leaf"), nullptr);
+  EXPECT_EQ(t.members("acme::Leaf")->at(0).type.name, "long") << "the refused text changed nothing";
 }
 
 // The encoder writes what the compiled type support writes: byte for byte.
