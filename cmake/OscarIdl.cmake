@@ -2,6 +2,34 @@
 # Runs fastddsgen (with type objects) on the IDL files at build time and adds the generated
 # sources to <target>. Generated code lands in ${CMAKE_CURRENT_BINARY_DIR}/generated/<SUBDIR>
 # and is included as <SUBDIR/name.h>; it is never committed and compiled without our warnings.
+# _oscar_idl_closure(<out-var> <idl file> <include dirs...>): the file and every IDL file it
+# includes (#include "..."), directly or not, resolved as the preprocessor does: beside the file,
+# then in the include dirs. What a generated file depends on, and no more: a new IDL file beside
+# the others does not regenerate theirs (and recompile everything that includes them).
+function(_oscar_idl_closure out file)
+  set(seen ${file})
+  set(todo ${file})
+  while(todo)
+    list(POP_FRONT todo current)
+    get_filename_component(dir ${current} DIRECTORY)
+    file(STRINGS ${current} lines REGEX "^[ \t]*#[ \t]*include[ \t]+\"")
+    foreach(line IN LISTS lines)
+      string(REGEX REPLACE "^[ \t]*#[ \t]*include[ \t]+\"([^\"]+)\".*" "\\1" name "${line}")
+      foreach(base IN ITEMS ${dir} ${ARGN})
+        if(EXISTS ${base}/${name})
+          get_filename_component(found ${base}/${name} ABSOLUTE)
+          if(NOT found IN_LIST seen)
+            list(APPEND seen ${found})
+            list(APPEND todo ${found})
+          endif()
+          break()
+        endif()
+      endforeach()
+    endforeach()
+  endwhile()
+  set(${out} ${seen} PARENT_SCOPE)
+endfunction()
+
 function(oscar_generate_idl target)
   cmake_parse_arguments(A "" "SUBDIR" "IDL;INCLUDE_DIRS" ${ARGN})
   if(NOT OSCAR_FASTDDSGEN)
@@ -30,6 +58,7 @@ function(oscar_generate_idl target)
     # it includes: it runs in a folder of its own per IDL, and only this IDL's files are copied
     # out (else the run for perception.idl overwrote cue_header.cxx after its sed, and two runs
     # at once wrote the same files).
+    _oscar_idl_closure(depends ${abs} ${A_INCLUDE_DIRS})
     set(own ${out}/.fastddsgen/${stem})
     set(own_files ${own}/${stem}.h ${own}/${stem}.cxx ${own}/${stem}PubSubTypes.h
                   ${own}/${stem}PubSubTypes.cxx ${own}/${stem}TypeObject.h
@@ -49,7 +78,7 @@ function(oscar_generate_idl target)
         "s/^\\([ ]*\\)register\\([A-Za-z0-9_]*\\)Types();$/\\1static const bool oscar_registered = (register\\2Types(), true); (void)oscar_registered;/"
         ${own}/${stem}.cxx
       COMMAND ${CMAKE_COMMAND} -E copy ${own_files} ${out}
-      DEPENDS ${A_IDL}
+      DEPENDS ${depends}
       COMMENT "fastddsgen ${stem}.idl"
       VERBATIM)
     list(APPEND all_sources ${generated})
@@ -58,3 +87,4 @@ function(oscar_generate_idl target)
   target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${root}>)
   set_source_files_properties(${all_sources} PROPERTIES GENERATED TRUE)
 endfunction()
+
