@@ -85,6 +85,46 @@ function(oscar_generate_idl target)
   endforeach()
   target_sources(${target} PRIVATE ${all_sources})
   target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${root}>)
-  set_source_files_properties(${all_sources} PROPERTIES GENERATED TRUE)
+  # fastddsgen's code is not ours: none of our warnings (a module's object library has them;
+  # -Wpedantic makes C++20's ambiguous reversed operators in Fast DDS's headers errors).
+  set_source_files_properties(${all_sources} PROPERTIES GENERATED TRUE
+                              COMPILE_OPTIONS "-Wno-pedantic;-w")
 endfunction()
 
+# oscar_idl_text_entries(<out-var> FILES <idl files...> [INCLUDE_DIRS <dirs...>])
+# The IDL text of each struct the files declare, made self-contained at configure time (includes
+# flattened by the C++ preprocessor, as the MCAP registry suggests for `omgidl`), as C++
+# initializer entries `{"module::Struct", R"oscaridl(text)oscaridl"},` in <out-var>. Each file
+# holds one module level ("module acme { ... }"); its structs are named in that module.
+function(oscar_idl_text_entries out)
+  cmake_parse_arguments(A "" "" "FILES;INCLUDE_DIRS" ${ARGN})
+  set(entries "")
+  foreach(file IN LISTS A_FILES)
+    get_filename_component(abs ${file} ABSOLUTE)
+    get_filename_component(dir ${abs} DIRECTORY)
+    set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${abs})
+    set(include_flags -I ${dir})
+    foreach(inc IN LISTS A_INCLUDE_DIRS)
+      list(APPEND include_flags -I ${inc})
+    endforeach()
+    execute_process(COMMAND ${CMAKE_CXX_COMPILER} -x c++ -E -P ${include_flags} ${abs}
+                    OUTPUT_VARIABLE text RESULT_VARIABLE rc ERROR_VARIABLE err)
+    if(NOT rc EQUAL 0)
+      message(FATAL_ERROR "cannot flatten ${file}: ${err}")
+    endif()
+    # The file's own module is the last one the flattened text opens: included files come first.
+    string(REGEX MATCHALL "module[ \t\n]+[A-Za-z_][A-Za-z_0-9]*" modules "${text}")
+    list(GET modules -1 module)
+    string(REGEX REPLACE "module[ \t\n]+" "" module "${module}")
+    # Only the structs of the file itself, not those of the files it includes.
+    file(READ ${abs} own)
+    string(REGEX REPLACE "//[^\n]*" "" own "${own}")
+    string(REGEX REPLACE "/\\*([^*]|\\*+[^*/])*\\*+/" "" own "${own}")
+    string(REGEX MATCHALL "struct[ \t\n]+[A-Za-z_][A-Za-z_0-9]*" structs "${own}")
+    foreach(s IN LISTS structs)
+      string(REGEX REPLACE "struct[ \t\n]+" "" name "${s}")
+      string(APPEND entries "    {\"${module}::${name}\", R\"oscaridl(${text})oscaridl\"},\n")
+    endforeach()
+  endforeach()
+  set(${out} "${entries}" PARENT_SCOPE)
+endfunction()

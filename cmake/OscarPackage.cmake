@@ -21,12 +21,15 @@ configure_file(${PROJECT_SOURCE_DIR}/cmake/OscarModule.cmake ${PROJECT_BINARY_DI
   COPYONLY)
 
 file(WRITE ${PROJECT_BINARY_DIR}/oscarBuildTree.cmake
-  "set(OSCAR_BIN_DIR \"${PROJECT_BINARY_DIR}/bin\")\n")
+  "set(OSCAR_BIN_DIR \"${PROJECT_BINARY_DIR}/bin\")\n"
+  "set(OSCAR_IDL_DIR \"${OSCAR_IDL_DIR}\")\n")
+# Where a module's own IDL finds OSCAR's (#include "oscar/cue_header.idl").
+set(OSCAR_INSTALL_IDL_DIR ${CMAKE_INSTALL_DATADIR}/oscar/idl)
 
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/oscarConfig.cmake.in
   ${PROJECT_BINARY_DIR}/oscarConfig.cmake
   INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/oscar
-  PATH_VARS CMAKE_INSTALL_BINDIR)
+  PATH_VARS CMAKE_INSTALL_BINDIR OSCAR_INSTALL_IDL_DIR)
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/oscarConfigVersion.cmake
   COMPATIBILITY SameMinorVersion)
 install(FILES

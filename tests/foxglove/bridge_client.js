@@ -156,7 +156,7 @@ async function main() {
     const state = (a.received.get(stateSub)[0] || {}).msg || {};
     const modules = (state.modules || []).map((m) => `${m.name}:${m.status}`).sort().join(" ");
     check(state.system === "viewed" && state.state === "running" &&
-          modules === "camera:running plain_camera:running robot:running sources:running",
+          modules === "arm:running camera:running plain_camera:running robot:running sources:running",
           `the last system state arrives on subscribing and decodes: ${state.system} ${state.state}, ${modules}`);
     a.client.unsubscribe(stateSub);
   }

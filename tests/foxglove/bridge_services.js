@@ -5,6 +5,7 @@
 // seen in the module's own published state (oscar/registry/module_state, decoded from its OMG
 // IDL) and in its behaviour (its robot state's rate). Called by bridge_client.js.
 "use strict";
+const { checkOwnTypes, HOLD } = require("./bridge_own_types");
 
 const ROBOT = "oscar/cue/r7/state", MODULE_STATE = "oscar/registry/module_state";
 const encode = (o) => new Uint8Array(Buffer.from(typeof o === "string" ? o : JSON.stringify(o)));
@@ -124,6 +125,7 @@ async function checkServices(a, configUrl, { check, until, sleep, Client, figure
   check(robotAfter > 1.6 * robotBefore,
         `and behaves so: r7's states ${robotBefore.toFixed(1)} Hz before, ${robotAfter.toFixed(1)} Hz after`);
   await checkCommandServices(c, { check, until, robotSub, callId: 2000, figures });
+  await checkOwnTypes(a, c, { check, until, call, callId: 3000 });
   c.close();
 }
 
@@ -131,15 +133,15 @@ const parse = (r) => { try { return JSON.parse(Buffer.from(r.response.data).toSt
 const said = (r) => (r.failure ? r.failure.message : r.response ? Buffer.from(r.response.data).toString("utf8") : JSON.stringify(r));
 
 // Kernel command ports as services: robot r7 (robot_sim) declares propose, commit, abort and
-// committed; the other kernels of the system declare none. A proposal and its commit, sent from
+// committed, the arm (a type of its own, bridge_own_types.js) hold; the other kernels declare none. A proposal and its commit, sent from
 // Foxglove's client, make r7 drive half a metre (seen in its published state); wrong arguments
 // and a commit the kernel refuses fail with the reason.
 async function checkCommandServices(c, { check, until, robotSub, callId, figures }) {
   const R7 = ["abort", "commit", "committed", "propose"].map((n) => `oscar/robot/r7/${n}`);
-  await until(() => R7.every((n) => c.services.has(n)), 10000);
+  await until(() => R7.every((n) => c.services.has(n)) && c.services.has(HOLD), 10000);
   const offered = [...c.services.keys()].filter((n) => n !== "oscar/config").sort();
-  check(JSON.stringify(offered) === JSON.stringify(R7),
-        `the command ports of r7 are services, no other kernel declares any: ${offered.join(", ")}`);
+  check(JSON.stringify(offered) === JSON.stringify([HOLD, ...R7]),
+        `the command ports of r7 and the arm are services, no other kernel declares any: ${offered.join(", ")}`);
   const propose = c.services.get(R7[3]), commit = c.services.get(R7[1]);
   if (!propose || !commit) return;
   const schema = JSON.parse(propose.request.schema);

@@ -156,7 +156,7 @@ async function checkSideChannels(a, { check, until, sleep, figures, imageComplet
   check(!graph.error, `the graph conforms to its schema ${graph.error || ""}`);
   const modules = (graph.modules || []).map((m) => `${m.name}:${m.status}`).sort().join(" ");
   check(graph.system === "viewed" && graph.state === "running" &&
-        modules === "camera:running plain_camera:running robot:running sources:running",
+        modules === "arm:running camera:running plain_camera:running robot:running sources:running",
         `the graph lists the booted modules with their states: ${graph.system} ${graph.state}, ${modules}`);
   const sig = (graph.modules || []).flatMap((m) => m.kernels).find((k) => k.name === "sig") || {};
   check(sig.type === "bench_source" && sig.mode === "continuous" && sig.cycle_ms === 20,

@@ -177,6 +177,7 @@ TEST(FoxgloveBridge, ServesABootedSystemToFoxglovesOwnClient) {
   BootedSystem system("foxglove", R"(
 system: viewed
 lease: 1s
+plugins: [ )" + test::build_dir() + R"(/lib/oscar/test_plugins/liboscar_kernel_acme_arm.so ]
 modules:
   - name: sources
     kernels: [ { type: bench_source, name: sig, params: { type: Bool } } ]
@@ -190,6 +191,9 @@ modules:
   - name: robot
     kernels: [ { type: robot_sim, name: r7, params: { start_x: 3, start_y: 4, radius: 0.3 } } ]
     mode: deactivated
+  - name: arm
+    kernels: [ { type: acme_arm, name: arm, params: { tool: welder } } ]
+    mode: { continuous: 100ms }
 )");
   system.running();
   for (const auto& [module, kernel, mode] : {std::tuple{"sources", "sig", "continuous:20ms"},

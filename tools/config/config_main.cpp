@@ -15,16 +15,17 @@
 #include <oscar/time.hpp>
 
 #include "idl_types.hpp"  // tools/inspect
-#include "oscar/idl_texts.hpp"
+#include "oscar/type_texts.hpp"
 
 namespace {
 
 // `command KERNEL NAME [YAML]`: the request is encoded from YAML as the IDL type the kernel
-// declares for NAME, which the module's published state names. Only types whose IDL OSCAR
-// embeds (idl/oscar/*.idl) can be encoded here; a program sends others with
-// ConfigClient::command().
-int send_command(oscar::ConfigClient& client, const std::string& module,
-                 const std::vector<std::string>& args, std::chrono::milliseconds timeout) {
+// declares for NAME, which the module's published state names: one of OSCAR's types
+// (idl/oscar/*.idl), or a type of the module's own whose IDL text the module announced
+// (oscar/type_texts.hpp).
+int send_command(oscar::ConfigClient& client, const oscar::AnnouncedTypes& announced,
+                 const std::string& module, const std::vector<std::string>& args,
+                 std::chrono::milliseconds timeout) {
   if (args.size() < 2 || args.size() > 3) {
     throw std::invalid_argument(fmt::format(
         "command takes KERNEL NAME [YAML] (the request as a YAML map, e.g. '{{mode: half}}'), "
@@ -56,14 +57,15 @@ int send_command(oscar::ConfigClient& client, const std::string& module,
                       : fmt::format("kernel '{}' ({}) has no command '{}'; its commands: {}",
                                     kernel, k->type(), name, known));
   }
-  oscar::inspect::IdlTypes types;
-  for (const auto& [t, text] : oscar::idl_texts()) types.add(text);
-  if (!types.has(type)) {
+  const auto text = announced.wait_for(type, timeout);
+  if (!text) {
     throw std::invalid_argument(fmt::format(
-        "command '{}' of kernel '{}' takes {}, whose IDL oscar config does not know (it encodes "
-        "the types of idl/oscar/*.idl)",
-        name, kernel, type));
+        "command '{}' of kernel '{}' takes {}, whose IDL oscar config does not know: OSCAR does "
+        "not define it and module '{}' announced no IDL text for it",
+        name, kernel, type, module));
   }
+  oscar::inspect::IdlTypes types;
+  types.add(*text);
   YAML::Node request;
   try {
     request = YAML::Load(args.size() == 3 ? args[2] : "{}");
@@ -123,7 +125,8 @@ int main(int argc, char** argv) {
     auto participant = tool.participant("oscar-config", oscar::ToolAuthority::kActAsBoot);
     oscar::ConfigClient client(*participant, as);
     if (kind == oscar::CMD_COMMAND) {
-      return send_command(client, module, args, std::chrono::milliseconds(timeout_ms));
+      const oscar::AnnouncedTypes announced(*participant);
+      return send_command(client, announced, module, args, std::chrono::milliseconds(timeout_ms));
     }
     const auto reply = client.send(module, kind, args, std::chrono::milliseconds(timeout_ms));
     if (!reply.ok()) {

@@ -851,6 +851,7 @@ void Module::Dds::start_config() {
       });
   log_writer_ =
       std::make_unique<TopicWriter<LogRecord, LogRecordPubSubType>>(participant_, topics::log());
+  announce_own_types();
   // The heartbeat: manual-by-topic liveliness with the module's lease (docs/architecture.md,
   // "Topics and QoS classes"). It stops when the process stops (SIGSTOP, crash) or a kernel call
   // outlives the watchdog.
@@ -1015,6 +1016,26 @@ void Module::Dds::stop_config() {
   if (config_thread_.joinable()) config_thread_.join();
   if (beat_thread_.joinable()) beat_thread_.join();
   config_reader_.reset();
+}
+
+// The IDL texts of the types its ports use that OSCAR does not define, for the tools
+// (oscar/type_texts.hpp); a module of OSCAR's types alone makes no writer for them.
+void Module::Dds::announce_own_types() {
+  std::vector<const KernelPorts*> kernels;
+  for (const auto& slot : module_.slots_) kernels.push_back(&slot->instance->ports());
+  const auto texts = own_type_texts(kernels);
+  if (texts.empty()) return;
+  ModuleTypes announcement;
+  announcement.module_name(module_.spec_.name);
+  for (const auto& [name, idl] : texts) {
+    TypeText t;
+    t.name(name);
+    t.idl(idl);
+    announcement.types().push_back(std::move(t));
+  }
+  types_writer_ = std::make_unique<TopicWriter<ModuleTypes, ModuleTypesPubSubType>>(
+      participant_, topics::module_types());
+  types_writer_->write(announcement);
 }
 
 void Module::Dds::publish_state(const ModuleState& state) {

@@ -28,6 +28,7 @@
 #include "oscar/module.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
+#include "oscar/type_texts.hpp"
 #include "reply_memory.hpp"
 
 namespace oscar::zero_copy {
@@ -68,6 +69,7 @@ class Module::Dds {
   void publish_state(const ModuleState& state);
 
  private:
+  void announce_own_types();
   class CueReader;
   class OutputWriter;
   /// A reader to make again, asking no more than the producer's writer offers.
@@ -162,6 +164,8 @@ class Module::Dds {
   std::unique_ptr<TopicWriter<ModuleState, ModuleStatePubSubType>> state_writer_;
   std::unique_ptr<TopicWriter<ConfigReply, ConfigReplyPubSubType>> reply_writer_;
   std::unique_ptr<TopicWriter<LogRecord, LogRecordPubSubType>> log_writer_;
+  /// Only in a module whose ports use types OSCAR does not define (announce_own_types()).
+  std::unique_ptr<TopicWriter<ModuleTypes, ModuleTypesPubSubType>> types_writer_;
   std::unique_ptr<TopicReader<ConfigCommand, ConfigCommandPubSubType>> config_reader_;
   std::mutex queue_mutex_;
   std::condition_variable queue_cv_;

@@ -30,12 +30,12 @@ ChannelDirectory::Change ChannelDirectory::update(
   }
   for (const auto& [topic, writer] : writers) {
     if (writer.alive == 0 || !topic.starts_with("oscar/") || live_.contains(topic)) continue;
-    const auto idl = idl_texts_.find(writer.type);
-    if (idl == idl_texts_.end()) {
+    auto idl = idl_text_(writer.type);
+    if (!idl) {
       if (unknown_.insert(topic).second) change.unknown.push_back(topic);
       continue;
     }
-    add({.id = 0, .topic = topic, .schema_name = writer.type, .schema = idl->second}, change);
+    add({.id = 0, .topic = topic, .schema_name = writer.type, .schema = std::move(*idl)}, change);
     if (!side_channel_) continue;
     for (auto& side : side_channel_(topic, writer.type)) {
       const auto side_topic = side.topic;

@@ -1,8 +1,9 @@
 #pragma once
 // ChannelDirectory: the bridge's channels, one per topic of the running system that a writer
-// publishes now and whose type has an IDL text; updated from what discovery shows, so a topic
-// that appears is advertised and one whose last writer went is unadvertised. A topic may have
-// side channels too (side_channels.hpp): they come and go with their source.
+// publishes now and whose type has an IDL text (OSCAR's own, or one its module announced); updated
+// from what discovery shows, so a topic that appears is advertised and one whose last writer went
+// is unadvertised. A topic may have side channels too (side_channels.hpp): they come and go with
+// their source.
 
 #include <cstdint>
 #include <functional>
@@ -23,16 +24,19 @@ class ChannelDirectory {
   using SideChannelFn =
       std::function<std::vector<ChannelInfo>(const std::string& topic, const std::string& type)>;
 
-  /// `idl_texts`: the self-contained IDL text of each type by scoped name (oscar::idl_texts());
+  /// The self-contained IDL text of a type by scoped name, or nullopt if there is none (yet).
+  using IdlTextFn = std::function<std::optional<std::string>(const std::string& type)>;
+
+  /// `idl_text`: OSCAR's own texts and those modules announce (AnnouncedTypes::idl_text);
   /// `side_channel`: none if empty.
-  explicit ChannelDirectory(const std::map<std::string, std::string>& idl_texts,
-                            SideChannelFn side_channel = {})
-      : idl_texts_(idl_texts), side_channel_(std::move(side_channel)) {}
+  explicit ChannelDirectory(IdlTextFn idl_text, SideChannelFn side_channel = {})
+      : idl_text_(std::move(idl_text)), side_channel_(std::move(side_channel)) {}
 
   struct Change {
     std::vector<ChannelInfo> added;
     std::vector<std::uint32_t> removed;
-    /// Topics seen for the first time whose type has no IDL text here (not advertised).
+    /// Topics seen for the first time whose type has no IDL text here (not advertised until a
+    /// text for it turns up: each update() looks again).
     std::vector<std::string> unknown;
   };
   /// Compares the writers discovery shows now with the channels so far. A topic that comes
@@ -51,7 +55,7 @@ class ChannelDirectory {
  private:
   void add(ChannelInfo channel, Change& change);
 
-  const std::map<std::string, std::string>& idl_texts_;
+  IdlTextFn idl_text_;
   SideChannelFn side_channel_;
   std::map<std::string, ChannelInfo> live_;   // by topic
   std::map<std::string, ChannelInfo> known_;  // every channel ever made, by topic

@@ -18,6 +18,7 @@
 #include "jpeg_encoder.hpp"
 #include "oscar/idl_texts.hpp"
 #include "oscar/topics.hpp"
+#include "oscar/type_texts.hpp"
 #include "raw_tap.hpp"
 #include "session.hpp"
 #include "side_channels.hpp"
@@ -69,7 +70,8 @@ struct FoxgloveBridge::Impl final : SessionHost {
   std::string started_ns = std::to_string(inspect::now_ns());  // the session id
   net::io_context io{1};
   tcp::acceptor acceptor{io};
-  ChannelDirectory directory{idl_texts(), side_channels_for};
+  ChannelDirectory directory{[this](const std::string& type) { return announced.idl_text(type); },
+                             side_channels_for};
   ConversionSettings conversion{.jpeg_quality = options.jpeg_quality};
   std::set<std::shared_ptr<Session>> sessions;
   void send_to_every_client(const std::string& text) const {
@@ -98,6 +100,12 @@ struct FoxgloveBridge::Impl final : SessionHost {
       [this](ConversionWorker::Result r) {
         net::post(io, [this, r = std::move(r)] { on_converted(r); });
       }};
+  Payload state_for_commands;  // the last system state, while it is read for the services
+  // The IDL texts of types OSCAR does not define, as their modules announce them. Deleted before
+  // `io`, so no Fast DDS thread posts to it once it is gone.
+  AnnouncedTypes announced{participant, [this](const std::string& type, const std::string& idl) {
+                             net::post(io, [this, type, idl] { on_type_text(type, idl); });
+                           }};
   // Last: deleted first, so no Fast DDS thread posts to `io` once it is gone.
   inspect::RawTap tap{
       participant,
@@ -162,7 +170,10 @@ struct FoxgloveBridge::Impl final : SessionHost {
   }
 
   void on_sample(const std::string& topic, const Payload& payload, std::uint64_t receive_ns) {
-    if (commands && topic == topics::system_state().name) update_commands(*payload);
+    if (commands && topic == topics::system_state().name) {
+      state_for_commands = payload;
+      update_commands(*payload);
+    }
     if (const auto raw = directory.id_of(topic); raw && wanted[*raw] > 0) {
       deliver(*raw, payload, receive_ns);
     }
@@ -251,10 +262,29 @@ struct FoxgloveBridge::Impl final : SessionHost {
     if (topic == topics::system_state().name) last_system_state.reset();
   }
 
+  // A module announced the IDL text of a type of its own: its topics are served from the next
+  // discover() on, and its command ports become services.
+  void on_type_text(const std::string& type, const std::string& idl) {
+    fmt::print(stderr, "oscar bridge: a module announced the IDL text of {}\n", type);
+    if (commands) {
+      try {
+        request_types.add(idl);
+        if (state_for_commands) update_commands(*state_for_commands);
+      } catch (const std::invalid_argument& e) {
+        fmt::print(stderr, "oscar bridge: no command services take {}: its IDL text: {}\n", type,
+                   e.what());
+      }
+    }
+    discover();
+  }
+
   void discover() {
     const auto change = directory.update(participant.discovered_writers());
     for (const auto& topic : change.unknown) {
-      fmt::print(stderr, "oscar bridge: {} is not served: its type has no IDL text here\n", topic);
+      fmt::print(stderr,
+                 "oscar bridge: {} is not served: its type has no IDL text here (it is once its "
+                 "module announces one)\n",
+                 topic);
     }
     for (const auto channel : change.removed) {
       if (wanted[channel] > 0) release(known[channel].source);
@@ -300,7 +330,8 @@ struct FoxgloveBridge::Impl final : SessionHost {
     const auto change = commands->update(running);
     for (const auto& c : change.unknown_types) {
       fmt::print(stderr,
-                 "oscar bridge: {} is not offered: its request type {} has no IDL text here\n",
+                 "oscar bridge: {} is not offered: its request type {} has no IDL text here (it "
+                 "is once its module announces one)\n",
                  c.service_name(), c.request_type);
     }
     for (const auto id : change.removed) {

@@ -16,8 +16,12 @@ DdsParticipant::DiscoveredWriter writer(const std::string& type, int alive = 1) 
   return w;
 }
 
-const std::map<std::string, std::string> kIdl{{"oscar::Bool", "bool idl"},
-                                              {"oscar::GvImage", "image idl"}};
+const std::map<std::string, std::string> kTexts{{"oscar::Bool", "bool idl"},
+                                                {"oscar::GvImage", "image idl"}};
+std::optional<std::string> kIdl(const std::string& type) {
+  const auto it = kTexts.find(type);
+  return it == kTexts.end() ? std::nullopt : std::optional(it->second);
+}
 
 TEST(ChannelDirectory, AdvertisesTopicsWithALiveWriterAndAnIdl) {
   ChannelDirectory d(kIdl);
@@ -54,6 +58,24 @@ TEST(ChannelDirectory, FollowsTopicsThatGoAndComeBack) {
   EXPECT_EQ(change.removed, std::vector<std::uint32_t>{id});
   ASSERT_EQ(change.added.size(), 1u);
   EXPECT_NE(change.added[0].id, id) << "another type: another channel";
+}
+
+TEST(ChannelDirectory, AdvertisesATopicOnceItsModuleAnnouncedTheTypesIdl) {
+  std::map<std::string, std::string> announced;
+  ChannelDirectory d([&](const std::string& type) -> std::optional<std::string> {
+    const auto it = announced.find(type);
+    return it == announced.end() ? std::nullopt : std::optional(it->second);
+  });
+  const Writers writers{{"oscar/cue/arm/state", writer("acme::ArmState")}};
+  auto change = d.update(writers);
+  EXPECT_TRUE(change.added.empty());
+  EXPECT_EQ(change.unknown, std::vector<std::string>{"oscar/cue/arm/state"});
+  announced["acme::ArmState"] = "module acme { struct ArmState { double x; }; };";
+  change = d.update(writers);
+  ASSERT_EQ(change.added.size(), 1u);
+  EXPECT_EQ(change.added[0].topic, "oscar/cue/arm/state");
+  EXPECT_EQ(change.added[0].schema, announced["acme::ArmState"]);
+  EXPECT_TRUE(change.unknown.empty());
 }
 
 // Two side channels for images only, as side_channels_for() makes them.

@@ -1,5 +1,6 @@
 // oscar echo TOPIC: every sample of a topic, readably (YAML-like), decoded from its CDR with the
-// type's IDL (the embedded OSCAR IDL texts), headers with seq, source and stamps.
+// type's IDL (the embedded OSCAR IDL texts, or the text the producing module announces for a type
+// of its own), headers with seq, source and stamps.
 #include <atomic>
 #include <condition_variable>
 #include <csignal>
@@ -13,6 +14,7 @@
 #include <oscar/command_line.hpp>
 #include "idl_types.hpp"
 #include "oscar/idl_texts.hpp"
+#include "oscar/type_texts.hpp"
 
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/registry/system_options.hpp"
@@ -48,6 +50,7 @@ int main(int argc, char** argv) {
       if (texts.insert(text).second) types.add(text);
     }
     auto participant = tool.participant("oscar-echo");
+    const oscar::AnnouncedTypes announced(*participant);
     const auto type = oscar::inspect::wait_for_writer(
         *participant, topic, std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));
     if (type.empty()) {
@@ -57,8 +60,14 @@ int main(int argc, char** argv) {
       return 1;
     }
     if (!types.has(type)) {
-      fmt::print(stderr, "oscar echo: topic '{}' has type '{}', whose IDL is unknown here\n", topic,
-                 type);
+      if (const auto text = announced.wait_for(type, std::chrono::seconds(2))) types.add(*text);
+    }
+    if (!types.has(type)) {
+      fmt::print(stderr,
+                 "oscar echo: topic '{}' has type '{}', whose IDL is unknown here: OSCAR does not "
+                 "define it and no module announced its IDL text (a module built with "
+                 "oscar_add_module(... IDL ...) does)\n",
+                 topic, type);
       return 1;
     }
     std::mutex mutex;

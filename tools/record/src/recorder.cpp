@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <map>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include <fmt/format.h>
@@ -16,11 +17,11 @@
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
 #include "oscar/dds_participant.hpp"
-#include "oscar/idl_texts.hpp"
 #include "oscar/malformed_samples.hpp"
 #include "oscar/mcap/writer.hpp"
 #include "oscar/raw_cdr_type.hpp"
 #include "oscar/topics.hpp"
+#include "oscar/type_texts.hpp"
 
 namespace oscar::record {
 namespace dds = eprosima::fastdds::dds;
@@ -28,6 +29,8 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 constexpr std::uint64_t kMaxQueuedBytes = 512ull << 20;  // beyond this, samples are dropped
+// How long the first sample of a type OSCAR does not define waits for its module's announcement.
+constexpr std::chrono::milliseconds kTypeTextWait{1000};
 
 std::uint64_t now_ns() {
   return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -81,12 +84,15 @@ struct Recorder::Impl {
   RecorderOptions o;
   std::map<std::size_t, std::uint16_t> channel_of;  // topic index -> channel id in this file
   std::map<std::string, std::uint16_t> schema_of;   // type -> schema id in this file
+  std::set<std::string> without_schema;             // types said to have no IDL text
   std::vector<std::string> files;
   std::uint64_t file_start_time = 0;
   // The file before the participant (open_file() uses the members above): an unwritable path
   // fails before anything joins the domain.
   std::unique_ptr<mcap::Writer> writer;
   DdsParticipant participant;
+  // The IDL texts of types OSCAR does not define, as their modules announce them.
+  AnnouncedTypes announced{participant};
   std::vector<Topic> topics;
   std::vector<std::unique_ptr<Listener>> listeners;
   std::mutex mutex;
@@ -168,9 +174,17 @@ struct Recorder::Impl {
     std::uint16_t schema = 0;
     if (auto s = schema_of.find(t.type); s != schema_of.end()) {
       schema = s->second;
-    } else if (auto idl = idl_texts().find(t.type); idl != idl_texts().end()) {
-      schema = writer->add_schema(t.type, "omgidl", {idl->second.begin(), idl->second.end()});
+    } else if (auto idl = without_schema.contains(t.type)
+                              ? announced.idl_text(t.type)
+                              : announced.wait_for(t.type, kTypeTextWait)) {
+      // A type of a module's own: its announcement normally came before its first cue.
+      schema = writer->add_schema(t.type, "omgidl", {idl->begin(), idl->end()});
       schema_of[t.type] = schema;
+    } else if (without_schema.insert(t.type).second) {
+      fmt::print(stderr,
+                 "{}{} ({}) is recorded without a schema: OSCAR does not define its type and no "
+                 "module announced its IDL text\n",
+                 o.progress ? "\r\033[K" : "", t.name, t.type);
     }
     std::map<std::string, std::string> meta{{"type", t.type}, {"qos", t.qos}};
     // oscar/cue/<kernel>/<channel>

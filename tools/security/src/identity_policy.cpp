@@ -7,6 +7,7 @@
 #include "oscar/registry/monitor_report_topic.hpp"
 #include "oscar/security_files.hpp"
 #include "oscar/topics.hpp"
+#include "oscar/type_texts.hpp"
 
 namespace oscar::security {
 namespace {
@@ -22,7 +23,8 @@ void add(std::vector<std::string>& list, const std::string& topic) {
 }
 
 // What every module process writes: its kernels' cues and pull replies, pull requests to the
-// outputs its inputs are wired to, its configuration replies, state, heartbeat and wishes.
+// outputs its inputs are wired to, its configuration replies, state, heartbeat and wishes, and
+// the IDL texts of its own types.
 std::vector<std::string> module_topics(const SystemModule& m) {
   std::vector<std::string> out{topics::log().name};
   for (const auto& k : m.spec.kernels) {
@@ -38,6 +40,7 @@ std::vector<std::string> module_topics(const SystemModule& m) {
   add(out, topics::module_state().name);
   add(out, topics::module_alive(std::chrono::milliseconds(1)).name);
   add(out, topics::sched_wishes().name);
+  add(out, topics::module_types().name);
   return out;
 }
 

@@ -1,0 +1,117 @@
+// A module of types OSCAR does not define (tests/own_types: acme::ArmState, acme::HoldRequest)
+// in a booted system: it announces their IDL texts, and oscar echo, oscar record and oscar
+// config decode and encode them without its code (docs/kernels.md, "Types of your own").
+#include <filesystem>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "booted_system.hpp"
+#include "oscar/dds_participant.hpp"
+#include "oscar/idl_texts.hpp"
+#include "oscar/mcap/reader.hpp"
+#include "oscar/type_texts.hpp"
+
+namespace oscar {
+namespace {
+using namespace std::chrono_literals;
+using test::BootedSystem;
+using test::Process;
+using ::testing::HasSubstr;
+
+std::string run_tool(std::vector<std::string> argv, int expected_exit = 0) {
+  const auto log = test::temp_path("own_types_" + argv.front()) + ".log";
+  argv.front() = test::bin(argv.front());
+  Process p(argv, log);
+  const auto rc = p.wait(60s);
+  EXPECT_EQ(rc, expected_exit) << p.output();
+  return p.output();
+}
+
+std::string arm_system(const std::string& tool) {
+  return R"(
+system: own_types
+lease: 1s
+plugins: [ )" +
+         test::build_dir() + "/lib/oscar/test_plugins/liboscar_kernel_acme_arm.so" + R"( ]
+modules:
+  - name: arm
+    kernels: [ { type: acme_arm, name: arm, params: { tool: )" +
+         tool + R"( } } ]
+    mode: { continuous: 50ms }
+  - name: sig_source
+    kernels: [ { type: bench_source, name: sig, params: { type: Bool } } ]
+    mode: { continuous: 50ms }
+)";
+}
+
+TEST(OwnTypes, AModuleAnnouncesTheIdlOfItsOwnTypesOnly) {
+  BootedSystem system("own_types_announced", arm_system("gripper"));
+  system.running();
+  DdsParticipant participant(test::test_domain(), "own_types_test");
+  const AnnouncedTypes announced(participant);
+  const auto state = announced.wait_for("acme::ArmState", 10s);
+  ASSERT_TRUE(state) << "the arm announced no IDL text for acme::ArmState";
+  EXPECT_THAT(*state, HasSubstr("module acme"));
+  EXPECT_THAT(*state, HasSubstr("struct ArmState"));
+  EXPECT_THAT(*state, HasSubstr("struct CueHeader")) << "self-contained: OSCAR's header included";
+  ASSERT_TRUE(announced.wait_for("acme::HoldRequest", 1s)) << "the command's request type";
+  const auto all = announced.announced();
+  EXPECT_EQ(all.size(), 2u) << "the bench source's Bool is OSCAR's own and not announced";
+  EXPECT_FALSE(all.contains("oscar::Bool"));
+  EXPECT_FALSE(idl_texts().contains("acme::ArmState"));
+  ASSERT_EQ(system.shut_down(), 0) << system.boot_output();
+}
+
+TEST(OwnTypes, EchoRecordAndConfigReadAndWriteThemWithoutTheModulesCode) {
+  BootedSystem system("own_types_tools", arm_system("welder"));
+  system.running();
+  const auto domain = std::to_string(test::test_domain());
+
+  const auto echoed = run_tool({"oscar-echo", "arm/state", "-d", domain, "-n", "2"});
+  EXPECT_THAT(echoed, HasSubstr("oscar/cue/arm/state (acme::ArmState)"));
+  EXPECT_THAT(echoed, HasSubstr("tool: \"welder\""));
+  EXPECT_THAT(echoed, HasSubstr("grip: GRIP_OPEN"));
+  EXPECT_THAT(echoed, HasSubstr("joints_rad"));
+
+  const auto accepted =
+      run_tool({"oscar-config", "arm", "command", "arm", "hold",
+                "{seconds: 2.5, grip: GRIP_CLOSED}", "-d", domain, "--as", "coordinator"});
+  EXPECT_THAT(accepted, HasSubstr("arm: arm accepted hold: holding closed for 2.5 s"));
+  const auto refused =
+      run_tool({"oscar-config", "arm", "command", "arm", "hold", "{seconds: 1, grip: GRIP_HALF}",
+                "-d", domain, "--as", "coordinator"},
+               2);
+  EXPECT_THAT(refused, HasSubstr("the request is no acme::HoldRequest"));
+  EXPECT_THAT(refused, HasSubstr("GRIP_HALF"));
+  // The arm holds closed from here on: its next states say so.
+  EXPECT_THAT(run_tool({"oscar-echo", "arm/state", "-d", domain, "-n", "1"}),
+              HasSubstr("grip: GRIP_CLOSED"));
+
+  const auto file = test::temp_path("own_types") + ".mcap";
+  std::filesystem::remove(file);
+  Process recorder({test::bin("oscar-record"), "-o", file, "--domain", domain, "--all"},
+                   test::temp_path("own_types_record") + ".log");
+  std::this_thread::sleep_for(2500ms);
+  recorder.stop();
+  ASSERT_EQ(system.shut_down(), 0) << system.boot_output();
+
+  mcap::Reader reader(file);
+  const auto info = reader.info();
+  const mcap::Channel* arm = nullptr;
+  for (const auto& [id, channel] : info.channels) {
+    if (channel.topic == "oscar/cue/arm/state") arm = &channel;
+  }
+  ASSERT_NE(arm, nullptr) << recorder.output();
+  EXPECT_GE(info.statistics.channel_message_counts.at(arm->id), 10u);
+  const auto schema = info.schemas.find(arm->schema_id);
+  ASSERT_NE(schema, info.schemas.end()) << "recorded without a schema: " << recorder.output();
+  EXPECT_EQ(schema->second.name, "acme::ArmState");
+  EXPECT_EQ(schema->second.encoding, "omgidl");
+  const std::string text(schema->second.data.begin(), schema->second.data.end());
+  EXPECT_THAT(text, HasSubstr("struct ArmState"));
+  EXPECT_THAT(text, HasSubstr("struct CueHeader"));
+}
+
+}  // namespace
+}  // namespace oscar
