@@ -12,23 +12,15 @@
 #include "oscar/cue_type_info.hpp"
 #include "oscar/cue_types.hpp"
 #include "oscar/mcap/reader.hpp"
+#include "run_tool.hpp"
 
 namespace oscar {
 namespace {
 using namespace std::chrono_literals;
 using test::BootedSystem;
 using test::Process;
+using test::run_tool;
 using ::testing::HasSubstr;
-
-// Runs a tool to its end and returns its output (stdout and stderr); fails if it hangs.
-std::string run(std::vector<std::string> argv, int expected_exit = 0) {
-  const auto log = test::temp_path("tool_" + argv.front()) + ".log";
-  argv.front() = test::bin(argv.front());
-  Process p(argv, log);
-  const auto rc = p.wait(60s);
-  EXPECT_EQ(rc, expected_exit) << p.output();
-  return p.output();
-}
 
 std::string domain() { return std::to_string(test::test_domain()); }
 
@@ -96,7 +88,7 @@ modules:
   EXPECT_TRUE(info.from_summary) << "the kernel finished the file when the system shut down";
   ASSERT_EQ(info.schemas.size(), 2u);
   // oscar info reads it like a recording of oscar record.
-  const auto printed = run({"oscar-info", file});
+  const auto printed = run_tool({"oscar-info", file});
   EXPECT_THAT(printed, HasSubstr("oscar/cue/sig/out"));
   EXPECT_THAT(printed, HasSubstr("oscar::GvImage"));
   std::filesystem::remove(file);
@@ -137,7 +129,7 @@ modules:
 BootedSystem* Inspect::system_ = nullptr;
 
 TEST_F(Inspect, TopicsListsEveryCueTopicWithItsTypeAndRate) {
-  const auto out = run({"oscar-topics", "-d", domain(), "--duration", "4", "--json"});
+  const auto out = run_tool({"oscar-topics", "-d", domain(), "--duration", "4", "--json"});
   const auto topics = nlohmann::json::parse(out.substr(out.find('[')));
   std::map<std::string, nlohmann::json> by_name;
   for (const auto& t : topics) by_name[t["topic"]] = t;
@@ -147,12 +139,12 @@ TEST_F(Inspect, TopicsListsEveryCueTopicWithItsTypeAndRate) {
   EXPECT_EQ(by_name["oscar/cue/cam/out"]["type"], "oscar::GvImage");
   EXPECT_NEAR(by_name["oscar/cue/cam/out"]["rate_hz"].get<double>(), 10, 3);
   EXPECT_EQ(by_name["oscar/cue/sig_relay/out"]["type"], "oscar::Bool");
-  const auto table = run({"oscar-topics", "-d", domain(), "--duration", "2"});
+  const auto table = run_tool({"oscar-topics", "-d", domain(), "--duration", "2"});
   EXPECT_THAT(table, ::testing::ContainsRegex("oscar/cue/cam/out +oscar::GvImage +[0-9]+\\.[0-9]"));
 }
 
 TEST_F(Inspect, EchoPrintsSamplesReadablyWithTheirHeaders) {
-  const auto out = run({"oscar-echo", "sig_relay/out", "-n", "3", "-d", domain()});
+  const auto out = run_tool({"oscar-echo", "sig_relay/out", "-n", "3", "-d", domain()});
   EXPECT_THAT(out, HasSubstr("--- oscar/cue/sig_relay/out (oscar::Bool) received "));
   EXPECT_THAT(out, HasSubstr("  source: \"sig_relay/out\"\n"));
   EXPECT_THAT(out, ::testing::ContainsRegex("  stamps: \\[[0-9]+, [0-9]+\\]  # generated 20"))
@@ -165,7 +157,8 @@ TEST_F(Inspect, EchoPrintsSamplesReadablyWithTheirHeaders) {
   ASSERT_EQ(seqs.size(), 3u) << out;
   EXPECT_EQ(seqs[1], seqs[0] + 1);
   EXPECT_EQ(seqs[2], seqs[1] + 1);
-  const auto image = run({"oscar-echo", "cam/out", "-n", "1", "--max-items", "4", "-d", domain()});
+  const auto image =
+      run_tool({"oscar-echo", "cam/out", "-n", "1", "--max-items", "4", "-d", domain()});
   EXPECT_THAT(
       image,
       ::testing::ContainsRegex(
@@ -173,14 +166,14 @@ TEST_F(Inspect, EchoPrintsSamplesReadablyWithTheirHeaders) {
 }
 
 TEST_F(Inspect, EchoOfATopicNobodyWritesIsAClearError) {
-  const auto out = run({"oscar-echo", "nobody/out", "--timeout", "1", "-d", domain()}, 1);
+  const auto out = run_tool({"oscar-echo", "nobody/out", "--timeout", "1", "-d", domain()}, 1);
   EXPECT_THAT(
       out, HasSubstr("oscar echo: no writer of topic 'oscar/cue/nobody/out' appeared on domain " +
                      domain() + " within 1 s"));
 }
 
 TEST_F(Inspect, HzMeasuresRateAndPeriodSpread) {
-  const auto out = run({"oscar-hz", "sig/out", "--duration", "3", "-d", domain()});
+  const auto out = run_tool({"oscar-hz", "sig/out", "--duration", "3", "-d", domain()});
   std::smatch m;
   ASSERT_TRUE(std::regex_search(
       out, m,
@@ -193,7 +186,7 @@ TEST_F(Inspect, HzMeasuresRateAndPeriodSpread) {
 }
 
 TEST_F(Inspect, GraphShowsModulesKernelsChannelsAndWiring) {
-  const auto dot = run({"oscar-graph", "-d", domain()});
+  const auto dot = run_tool({"oscar-graph", "-d", domain()});
   EXPECT_THAT(dot, HasSubstr("digraph \"inspected\""));
   EXPECT_THAT(dot, HasSubstr("subgraph \"cluster_sources\""));
   EXPECT_THAT(dot, ::testing::ContainsRegex("sources @localhost pid [0-9]+ \\[running\\]"));
@@ -203,7 +196,7 @@ TEST_F(Inspect, GraphShowsModulesKernelsChannelsAndWiring) {
   EXPECT_THAT(dot, HasSubstr("label=\"cam/out\\noscar::GvImage\"")) << "kernel/channel";
   EXPECT_THAT(dot, HasSubstr("sig\\n(bench_source)\\ncontinuous 20ms"));
   const auto svg = test::temp_path("graph") + ".svg";
-  EXPECT_THAT(run({"oscar-graph", "-d", domain(), "-o", svg}), HasSubstr("wrote " + svg));
+  EXPECT_THAT(run_tool({"oscar-graph", "-d", domain(), "-o", svg}), HasSubstr("wrote " + svg));
   std::ifstream in(svg);
   const std::string text((std::istreambuf_iterator<char>(in)), {});
   EXPECT_THAT(text, HasSubstr("<svg"));

@@ -11,22 +11,15 @@
 #include "oscar/idl_texts.hpp"
 #include "oscar/mcap/reader.hpp"
 #include "oscar/type_texts.hpp"
+#include "run_tool.hpp"
 
 namespace oscar {
 namespace {
 using namespace std::chrono_literals;
 using test::BootedSystem;
 using test::Process;
+using test::run_tool;
 using ::testing::HasSubstr;
-
-std::string run_tool(std::vector<std::string> argv, int expected_exit = 0) {
-  const auto log = test::temp_path("own_types_" + argv.front()) + ".log";
-  argv.front() = test::bin(argv.front());
-  Process p(argv, log);
-  const auto rc = p.wait(60s);
-  EXPECT_EQ(rc, expected_exit) << p.output();
-  return p.output();
-}
 
 std::string arm_system(const std::string& tool) {
   return R"(
