@@ -1033,9 +1033,14 @@ void Module::Dds::announce_own_types() {
     t.idl(idl);
     announcement.types().push_back(std::move(t));
   }
-  types_writer_ = std::make_unique<TopicWriter<ModuleTypes, ModuleTypesPubSubType>>(
-      participant_, topics::module_types());
-  types_writer_->write(announcement);
+  try {
+    types_writer_ = std::make_unique<TopicWriter<ModuleTypes, ModuleTypesPubSubType>>(
+        participant_, topics::module_types());
+    types_writer_->write(announcement);
+  } catch (const std::runtime_error& e) {
+    // The module works without it; only the tools cannot decode its own types then.
+    module_.log_->warn("the IDL texts of its own types are not announced: {}", e.what());
+  }
 }
 
 void Module::Dds::publish_state(const ModuleState& state) {
