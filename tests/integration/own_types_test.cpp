@@ -1,6 +1,6 @@
 // A module of types OSCAR does not define (tests/own_types: acme::ArmState, acme::HoldRequest)
-// in a booted system: it announces their IDL texts, and oscar echo, oscar record and oscar
-// config decode and encode them without its code (docs/kernels.md, "Types of your own").
+// in a booted system: it announces their IDL texts, and oscar echo, record, replay and config
+// decode and encode them without its code (docs/kernels.md, "Types of your own").
 #include <filesystem>
 
 #include <gmock/gmock.h>
@@ -56,7 +56,7 @@ TEST(OwnTypes, AModuleAnnouncesTheIdlOfItsOwnTypesOnly) {
   ASSERT_EQ(system.shut_down(), 0) << system.boot_output();
 }
 
-TEST(OwnTypes, EchoRecordAndConfigReadAndWriteThemWithoutTheModulesCode) {
+TEST(OwnTypes, EchoRecordReplayAndConfigReadAndWriteThemWithoutTheModulesCode) {
   BootedSystem system("own_types_tools", arm_system("welder"));
   system.running();
   const auto domain = std::to_string(test::test_domain());
@@ -104,6 +104,14 @@ TEST(OwnTypes, EchoRecordAndConfigReadAndWriteThemWithoutTheModulesCode) {
   const std::string text(schema->second.data.begin(), schema->second.data.end());
   EXPECT_THAT(text, HasSubstr("struct ArmState"));
   EXPECT_THAT(text, HasSubstr("struct CueHeader"));
+
+  // Replayed, the cues are decoded again: the replay announces the recorded texts.
+  Process replay({test::bin("oscar-replay"), file, "--domain", domain, "--loop"},
+                 test::temp_path("own_types_replay") + ".log");
+  const auto replayed = run_tool({"oscar-echo", "arm/state", "-d", domain, "-n", "1"});
+  EXPECT_THAT(replayed, HasSubstr("oscar/cue/arm/state (acme::ArmState)"));
+  EXPECT_THAT(replayed, HasSubstr("tool: \"welder\"")) << replay.output();
+  replay.stop();
 }
 
 }  // namespace

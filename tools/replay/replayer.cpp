@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <iostream>
+#include <set>
 #include <thread>
 
 #include <fmt/format.h>
@@ -11,11 +12,13 @@
 
 #include "lanes.hpp"
 #include "oscar/dds_participant.hpp"
+#include "oscar/idl_texts.hpp"
 #include "oscar/mcap/reader.hpp"
 #include "oscar/output.hpp"
 #include "oscar/process_util.hpp"
 #include "oscar/raw_cdr_type.hpp"
 #include "oscar/topic_io.hpp"
+#include "oscar/type_texts.hpp"
 #include "reading_priority.hpp"
 #include "recorder.hpp"  // topic_of
 
@@ -41,6 +44,8 @@ struct Replayer::Impl {
   // and a 45-byte cue waited up to 5 ms behind the fragments of four images.
   std::vector<std::unique_ptr<DdsParticipant>> lanes;
   std::map<std::uint16_t, std::pair<DdsParticipant*, dds::DataWriter*>> writers;  // by channel
+  // The recorded IDL texts of types OSCAR does not define, announced as their module did.
+  std::unique_ptr<TopicWriter<ModuleTypes, ModuleTypesPubSubType>> types_writer;
   static constexpr std::size_t kHistoryDepth = OutputOptions{}.depth;
 
   explicit Impl(ReplayOptions options)
@@ -89,6 +94,30 @@ struct Replayer::Impl {
       fmt::print(stderr, "replaying {} as {} ({})\n", info.channels.at(id).topic, tt.first,
                  tt.second);
     }
+    announce_own_types();
+  }
+
+  // A module announced the IDL texts of its own types (oscar/type_texts.hpp), and the recorder
+  // kept them as schemas: announced again, the tools decode the replayed cues as the recorded.
+  void announce_own_types() {
+    ModuleTypes announcement;
+    announcement.module_name("oscar-replay");
+    std::set<std::string> done;
+    for (const auto& [id, w] : writers) {
+      const auto s = info.schemas.find(info.channels.at(id).schema_id);
+      if (s == info.schemas.end() || s->second.encoding != "omgidl" ||
+          idl_texts().contains(s->second.name) || !done.insert(s->second.name).second) {
+        continue;
+      }
+      TypeText t;
+      t.name(s->second.name);
+      t.idl(std::string(s->second.data.begin(), s->second.data.end()));
+      announcement.types().push_back(std::move(t));
+    }
+    if (announcement.types().empty()) return;
+    types_writer = std::make_unique<TopicWriter<ModuleTypes, ModuleTypesPubSubType>>(
+        *participant, topics::module_types());
+    types_writer->write(announcement);
   }
 
   ~Impl() {
