@@ -17,15 +17,16 @@
 namespace oscar {
 namespace {
 
-using test::camera_system;
+using test::camera_system_with_longer_lease;
 using test::CoordinatedSystem;
 using test::entry;
 using ::testing::HasSubstr;
 using Strings = std::vector<std::string>;
 
-// The camera system with a second camera module that no service of the file names.
+// The camera system (module lease 1 s) with a second camera module that no service of the file
+// names.
 std::string two_camera_system() {
-  auto yaml = camera_system();
+  auto yaml = camera_system_with_longer_lease();
   const std::string modules = "modules:\n";
   yaml.replace(yaml.find(modules), modules.size(),
                modules +
