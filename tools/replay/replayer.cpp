@@ -4,7 +4,7 @@
 
 #include <cstdio>
 #include <iostream>
-#include <set>
+#include <map>
 #include <thread>
 
 #include <fmt/format.h>
@@ -45,7 +45,7 @@ struct Replayer::Impl {
   std::vector<std::unique_ptr<DdsParticipant>> lanes;
   std::map<std::uint16_t, std::pair<DdsParticipant*, dds::DataWriter*>> writers;  // by channel
   // The recorded IDL texts of types OSCAR does not define, announced as their module did.
-  std::unique_ptr<TopicWriter<ModuleTypes, ModuleTypesPubSubType>> types_writer;
+  std::unique_ptr<TypeTextsWriter> types_writer;
   static constexpr std::size_t kHistoryDepth = OutputOptions{}.depth;
 
   explicit Impl(ReplayOptions options)
@@ -100,24 +100,15 @@ struct Replayer::Impl {
   // A module announced the IDL texts of its own types (oscar/type_texts.hpp), and the recorder
   // kept them as schemas: announced again, the tools decode the replayed cues as the recorded.
   void announce_own_types() {
-    ModuleTypes announcement;
-    announcement.module_name("oscar-replay");
-    std::set<std::string> done;
+    std::map<std::string, std::string> texts;
     for (const auto& [id, w] : writers) {
       const auto s = info.schemas.find(info.channels.at(id).schema_id);
-      if (s == info.schemas.end() || s->second.encoding != "omgidl" ||
-          idl_texts().contains(s->second.name) || !done.insert(s->second.name).second) {
-        continue;
+      if (s != info.schemas.end() && s->second.encoding == "omgidl" &&
+          !idl_texts().contains(s->second.name)) {
+        texts[s->second.name] = std::string(s->second.data.begin(), s->second.data.end());
       }
-      TypeText t;
-      t.name(s->second.name);
-      t.idl(std::string(s->second.data.begin(), s->second.data.end()));
-      announcement.types().push_back(std::move(t));
     }
-    if (announcement.types().empty()) return;
-    types_writer = std::make_unique<TopicWriter<ModuleTypes, ModuleTypesPubSubType>>(
-        *participant, topics::module_types());
-    types_writer->write(announcement);
+    types_writer = announce_type_texts(*participant, "oscar-replay", texts);
   }
 
   ~Impl() {

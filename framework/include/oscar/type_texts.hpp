@@ -34,6 +34,15 @@ TopicSpec<ModuleTypes, ModuleTypesPubSubType> module_types();
 /// does not define and whose IDL text this process has registered (find_idl_text()), by name.
 std::map<std::string, std::string> own_type_texts(const std::vector<const KernelPorts*>& kernels);
 
+using TypeTextsWriter = TopicWriter<ModuleTypes, ModuleTypesPubSubType>;
+
+/// Announces `texts` (the IDL text of each type, by name) as `module`'s on oscar/types, once;
+/// nullptr, and no writer, if there are none.
+/// @throws std::runtime_error if DDS refuses the writer (e.g. the identity's permissions).
+std::unique_ptr<TypeTextsWriter> announce_type_texts(
+    DdsParticipant& participant, const std::string& module,
+    const std::map<std::string, std::string>& texts);
+
 /// The IDL texts of types OSCAR does not define, as a running system's modules announce them.
 /// Thread-safe.
 class AnnouncedTypes {

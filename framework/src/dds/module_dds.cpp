@@ -1023,20 +1023,8 @@ void Module::Dds::stop_config() {
 void Module::Dds::announce_own_types() {
   std::vector<const KernelPorts*> kernels;
   for (const auto& slot : module_.slots_) kernels.push_back(&slot->instance->ports());
-  const auto texts = own_type_texts(kernels);
-  if (texts.empty()) return;
-  ModuleTypes announcement;
-  announcement.module_name(module_.spec_.name);
-  for (const auto& [name, idl] : texts) {
-    TypeText t;
-    t.name(name);
-    t.idl(idl);
-    announcement.types().push_back(std::move(t));
-  }
   try {
-    types_writer_ = std::make_unique<TopicWriter<ModuleTypes, ModuleTypesPubSubType>>(
-        participant_, topics::module_types());
-    types_writer_->write(announcement);
+    types_writer_ = announce_type_texts(participant_, module_.spec_.name, own_type_texts(kernels));
   } catch (const std::runtime_error& e) {
     // The module works without it; only the tools cannot decode its own types then.
     module_.log_->warn("the IDL texts of its own types are not announced: {}", e.what());

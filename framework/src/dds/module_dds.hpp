@@ -165,7 +165,7 @@ class Module::Dds {
   std::unique_ptr<TopicWriter<ConfigReply, ConfigReplyPubSubType>> reply_writer_;
   std::unique_ptr<TopicWriter<LogRecord, LogRecordPubSubType>> log_writer_;
   /// Only in a module whose ports use types OSCAR does not define (announce_own_types()).
-  std::unique_ptr<TopicWriter<ModuleTypes, ModuleTypesPubSubType>> types_writer_;
+  std::unique_ptr<TypeTextsWriter> types_writer_;
   std::unique_ptr<TopicReader<ConfigCommand, ConfigCommandPubSubType>> config_reader_;
   std::mutex queue_mutex_;
   std::condition_variable queue_cv_;

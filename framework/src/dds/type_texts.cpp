@@ -28,6 +28,23 @@ std::map<std::string, std::string> own_type_texts(const std::vector<const Kernel
   return out;
 }
 
+std::unique_ptr<TypeTextsWriter> announce_type_texts(
+    DdsParticipant& participant, const std::string& module,
+    const std::map<std::string, std::string>& texts) {
+  if (texts.empty()) return nullptr;
+  ModuleTypes announcement;
+  announcement.module_name(module);
+  for (const auto& [name, idl] : texts) {
+    TypeText t;
+    t.name(name);
+    t.idl(idl);
+    announcement.types().push_back(std::move(t));
+  }
+  auto writer = std::make_unique<TypeTextsWriter>(participant, topics::module_types());
+  writer->write(announcement);
+  return writer;
+}
+
 AnnouncedTypes::AnnouncedTypes(DdsParticipant& participant, OnText on_text)
     : on_text_(std::move(on_text)),
       reader_(std::make_unique<TopicReader<ModuleTypes, ModuleTypesPubSubType>>(
