@@ -3,6 +3,7 @@
 // synthetic scene's ground truth. CobraControl, an applet in the coordinator, sequences the
 // cameras while it holds them and switches their frame mode. A logger kernel in another
 // process records the application's own cues.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -104,7 +105,12 @@ TEST(Landmarks, OneHostDetectsTheTagsOncePerCycleAndFusesThePoseOfTheGroundTruth
   std::printf("in 4 s: %zu poses, %zu tag cues of camera A\n", got_poses.size(), got_tags.size());
   EXPECT_GE(got_poses.size(), 8u);
   EXPECT_LE(got_poses.size(), 44u);
-  EXPECT_NEAR(static_cast<double>(got_tags.size()), static_cast<double>(got_poses.size()), 2.0);
+  // One pose per detection of A, give or take the cues on their way at the window's two ends.
+  // When the fusion runs late (a loaded machine, a sanitizer) two of A's detections may wait
+  // for it, and it fuses only the newer one: a few more tags than poses, never more poses, and
+  // no detection of A fused twice.
+  EXPECT_LE(got_poses.size(), got_tags.size() + 2);
+  EXPECT_GE(got_poses.size() + std::max<std::size_t>(2, got_tags.size() / 8), got_tags.size());
   for (const auto& t : got_tags) {
     ASSERT_EQ(t.detections().size(), 1u);
     const auto& d = t.detections()[0];
@@ -116,6 +122,7 @@ TEST(Landmarks, OneHostDetectsTheTagsOncePerCycleAndFusesThePoseOfTheGroundTruth
     for (int k = 0; k < 8; ++k) EXPECT_NEAR(d.corners()[k], truth->corners()[k], 1.0);
   }
   std::size_t compared = 0;
+  std::set<unsigned long long> fused_grabs;
   for (const auto& c : got_poses) {
     EXPECT_TRUE(c.valid());
     EXPECT_EQ(c.estimates(), 2u);
@@ -123,6 +130,8 @@ TEST(Landmarks, OneHostDetectsTheTagsOncePerCycleAndFusesThePoseOfTheGroundTruth
     // A's grab and detection, B's grab and detection, the fusion: five stamps, in time order.
     ASSERT_EQ(c.header().stamps().size(), 5u);
     EXPECT_TRUE(std::is_sorted(c.header().stamps().begin(), c.header().stamps().end()));
+    EXPECT_TRUE(fused_grabs.insert(c.header().stamps()[0]).second)
+        << "A's grab " << c.header().stamps()[0] << " fused twice";
     // The target moves, and B's image is taken after A's (how long after is the machine's
     // speed): the fusion averages one estimate from each camera, so the pose is compared with
     // the mean of the target's true positions at the two grabs.
