@@ -7,9 +7,14 @@
 #include <gtest/gtest.h>
 
 #include "booted_system.hpp"
+#include "oscar/cue_type_info.hpp"
+#include "oscar/cue_types.hpp"
 #include "oscar/dds_participant.hpp"
 #include "oscar/idl_texts.hpp"
 #include "oscar/mcap/reader.hpp"
+#include "oscar/raw_cdr_type.hpp"
+#include "oscar/raw_cue.hpp"
+#include "oscar/topic_io.hpp"
 #include "oscar/type_texts.hpp"
 #include "run_tool.hpp"
 
@@ -112,6 +117,47 @@ TEST(OwnTypes, EchoRecordReplayAndConfigReadAndWriteThemWithoutTheModulesCode) {
   EXPECT_THAT(replayed, HasSubstr("oscar/cue/arm/state (acme::ArmState)"));
   EXPECT_THAT(replayed, HasSubstr("tool: \"welder\"")) << replay.output();
   replay.stop();
+}
+
+// A writer no OSCAR module made (here: bytes under a type name nobody announced) has no IDL text
+// anywhere: the recorder keeps its cues without a schema and says so, once.
+TEST(OwnTypes, ATypeNobodyAnnouncedIsRecordedWithoutASchemaAndTheRecorderSaysSo) {
+  DdsParticipant participant(test::test_domain(), "stray_writer");
+  const std::string type = "acme::NobodyAnnounced";
+  auto* writer = participant.publisher().create_datawriter(
+      &participant.topic("oscar/cue/stray/out", new RawCdrType(type)), qos::stream_writer(16));
+  ASSERT_NE(writer, nullptr);
+  const auto file = test::temp_path("unannounced") + ".mcap";
+  std::filesystem::remove(file);
+  Process recorder({test::bin("oscar-record"), "-o", file, "--domain",
+                    std::to_string(test::test_domain()), "--all"},
+                   test::temp_path("unannounced_record") + ".log");
+  // Bool's bytes (a header first, as every cue) under the unknown name, every 50 ms for 2.5 s.
+  for (std::uint64_t seq = 1; seq <= 50; ++seq) {
+    Bool b;
+    b.header().stamps({static_cast<unsigned long long>(seq)});
+    b.header().source("stray/out");
+    b.header().seq(seq);
+    RawCue cue{.type = type, .cdr = cue_type_info<Bool>().serialize(&b), .cue_header = {}};
+    ASSERT_TRUE(writer->write(&cue));
+    std::this_thread::sleep_for(50ms);
+  }
+  recorder.stop();
+  participant.publisher().delete_datawriter(writer);
+
+  EXPECT_THAT(recorder.output(),
+              HasSubstr("oscar/cue/stray/out (acme::NobodyAnnounced) is recorded without a schema: "
+                        "OSCAR does not define its type and no module announced its IDL text"));
+  mcap::Reader reader(file);
+  const auto info = reader.info();
+  const mcap::Channel* stray = nullptr;
+  for (const auto& [id, channel] : info.channels) {
+    if (channel.topic == "oscar/cue/stray/out") stray = &channel;
+  }
+  ASSERT_NE(stray, nullptr) << recorder.output();
+  EXPECT_EQ(stray->schema_id, 0) << "no schema for a type nobody announced";
+  EXPECT_EQ(stray->metadata.at("type"), type);
+  EXPECT_GE(info.statistics.channel_message_counts.at(stray->id), 10u) << "its cues are kept";
 }
 
 }  // namespace
