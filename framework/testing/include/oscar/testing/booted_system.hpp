@@ -111,13 +111,13 @@ class CueWatch {
   CueWatch(DdsParticipant& participant, const std::string& channel, std::size_t capacity = 1000,
            std::shared_ptr<WatchRegistry> registry = nullptr)
       : capacity_(capacity), registry_(std::move(registry)) {
-    reader_.emplace(participant, topics::cue(channel), reader_qos(capacity),
-                    [this](const T& cue, const auto&) {
-                      std::lock_guard lock(mutex_);
-                      cues_.push_back(cue);
-                      if (cues_.size() > capacity_) cues_.pop_front();
-                      arrived_.notify_all();
-                    });
+    reader_ = std::make_unique<Reader>(participant, topics::cue(channel), reader_qos(capacity),
+                                       [this](const T& cue, const auto&) {
+                                         std::lock_guard lock(mutex_);
+                                         cues_.push_back(cue);
+                                         if (cues_.size() > capacity_) cues_.pop_front();
+                                         arrived_.notify_all();
+                                       });
     if (registry_) registry_->add(this, [this] { reader_.reset(); });
   }
   ~CueWatch() {
@@ -155,7 +155,10 @@ class CueWatch {
   std::condition_variable arrived_;
   std::deque<T> cues_;
   std::shared_ptr<WatchRegistry> registry_;
-  std::optional<TopicReader<T, typename CueTraits<T>::PubSubType>> reader_;  // uses the rest
+  // Not std::optional: GCC 12 then warns that the reader's pointer "may be used uninitialized"
+  // in the destructor of some instantiations (a false positive that -Werror makes an error).
+  using Reader = TopicReader<T, typename CueTraits<T>::PubSubType>;
+  std::unique_ptr<Reader> reader_;  // uses the rest
 };
 
 /// A system booted by `oscar boot` for a test, on a domain of its own. The destructor shuts it
