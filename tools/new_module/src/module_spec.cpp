@@ -99,6 +99,29 @@ const std::set<std::string>& keywords() {
 }
 
 const std::vector<std::string> kCueTypes{"Bool", "LineSeg3DSeq", "GvImage"};
+
+// The words OMG IDL 4 reserves (case-insensitively): a module with types of its own becomes an
+// IDL module of its name, and its types IDL structs.
+bool idl_keyword(std::string word) {
+  static const std::set<std::string> k{
+      "abstract",  "any",       "alias",      "attribute", "bitfield",    "bitmask",
+      "bitset",    "boolean",   "case",       "char",      "component",   "connector",
+      "const",     "consumes",  "context",    "custom",    "default",     "double",
+      "exception", "emits",     "enum",       "eventtype", "factory",     "false",
+      "finder",    "fixed",     "float",      "getraises", "getter",      "home",
+      "import",    "in",        "inout",      "interface", "local",       "long",
+      "manages",   "map",       "mirrorport", "module",    "multiple",    "native",
+      "object",    "octet",     "oneway",     "out",       "primarykey",  "private",
+      "port",      "porttype",  "provides",   "public",    "publishes",   "raises",
+      "readonly",  "setraises", "setter",     "sequence",  "short",       "string",
+      "struct",    "supports",  "switch",     "true",      "truncatable", "typedef",
+      "typeid",    "typename",  "typeprefix", "unsigned",  "union",       "uses",
+      "valuebase", "valuetype", "void",       "wchar",     "wstring",     "int8",
+      "uint8",     "int16",     "int32",      "int64",     "uint16",      "uint32",
+      "uint64"};
+  for (auto& c : word) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return k.contains(word);
+}
 const std::vector<std::string> kParamTypes{"bool", "int", "int64", "double", "string", "duration"};
 
 std::string join(const std::vector<std::string>& v) {
@@ -160,6 +183,27 @@ void ModuleSpec::validate(const std::set<std::string>& taken) const {
   if (outputs.empty()) {
     throw std::invalid_argument("a module needs at least one --output name:Type");
   }
+  std::set<std::string> own;
+  for (const auto& t : types) {
+    check_identifier(t, "--type");
+    if (!std::regex_match(t, std::regex("[A-Z][A-Za-z0-9]*"))) {
+      throw std::invalid_argument(
+          fmt::format("--type '{}' must be CamelCase (a capital, then letters and digits)", t));
+    }
+    if (std::find(kCueTypes.begin(), kCueTypes.end(), t) != kCueTypes.end()) {
+      throw std::invalid_argument(
+          fmt::format("--type '{}' is OSCAR's own cue type: use it without --type", t));
+    }
+    if (idl_keyword(t))
+      throw std::invalid_argument(fmt::format("--type '{}' is an IDL keyword", t));
+    if (!own.insert(t).second)
+      throw std::invalid_argument(fmt::format("--type '{}' is given twice", t));
+  }
+  if (!types.empty() && idl_keyword(name)) {
+    throw std::invalid_argument(fmt::format(
+        "module name '{}' is an IDL keyword: a module with --type is an IDL module of its name",
+        name));
+  }
   std::set<std::string> names;
   const auto unique = [&](const std::string& n, const char* what) {
     check_identifier(n, what);
@@ -170,9 +214,20 @@ void ModuleSpec::validate(const std::set<std::string>& taken) const {
     for (const auto& p : *ports) {
       const char* what = ports == &inputs ? "input" : "output";
       unique(p.name, what);
-      if (std::find(kCueTypes.begin(), kCueTypes.end(), p.type) == kCueTypes.end()) {
-        throw std::invalid_argument(fmt::format("{} '{}': unknown cue type '{}' (known: {})", what,
-                                                p.name, p.type, join(kCueTypes)));
+      if (ports == &inputs && own.contains(p.type)) {
+        throw std::invalid_argument(fmt::format(
+            "input '{}': a --type of the module's own is for its outputs (the generated system "
+            "test feeds each input from a bench_source, which publishes OSCAR's types); read "
+            "another module's type by hand (docs/kernels.md, \"Types of your own\")",
+            p.name));
+      }
+      if (std::find(kCueTypes.begin(), kCueTypes.end(), p.type) == kCueTypes.end() &&
+          !own.contains(p.type)) {
+        throw std::invalid_argument(fmt::format(
+            "{} '{}': unknown cue type '{}' (known: {}; a type of the module's own needs "
+            "--type {})",
+            what, p.name, p.type, join(kCueTypes) + (types.empty() ? "" : ", " + join(types)),
+            p.type));
       }
     }
   }
@@ -212,6 +267,14 @@ std::string ModuleSpec::class_name() const {
     up = false;
   }
   return out;
+}
+
+bool ModuleSpec::is_own_type(const std::string& type) const {
+  return std::find(types.begin(), types.end(), type) != types.end();
+}
+
+std::string ModuleSpec::cpp_cue_type(const std::string& type) const {
+  return (is_own_type(type) ? name : std::string("oscar")) + "::" + type;
 }
 
 std::filesystem::path write_module(const ModuleSpec& spec, const std::filesystem::path& dir) {

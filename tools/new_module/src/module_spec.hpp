@@ -10,7 +10,8 @@
 namespace oscar::new_module {
 
 struct Port {
-  std::string name, type;  ///< type: a standard cue type without "oscar::" (Bool, GvImage, ...)
+  /// type: a standard cue type without "oscar::" (Bool, GvImage, ...) or one of the module's own
+  std::string name, type;
 };
 
 struct Param {
@@ -21,6 +22,8 @@ struct ModuleSpec {
   std::string name;  ///< the kernel type and folder, snake_case
   std::vector<Port> inputs, outputs;
   std::vector<Param> params;
+  /// Cue types of the module's own (CamelCase), declared in <name>_types.idl in IDL module <name>.
+  std::vector<std::string> types;
   bool out_of_tree = false;
 
   /// Parses the command line's "name:Type" and "name:type=default".
@@ -36,6 +39,10 @@ struct ModuleSpec {
 
   /// "line_fuser" -> "LineFuser".
   std::string class_name() const;
+
+  /// The C++ type of a port's cue type: "oscar::Bool", or "<name>::T" for a type of its own.
+  std::string cpp_cue_type(const std::string& type) const;
+  bool is_own_type(const std::string& type) const;
 };
 
 /// The files of the module, by path relative to its folder.

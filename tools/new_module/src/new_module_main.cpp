@@ -15,7 +15,9 @@ int main(int argc, char** argv) {
   std::string dir;
   app.add_option("NAME", spec.name, "the kernel type and folder name (snake_case)")->required();
   app.add_option("--input", inputs, "an input, name:Type (Bool, LineSeg3DSeq, GvImage)");
-  app.add_option("--output", outputs, "an output, name:Type");
+  app.add_option("--output", outputs, "an output, name:Type (OSCAR's or one of --type)");
+  app.add_option("--type", spec.types,
+                 "a cue type of the module's own (CamelCase), declared in NAME_types.idl");
   app.add_option("--param", params,
                  "a parameter, name:type=default "
                  "(bool, int, int64, double, string, duration)");

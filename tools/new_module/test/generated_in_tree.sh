@@ -16,7 +16,8 @@ mkdir "$work/src"
   (cd "$source_dir" && xargs -0 cp --parents -t "$work/src")
 cd "$work/src"
 "$build_dir/bin/oscar-new-module" fuse_pair --input flag:Bool --input image:GvImage \
-  --output out:Bool --param gain:double=1.5 --param period:duration=20ms
+  --output out:Bool --output summary:FuseSummary --type FuseSummary \
+  --param gain:double=1.5 --param period:duration=20ms
 grep -q '^add_subdirectory(fuse_pair)$' modules/CMakeLists.txt || fail "not added to modules/"
 launcher="$(grep -E '^CMAKE_CXX_COMPILER_LAUNCHER:' "$build_dir/CMakeCache.txt" | cut -d= -f2 || true)"
 export CCACHE_BASEDIR="$work/src"

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# The walkthrough of docs/tutorial.md, step by step: generates a module with two inputs, an
-# output and two params with the installed oscar-new-module; builds it out of tree against an
-# install of this build (find_package(oscar)); runs its unit and system tests; boots a system that names its
-# plugin folder under plugins: and feeds it; inspects it (oscar ps, oscar echo); records every
-# cue; then boots the module alone and replays the recorded inputs into it.
+# The walkthrough of docs/tutorial.md, step by step: generates a module with two inputs, two
+# outputs (one of a type of its own) and two params with the installed oscar-new-module; builds
+# it out of tree against an install of this build (find_package(oscar)); runs its unit and system
+# tests; boots a system that names its plugin folder under plugins: and feeds it; inspects it
+# (oscar ps, oscar echo); records every cue; then boots the module alone and replays the recorded
+# inputs into it.
 set -euo pipefail
 build_dir="$1"
 work="$(mktemp -d)"
@@ -40,7 +41,8 @@ grep -q "input 'x': unknown cue type 'Image'" err.txt || fail "$(cat err.txt)"
 [ ! -e fuse_pair ] || fail "a refused module left a folder"
 
 "$bin/oscar-new-module" fuse_pair --out-of-tree --input flag:Bool --input image:GvImage \
-  --output out:Bool --param gain:double=1.5 --param period:duration=20ms
+  --output out:Bool --output summary:FuseSummary --type FuseSummary \
+  --param gain:double=1.5 --param period:duration=20ms
 cmake -S fuse_pair -B build -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" \
   -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j2 >/dev/null
@@ -79,6 +81,12 @@ grep -q '^--- oscar/cue/fuse/out (oscar::Bool)' <<<"$out" || fail "no sample of 
 grep -q '  source: "fuse/out"' <<<"$out" || fail "no header source"
 grep -Eq '  stamps: \[[0-9]+, [0-9]+(, [0-9]+)?\]' <<<"$out" || fail "no fused stamps"
 grep -Eq '^value: (true|false)$' <<<"$out" || fail "no value"
+# The module's own type, which no OSCAR program was built with: decoded from the IDL it announces.
+own="$(timeout 60 "$bin/oscar-echo" fuse/summary -n 1 -d "$domain" --timeout 40 2>echo.err)" ||
+  fail "oscar echo fuse/summary (exit $?): $own $(cat echo.err)"
+echo "$own"
+grep -q '^--- oscar/cue/fuse/summary (fuse_pair::FuseSummary)' <<<"$own" || fail "no summary"
+grep -Eq '^value: [0-9]+' <<<"$own" || fail "the summary's value was not decoded"
 # The registry counts a module running once its state arrives; its cues may come first (the state
 # writer is made after the cue writers, and discovery matches it later), so ps is asked again.
 for attempt in 1 2 3 4 5 6 7 8 9 10; do
@@ -98,9 +106,11 @@ wait "$boot" || fail "boot exited with $?: $(cat boot.log)"
 boot=""
 info="$("$bin/oscar-info" rec.mcap)" || fail "oscar info: $info"
 echo "$info"
-for topic in sig/out cam/out fuse/out; do
+for topic in sig/out cam/out fuse/out fuse/summary; do
   grep -q "oscar/cue/$topic" <<<"$info" || fail "the recording has no oscar/cue/$topic"
 done
+grep -Eq 'oscar/cue/fuse/summary +fuse_pair::FuseSummary .*omgidl' <<<"$info" ||
+  fail "the summary was recorded without the IDL its module announced"
 
 # The module alone, fed by the recording: a module file (its inputs wired to kernels that are
 # not there; the replay publishes their topics) run by oscar-run.

@@ -61,7 +61,9 @@ TEST(ModuleSpec, RejectsBadNamesClashesTypesAndDefaults) {
   expect_error(s, "input 'left': the name is used twice");
   s = valid();
   s.outputs[0].type = "Image";
-  expect_error(s, "output 'fused': unknown cue type 'Image' (known: Bool, LineSeg3DSeq, GvImage)");
+  expect_error(s,
+               "output 'fused': unknown cue type 'Image' (known: Bool, LineSeg3DSeq, GvImage; a "
+               "type of the module's own needs --type Image)");
   s = valid();
   s.params[0].type = "float";
   expect_error(
@@ -72,6 +74,62 @@ TEST(ModuleSpec, RejectsBadNamesClashesTypesAndDefaults) {
   s = valid();
   s.outputs.clear();
   expect_error(s, "a module needs at least one --output name:Type");
+}
+
+TEST(ModuleSpec, RejectsTypesOfItsOwnThatAreNoCamelCaseNamesOrOscarsOrForInputs) {
+  auto s = valid();
+  s.types = {"fusedLines"};
+  expect_error(s, "--type 'fusedLines' must be CamelCase (a capital, then letters and digits)");
+  s.types = {"Bool"};
+  expect_error(s, "--type 'Bool' is OSCAR's own cue type: use it without --type");
+  s.types = {"Struct"};
+  expect_error(s, "--type 'Struct' is an IDL keyword");
+  s.types = {"Fused", "Fused"};
+  expect_error(s, "--type 'Fused' is given twice");
+  s.types = {"Fused"};
+  s.inputs[0].type = "Fused";
+  expect_error(s, "input 'left': a --type of the module's own is for its outputs");
+  s = valid();
+  s.name = "sequence";
+  s.types = {"Fused"};
+  expect_error(s, "module name 'sequence' is an IDL keyword");
+  s = valid();
+  s.outputs[0].type = "Fused";
+  expect_error(s,
+               "unknown cue type 'Fused' (known: Bool, LineSeg3DSeq, GvImage; a type of the "
+               "module's own needs --type Fused)");
+  s.types = {"Fused"};
+  EXPECT_NO_THROW(s.validate({}));
+}
+
+TEST(ModuleSpec, GeneratesTheIdlOfItsOwnTypesAndUsesThem) {
+  auto s = valid();
+  s.outputs.push_back({"quality", "FuseQuality"});
+  s.types = {"FuseQuality"};
+  const auto files = generate(s);
+  ASSERT_EQ(files.size(), 9u);
+  const auto& idl = files.at("line_fuser_types.idl");
+  EXPECT_THAT(idl, HasSubstr("#include \"oscar/cue_header.idl\"\nmodule line_fuser {\n"
+                             "  struct FuseQuality {\n    oscar::CueHeader header;"));
+  EXPECT_THAT(files.at("line_fuser_types.hpp"),
+              HasSubstr("#include <line_fuser/line_fuser_types.h>\n"
+                        "#include <line_fuser/line_fuser_typesPubSubTypes.h>"));
+  EXPECT_THAT(files.at("line_fuser_types.hpp"),
+              HasSubstr("OSCAR_DECLARE_CUE_TYPE(line_fuser, FuseQuality)"));
+  EXPECT_THAT(files.at("CMakeLists.txt"), HasSubstr("\n  IDL line_fuser_types.idl)\n"));
+  EXPECT_THAT(files.at("CMakeLists.txt"), HasSubstr("\n  LIBS oscar_kernel_line_fuser_objects)"));
+  EXPECT_THAT(files.at("line_fuser_kernel.hpp"), HasSubstr("#include \"line_fuser_types.hpp\""));
+  EXPECT_THAT(files.at("line_fuser_kernel.hpp"),
+              HasSubstr("  oscar::Output<line_fuser::FuseQuality>& quality_;"));
+  EXPECT_THAT(files.at("line_fuser_kernel.cpp"),
+              HasSubstr("setup.output<line_fuser::FuseQuality>(\"quality\")"));
+  EXPECT_THAT(files.at("test/line_fuser_kernel_test.cpp"), HasSubstr("oscar::find_idl_text(type)"));
+  const auto& system_test = files.at("test/line_fuser_system_test.cpp");
+  EXPECT_THAT(system_test, HasSubstr("wait_for_cues({\"line_fuser/fused\"})"))
+      << "only OSCAR's types";
+  EXPECT_THAT(system_test,
+              HasSubstr("read_cues<line_fuser::FuseQuality>(\"line_fuser/quality\", 3)"));
+  EXPECT_THAT(files.at("README.md"), HasSubstr("| `quality` | out | `line_fuser::FuseQuality` |"));
 }
 
 TEST(ModuleSpec, GeneratesTheFolderOfAModule) {
