@@ -18,6 +18,7 @@
 #include "oscar/testing/eventually.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
+#include "oscar/type_texts.hpp"
 #include "source_tree.hpp"
 
 // Fast DDS 2.9's PKI-DH plugin leaks what it allocated through OpenSSL for a handshake with a
@@ -236,6 +237,26 @@ TEST_F(SecureSystem, OnlyTheRegistryMayWriteLaunchRequests) {
       EXPECT_THAT(e.what(), HasSubstr(std::string("identity '") + identity + "'"));
     }
   }
+}
+
+// The IDL texts of a module's own types (oscar/types) are for modules to announce: another
+// identity is refused with an error naming it and the topic (a module started with a keystore
+// made before OSCAR had the topic gets the same error, logs it and runs on).
+TEST_F(SecureSystem, OnlyModulesMayAnnounceTheIdlTextsOfTheirTypes) {
+  const std::map<std::string, std::string> texts{
+      {"acme::Probe", "module acme { struct Probe { double value; }; };"}};
+  for (const auto* identity : {"operator", "monitor.localhost", "registry"}) {
+    DdsParticipant p(system_->domain(), "announcer", as(keystore_, identity));
+    try {
+      announce_type_texts(p, "signal", texts);
+      ADD_FAILURE() << identity << " may announce IDL texts";
+    } catch (const std::runtime_error& e) {
+      EXPECT_THAT(e.what(), HasSubstr(std::string("identity '") + identity + "'"));
+      EXPECT_THAT(e.what(), HasSubstr("may not publish on oscar/types"));
+    }
+  }
+  DdsParticipant module(system_->domain(), "signal-2", as(keystore_, "module.signal"));
+  EXPECT_NE(announce_type_texts(module, "signal", texts), nullptr);
 }
 
 TEST_F(SecureSystem, AKilledModuleIsRestartedWithItsIdentity) {
