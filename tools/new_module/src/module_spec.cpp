@@ -199,10 +199,10 @@ void ModuleSpec::validate(const std::set<std::string>& taken) const {
     if (!own.insert(t).second)
       throw std::invalid_argument(fmt::format("--type '{}' is given twice", t));
   }
-  if (!types.empty() && idl_keyword(name)) {
-    throw std::invalid_argument(fmt::format(
-        "module name '{}' is an IDL keyword: a module with --type is an IDL module of its name",
-        name));
+  if (!types.empty() && (idl_keyword(name) || name == "oscar")) {
+    throw std::invalid_argument(
+        fmt::format("module name '{}' is {}: a module with --type is an IDL module of its name",
+                    name, name == "oscar" ? "OSCAR's IDL module" : "an IDL keyword"));
   }
   std::set<std::string> names;
   const auto unique = [&](const std::string& n, const char* what) {

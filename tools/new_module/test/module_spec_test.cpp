@@ -93,6 +93,8 @@ TEST(ModuleSpec, RejectsTypesOfItsOwnThatAreNoCamelCaseNamesOrOscarsOrForInputs)
   s.name = "sequence";
   s.types = {"Fused"};
   expect_error(s, "module name 'sequence' is an IDL keyword");
+  s.name = "oscar";
+  expect_error(s, "module name 'oscar' is OSCAR's IDL module");
   s = valid();
   s.outputs[0].type = "Fused";
   expect_error(s,
