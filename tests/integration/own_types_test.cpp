@@ -14,6 +14,7 @@
 #include "oscar/mcap/reader.hpp"
 #include "oscar/raw_cdr_type.hpp"
 #include "oscar/raw_cue.hpp"
+#include "oscar/testing/eventually.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/type_texts.hpp"
 #include "run_tool.hpp"
@@ -25,6 +26,14 @@ using test::BootedSystem;
 using test::Process;
 using test::run_tool;
 using ::testing::HasSubstr;
+
+// Waits until the recorder says it records `topic` (a recorder under a sanitizer on a loaded
+// machine may take seconds to discover it).
+void wait_until_recording(const Process& recorder, const std::string& topic) {
+  ASSERT_TRUE(eventually(
+      [&] { return recorder.output().find("recording " + topic) != std::string::npos; }, 60s))
+      << recorder.output();
+}
 
 std::string arm_system(const std::string& tool) {
   return R"(
@@ -90,6 +99,7 @@ TEST(OwnTypes, EchoRecordReplayAndConfigReadAndWriteThemWithoutTheModulesCode) {
   std::filesystem::remove(file);
   Process recorder({test::bin("oscar-record"), "-o", file, "--domain", domain, "--all"},
                    test::temp_path("own_types_record") + ".log");
+  wait_until_recording(recorder, "oscar/cue/arm/state");
   std::this_thread::sleep_for(2500ms);
   recorder.stop();
   ASSERT_EQ(system.shut_down(), 0) << system.boot_output();
@@ -132,6 +142,7 @@ TEST(OwnTypes, ATypeNobodyAnnouncedIsRecordedWithoutASchemaAndTheRecorderSaysSo)
   Process recorder({test::bin("oscar-record"), "-o", file, "--domain",
                     std::to_string(test::test_domain()), "--all"},
                    test::temp_path("unannounced_record") + ".log");
+  wait_until_recording(recorder, "oscar/cue/stray/out");
   // Bool's bytes (a header first, as every cue) under the unknown name, every 50 ms for 2.5 s.
   for (std::uint64_t seq = 1; seq <= 50; ++seq) {
     Bool b;
