@@ -27,6 +27,14 @@ using test::Process;
 using test::run_tool;
 using ::testing::HasSubstr;
 
+// The recording's channel of `topic`, or nullptr.
+const mcap::Channel* channel_of(const mcap::FileInfo& info, const std::string& topic) {
+  for (const auto& [id, channel] : info.channels) {
+    if (channel.topic == topic) return &channel;
+  }
+  return nullptr;
+}
+
 // Waits until the recorder says it records `topic` (a recorder under a sanitizer on a loaded
 // machine may take seconds to discover it).
 void wait_until_recording(const Process& recorder, const std::string& topic) {
@@ -106,10 +114,7 @@ TEST(OwnTypes, EchoRecordReplayAndConfigReadAndWriteThemWithoutTheModulesCode) {
 
   mcap::Reader reader(file);
   const auto info = reader.info();
-  const mcap::Channel* arm = nullptr;
-  for (const auto& [id, channel] : info.channels) {
-    if (channel.topic == "oscar/cue/arm/state") arm = &channel;
-  }
+  const auto* arm = channel_of(info, "oscar/cue/arm/state");
   ASSERT_NE(arm, nullptr) << recorder.output();
   EXPECT_GE(info.statistics.channel_message_counts.at(arm->id), 10u);
   const auto schema = info.schemas.find(arm->schema_id);
@@ -161,10 +166,7 @@ TEST(OwnTypes, ATypeNobodyAnnouncedIsRecordedWithoutASchemaAndTheRecorderSaysSo)
                         "OSCAR does not define its type and no module announced its IDL text"));
   mcap::Reader reader(file);
   const auto info = reader.info();
-  const mcap::Channel* stray = nullptr;
-  for (const auto& [id, channel] : info.channels) {
-    if (channel.topic == "oscar/cue/stray/out") stray = &channel;
-  }
+  const auto* stray = channel_of(info, "oscar/cue/stray/out");
   ASSERT_NE(stray, nullptr) << recorder.output();
   EXPECT_EQ(stray->schema_id, 0) << "no schema for a type nobody announced";
   EXPECT_EQ(stray->metadata.at("type"), type);

@@ -289,12 +289,12 @@ TEST({cls}, BringsTheIdlOfItsOwnTypes) {{
 )",
                            fmt::arg("cls", s.class_name()), fmt::arg("types", own_types));
   }
-  return fmt::format(R"(#include "{name}_kernel.hpp"
+  return fmt::format(
+      R"(#include "{name}_kernel.hpp"
 
 #include <gtest/gtest.h>
 #include <oscar/harness.hpp>
-#include <oscar/idl_texts.hpp>
-#include <oscar/testing/conformance.hpp>
+{idl_include}#include <oscar/testing/conformance.hpp>
 
 namespace {ns} {{
 namespace {{
@@ -315,9 +315,10 @@ TEST({cls}, StubWritesEveryOutput) {{
 }}  // namespace
 }}  // namespace {ns}
 )",
-                     fmt::arg("name", s.name), fmt::arg("ns", ns), fmt::arg("cls", s.class_name()),
-                     fmt::arg("feed", feed), fmt::arg("check", check), fmt::arg("again", again),
-                     fmt::arg("stub_check", stub_check), fmt::arg("idl_test", idl_test));
+      fmt::arg("name", s.name), fmt::arg("ns", ns), fmt::arg("cls", s.class_name()),
+      fmt::arg("feed", feed), fmt::arg("check", check), fmt::arg("again", again),
+      fmt::arg("stub_check", stub_check), fmt::arg("idl_test", idl_test),
+      fmt::arg("idl_include", idl_test.empty() ? "" : "#include <oscar/idl_texts.hpp>\n"));
 }
 
 // The parameters with which bench_source publishes a cue of each standard type.
