@@ -1,8 +1,12 @@
 #include "host_roudi.hpp"
 
+#include <signal.h>
+
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -20,6 +24,25 @@ constexpr auto kShortLife = 5s;  // a RouDi that ends sooner is started again af
 constexpr auto kFirstPause = 500ms;
 constexpr auto kLongestPause = 8s;
 constexpr const char* kProgram = "iox-roudi";
+// iceoryx 2.0's thread that monitors RouDi's processes and connects ports, every 100 ms.
+constexpr std::string_view kDiscoveryThread = "Mon+Discover";
+
+// How often the thread of process `pid` named `name` has gone to sleep so far (its voluntary
+// context switches); nothing if the process has no such thread.
+std::optional<unsigned long long> sleeps_of_thread(pid_t pid, std::string_view name) {
+  std::error_code ec;
+  for (const auto& task :
+       std::filesystem::directory_iterator(fmt::format("/proc/{}/task", pid), ec)) {
+    std::string comm;
+    if (!std::getline(std::ifstream(task.path() / "comm"), comm) || comm != name) continue;
+    std::ifstream status(task.path() / "status");
+    for (std::string line; std::getline(status, line);) {
+      constexpr std::string_view kKey = "voluntary_ctxt_switches:";
+      if (line.starts_with(kKey)) return std::stoull(line.substr(kKey.size()));
+    }
+  }
+  return std::nullopt;
+}
 
 }  // namespace
 
@@ -55,8 +78,10 @@ void HostRoudi::tick(Clock::time_point now) {
     spdlog::warn("RouDi (pid {}) {} (its output: {})", x.pid, x.describe(),
                  processes_.log_path(kProgram));
     listening_said_ = false;
+    discovery_sleeps_.reset();
   }
   const bool ours = pid() != 0;
+  if (ours) kill_if_hung(now);
   if (zero_copy::roudi_running()) {
     if (ours && !listening_said_) {
       spdlog::info("RouDi runs (pid {}, mempools in {})", pid(), config_path_);
@@ -75,6 +100,22 @@ void HostRoudi::tick(Clock::time_point now) {
     foreign_said_ = false;
   }
   if (now >= next_start_) start(now);
+}
+
+void HostRoudi::kill_if_hung(Clock::time_point now) {
+  const auto sleeps = sleeps_of_thread(pid(), kDiscoveryThread);
+  if (!sleeps) return;  // starting
+  if (sleeps != discovery_sleeps_) {
+    discovery_sleeps_ = sleeps;
+    discovery_slept_at_ = now;
+    return;
+  }
+  if (now - discovery_slept_at_ < kHungAfter) return;
+  spdlog::error(
+      "RouDi (pid {}) hangs: its discovery thread has not run for {} s (iceoryx 2.0 waits for "
+      "good on a lock of a process that died holding it); killing it",
+      pid(), kHungAfter.count());
+  ::kill(pid(), SIGKILL);
 }
 
 void HostRoudi::start(Clock::time_point now) {

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "oscar/registry/supervisor.hpp"
@@ -26,8 +27,15 @@ class HostRoudi {
   /// none listens on this host, and says when one ended. A RouDi another process started (an
   /// earlier monitor's, another system's) is used, not doubled; when it goes, this one starts
   /// its own. A RouDi that ends within 5 s of its start is started again after a pause that
-  /// doubles from 0.5 s to 8 s; one that ran longer, at once.
+  /// doubles from 0.5 s to 8 s; one that ran longer, at once. A RouDi it started that hangs
+  /// (its discovery thread, which wakes every 100 ms, has not run for `kHungAfter`) is killed,
+  /// and so started again.
   void tick(Clock::time_point now = Clock::now());
+
+  /// How long RouDi's discovery thread may not run before it counts as hung. iceoryx 2.0 hangs
+  /// for good when a process dies holding the lock of one of its publishers (iceoryx issue 1711:
+  /// a producer killed while it publishes, and another process asking for a port of the topic).
+  static constexpr std::chrono::seconds kHungAfter{3};
 
   /// How many RouDis it has started so far (a restart invalidates what processes that joined the
   /// one before hold: iceoryx 2.0 cannot re-register them).
@@ -38,6 +46,8 @@ class HostRoudi {
 
  private:
   void start(Clock::time_point now);
+  /// Kills the RouDi it started if its discovery thread has not run for kHungAfter.
+  void kill_if_hung(Clock::time_point now);
 
   Supervisor processes_;
   std::string config_path_;
@@ -47,6 +57,9 @@ class HostRoudi {
   bool listening_said_ = false;  // "RouDi runs" logged for the current RouDi
   bool foreign_said_ = false;    // "uses the RouDi already running" logged
   bool failure_said_ = false;    // why it cannot start RouDi, logged
+  // The discovery thread's count of sleeps, and since when it has not changed.
+  std::optional<unsigned long long> discovery_sleeps_;
+  Clock::time_point discovery_slept_at_{};
 };
 
 }  // namespace oscar

@@ -152,6 +152,29 @@ TEST_F(HostRoudi, AKilledRouDiIsStartedAgainAndSaysWhatThatMeansForJoinedProcess
   cues_flow("PlainBool", "5", "1", "0");  // the new one carries cues
 }
 
+// iceoryx 2.0's RouDi hangs for good when a process dies holding a lock of one of its publishers
+// (a producer killed while it publishes). A stopped RouDi hangs the same way: its discovery
+// thread stops running, and after 3 s the monitor kills it and starts another.
+TEST_F(HostRoudi, AHungRouDiIsKilledAndStartedAgain) {
+  auto& monitor = start_monitor();
+  ASSERT_TRUE(eventually([&] { return monitor_said("RouDi runs"); })) << monitor.output();
+  const auto first = roudis();
+  ASSERT_EQ(first.size(), 1u);
+  std::this_thread::sleep_for(4s);  // longer than the 3 s: an idle RouDi does not count as hung
+  EXPECT_FALSE(monitor_said("hangs")) << monitor.output();
+  ::kill(static_cast<pid_t>(first.front()), SIGSTOP);
+  ASSERT_TRUE(eventually([&] { return monitor_said("started RouDi again"); })) << monitor.output();
+  EXPECT_TRUE(monitor_said(
+      fmt::format("RouDi (pid {}) hangs: its discovery thread has not run for 3 s", first.front())))
+      << monitor.output();
+  EXPECT_TRUE(monitor_said("killed by signal 9")) << monitor.output();
+  ASSERT_TRUE(eventually([] { return zero_copy::roudi_running(); }));
+  const auto second = roudis();
+  ASSERT_EQ(second.size(), 1u);
+  EXPECT_NE(second.front(), first.front());
+  cues_flow("PlainBool", "5", "1", "0");  // the new one carries cues
+}
+
 // A module that joined a RouDi which was killed and started again would publish where nobody
 // started since looks: it ends with kKernelFailureExit, saying why, and the registry starts it
 // again (on the new RouDi).
