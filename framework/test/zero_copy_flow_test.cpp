@@ -223,7 +223,11 @@ TEST_F(ZeroCopyWiring, ASinkReadsTheSourcesImagesInTheChunksTheSourceFilledThem)
 }
 
 // The source in an oscar-run child: every image the sink gets lies in shared memory, whole, in
-// order; after a kill -9 of the source, another one's images come the same way.
+// order; after the source has stopped, another one's images come the same way. Stopped, not
+// killed: a source killed while it publishes leaves this RouDi hanging now and then (iceoryx 2.0,
+// a lock of its publisher held for good), which this process, joined to it, cannot get over. In a
+// booted system the monitor replaces such a RouDi, and the registry the modules that joined it
+// (ZeroCopySystem.AProducerKilledOverAndOver..., tests/integration/host_roudi_test.cpp).
 TEST_F(ZeroCopyWiring, ImagesCrossProcessesInPlaceAndAgainFromARestartedSource) {
   auto src = plain_source_process();
   ASSERT_TRUE(eventually([] { return offered_here("src/image", "oscar::PlainGvImage"); }, 30s))
@@ -248,8 +252,8 @@ TEST_F(ZeroCopyWiring, ImagesCrossProcessesInPlaceAndAgainFromARestartedSource) 
       },
       60s))
       << src->output();
-  ::kill(src->pid(), SIGKILL);
-  src->wait(10s);
+  ::kill(src->pid(), SIGTERM);
+  ASSERT_EQ(src->wait(10s), 0) << src->output();
   const auto before = k.images().size();
   auto again = plain_source_process();
   ASSERT_TRUE(eventually(

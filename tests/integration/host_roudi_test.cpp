@@ -12,6 +12,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "booted_system.hpp"
 #include "oscar/module_spec.hpp"
 #include "oscar/registry/host_check.hpp"
 #include "private_tmp.hpp"
@@ -262,6 +263,70 @@ TEST_F(HostRoudi, WithoutIoxRoudiMonitorBootAndTheHostCheckNameThePackage) {
   EXPECT_THAT(check.output(),
               HasSubstr("\nzero_copy: iox-roudi is not installed on this host (Debian package "
                         "iceoryx)\n"));
+}
+
+// A booted system's plain images from a producer that is killed with -9 again and again, at
+// whatever point of publishing: its registry starts it again, and its consumer in another module
+// gets its images again, in shared memory. When a kill leaves RouDi hanging (iceoryx 2.0 waits
+// for good on the lock of a producer that died holding it), the monitor starts another RouDi and
+// the registry the modules that had joined the one before.
+TEST(ZeroCopySystem, AProducerKilledOverAndOverIsStartedAgainAndItsConsumerGetsItsCuesAgain) {
+  if (!test::kNoPrivateTmp.empty())
+    GTEST_SKIP() << "needs a private mount namespace (root): " << test::kNoPrivateTmp;
+  test::BootedSystem sys("zc_kill", R"(
+system: zc_kill
+zero_copy: { chunks: 64 }
+modules:
+  - name: src
+    kernels: [ { type: bench_source, name: src, params: { type: PlainGvImage } } ]
+    mode: { continuous: 10ms }
+    restart: { policy: auto, max: 30, backoff: 50ms }
+  - name: sink
+    kernels:
+      - { type: bench_sink, name: sink, params: { type: PlainGvImage }, inputs: { in: src/out } }
+    mode: single_step
+    restart: { policy: auto, max: 30, backoff: 50ms }
+)");
+  auto s = sys.running();
+  // The sink's incarnation and the cues it has taken in it.
+  const auto sink_taken = [](const SystemState& st) {
+    const auto* m = test::entry(st, "sink");
+    const auto* k = m ? test::kernel_state(*m, "sink") : nullptr;
+    return std::pair(m ? m->incarnation() : 0u, k ? k->cycles() : 0u);
+  };
+  constexpr int kKills = 6;
+  for (int kill = 0; kill <= kKills; ++kill) {
+    const auto [incarnation, taken] = sink_taken(s);
+    s = sys.wait_for(
+        [&, incarnation = incarnation, taken = taken](const SystemState& st) {
+          const auto [now_incarnation, now_taken] = sink_taken(st);
+          return st.state() == "running" &&
+                 now_taken >= (now_incarnation == incarnation ? taken : 0) + 10;
+        },
+        60s);
+    ASSERT_EQ(s.state(), "running") << "kill " << kill;
+    if (kill == kKills) break;
+    const auto src_incarnation = test::entry(s, "src")->incarnation();
+    ASSERT_EQ(::kill(static_cast<pid_t>(test::entry(s, "src")->pid()), SIGKILL), 0);
+    s = sys.wait_for(
+        [&](const SystemState& st) {
+          return test::entry(st, "src")->incarnation() > src_incarnation && st.state() == "running";
+        },
+        60s);
+  }
+  const auto sink_log = read(sys.log_dir() + "/localhost/sink.log");
+  EXPECT_THAT(sink_log, HasSubstr("cues of src/out come zero-copy")) << sink_log;
+  const auto monitor_log = read(sys.log_dir() + "/monitor-localhost.log");
+  const auto count = [&](const std::string& text) {
+    std::size_t n = 0;
+    for (auto at = monitor_log.find(text); at != std::string::npos;
+         at = monitor_log.find(text, at + 1))
+      ++n;
+    return n;
+  };
+  std::cout << kKills << " kills of the producer: RouDi was replaced "
+            << count("started RouDi again") << " times, after hanging " << count(" hangs: ")
+            << " times\n";
 }
 
 }  // namespace
