@@ -23,8 +23,10 @@ namespace {
 
 using ::testing::HasSubstr;
 
-// The shipped system file, ending after `doors` doors, reading each sign for 3 s (long enough
-// for the registry's state to show the phase).
+// The shipped system file, ending after `doors` doors, exploring for at least 4 s and reading each
+// sign for 3 s: long enough for the registry's state to show the phase when the machine is loaded
+// (with 1.5 s of exploring, the mission once moved on under the address sanitizer before its
+// modules had answered the coordinator's commands).
 std::string marvin_system(int doors) {
   std::ifstream in(oscar::testing::source_path("config/marvin-phases.yaml"));
   std::stringstream text;
@@ -36,6 +38,7 @@ std::string marvin_system(int doors) {
     if (at != std::string::npos) yaml.replace(at, from.size(), to);
   };
   replace("doors: 0", "doors: " + std::to_string(doors));
+  replace("explore_min_ms: 1500", "explore_min_ms: 4000");
   replace("read_ms: 1000", "read_ms: 3000");
   return yaml;
 }
