@@ -3,6 +3,7 @@
 // fresh /dev/shm and /tmp (private_tmp.hpp), so its RouDis meet nobody else's.
 #include <signal.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -164,7 +165,17 @@ TEST_F(HostRoudi, AHungRouDiIsKilledAndStartedAgain) {
   std::this_thread::sleep_for(4s);  // longer than the 3 s: an idle RouDi does not count as hung
   EXPECT_FALSE(monitor_said("hangs")) << monitor.output();
   ::kill(static_cast<pid_t>(first.front()), SIGSTOP);
+  // A module started meanwhile waits for RouDi's answer to its registration.
+  auto module = test::run_module(
+      "plain_src", {"-k", "bench_source:src", "-p", "src.type=PlainBool", "-m", "continuous:20ms"});
   ASSERT_TRUE(eventually([&] { return monitor_said("started RouDi again"); })) << monitor.output();
+  // It ends once that RouDi is gone, so that its registry starts it again on the new one (iceoryx
+  // would try the dead connection for a minute, an error line per try).
+  EXPECT_EQ(module->wait(10s), kKernelFailureExit) << module->output().substr(0, 4000);
+  const auto said = module->output();
+  EXPECT_THAT(said, HasSubstr("the RouDi this process was registering with went away before it "
+                              "answered (/tmp/roudi "));
+  EXPECT_LT(std::count(said.begin(), said.end(), '\n'), 100) << said.substr(0, 4000);
   EXPECT_TRUE(monitor_said(
       fmt::format("RouDi (pid {}) hangs: its discovery thread has not run for 3 s", first.front())))
       << monitor.output();

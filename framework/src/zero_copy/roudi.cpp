@@ -5,6 +5,7 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -13,6 +14,8 @@
 #include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <stop_token>
+#include <thread>
 
 #include <fmt/format.h>
 #include <iceoryx_hoofs/cxx/generic_raii.hpp>
@@ -50,6 +53,74 @@ unsigned long mapped_inode(const std::string& segment) {
   return 0;
 }
 
+// The inode of file `path`; 0 if there is none.
+unsigned long inode_of(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 ? st.st_ino : 0;
+}
+
+// How this process ends when iceoryx cannot go on (end_process_on_iceoryx_error()).
+struct Ending {
+  int exit_code = 1;
+  std::function<void(const std::string& what, bool ending)> say;
+};
+std::mutex ending_mutex;
+Ending ending;  // under ending_mutex
+
+// Ends the process at once, saying `why` through end_process_on_iceoryx_error()'s `say` (or on
+// stderr if none was given) with the exit code given there (else 1).
+[[noreturn]] void end_process(const std::string& why) {
+  Ending e;
+  {
+    std::lock_guard lock(ending_mutex);
+    e = ending;
+  }
+  const auto what = fmt::format("{}: the process ends with exit code {}", why, e.exit_code);
+  if (e.say) {
+    e.say(what, true);
+  } else {
+    std::fprintf(stderr, "%s\n", what.c_str());
+  }
+  std::fflush(nullptr);
+  std::_Exit(e.exit_code);
+}
+
+// iceoryx 2.0 registers through a socket connected to the RouDi's it found. When that RouDi goes
+// before it answers (its monitor killed it because it hung, and started another), iceoryx would
+// try the dead connection again and again for a minute, logging an error each time, and then
+// abort. While it lives, this ends the process instead as soon as RouDi's socket takes no message
+// or is another file.
+class RegistrationWatch {
+ public:
+  RegistrationWatch()
+      : socket_(roudi_socket()),
+        inode_(inode_of(socket_)),
+        thread_([this](std::stop_token stop) { watch(stop); }) {}
+
+ private:
+  void watch(std::stop_token stop) {
+    std::mutex mutex;
+    std::condition_variable_any wake;
+    std::unique_lock lock(mutex);
+    for (;;) {
+      wake.wait_for(lock, stop, std::chrono::milliseconds(5), [] { return false; });
+      if (stop.stop_requested()) return;
+      const auto now = inode_of(socket_);
+      if (now == inode_ && roudi_running()) continue;
+      end_process(fmt::format(
+          "the RouDi this process was registering with went away before it answered ({} {})",
+          socket_,
+          now == 0        ? "is gone"
+          : now != inode_ ? "is another socket"
+                          : "takes no message"));
+    }
+  }
+
+  const std::string socket_;
+  const unsigned long inode_;
+  std::jthread thread_;  // last: stopped and joined first
+};
+
 }  // namespace
 
 bool roudi_running() {
@@ -85,8 +156,11 @@ std::optional<std::string> join_roudi(const std::string& name) {
     return fmt::format("no RouDi runs on this host (nothing listens on {}; start iox-roudi)",
                        roudi_socket());
   }
-  iox::runtime::PoshRuntime::initRuntime(
-      iox::RuntimeName_t(iox::cxx::TruncateToCapacity, name.c_str()));
+  {
+    const RegistrationWatch watch;
+    iox::runtime::PoshRuntime::initRuntime(
+        iox::RuntimeName_t(iox::cxx::TruncateToCapacity, name.c_str()));
+  }
   joined = true;
   return std::nullopt;
 }
@@ -96,11 +170,14 @@ void end_process_on_iceoryx_error(int exit_code,
   static std::mutex mutex;
   static std::optional<iox::cxx::GenericRAII> handler;  // puts iceoryx's own back at exit
   std::lock_guard lock(mutex);
+  {
+    std::lock_guard ending_lock(ending_mutex);
+    ending = Ending{exit_code, say};
+  }
   handler.reset();
   handler.emplace(iox::ErrorHandler::setTemporaryErrorHandler(
-      [exit_code, say = std::move(say)](const iox::Error error,
-                                        const std::function<void()>& callback,
-                                        const iox::ErrorLevel level) {
+      [say = std::move(say)](const iox::Error error, const std::function<void()>& callback,
+                             const iox::ErrorLevel level) {
         if (callback) callback();
         const char* name = iox::ErrorHandler::toString(error);
         if (level == iox::ErrorLevel::MODERATE) {
@@ -108,13 +185,10 @@ void end_process_on_iceoryx_error(int exit_code,
           return;
         }
         // The caller cannot go on (a severe error hands it a null port): end before it does.
-        say(fmt::format(
-                "iceoryx reports {}, a {} error it cannot go on from (most often the RouDi "
-                "this process joined no longer answers): the process ends with exit code {}",
-                name, level == iox::ErrorLevel::FATAL ? "fatal" : "severe", exit_code),
-            true);
-        std::fflush(nullptr);
-        std::_Exit(exit_code);
+        end_process(fmt::format(
+            "iceoryx reports {}, a {} error it cannot go on from (most often the RouDi this "
+            "process joined no longer answers)",
+            name, level == iox::ErrorLevel::FATAL ? "fatal" : "severe"));
       }));
 }
 

@@ -16,7 +16,9 @@ bool roudi_running();
 
 /// Registers this process with the host's RouDi as `name` (once per process: after a success,
 /// later calls return at once, whatever name they give). iceoryx itself would wait a minute for an
-/// absent RouDi and then abort, so this asks first.
+/// absent RouDi and then abort, so this asks first. A RouDi that goes away before it answers (one
+/// that hung, killed by its monitor) ends the process at once, as end_process_on_iceoryx_error()
+/// says (without it: exit code 1, the reason on stderr).
 /// @throws std::invalid_argument for a name iceoryx cannot take (empty, too long, with '/').
 /// @return nothing when registered, else why not (no RouDi, iox-roudi not installed).
 std::optional<std::string> join_roudi(const std::string& name);
