@@ -329,7 +329,11 @@ TEST(Tools, FindTheSystemBootedOnThisMachineWithoutFlagsAndAskWhenThereAreSevera
     const auto file = test::temp_path("found") + ".mcap";
     test::Process record({test::bin("oscar-record"), "--all", "-o", file},
                          test::temp_path("found_record.log"));
-    std::this_thread::sleep_for(1500ms);
+    // Under load it may take a while to find the system and its topics.
+    ASSERT_TRUE(eventually(
+        [&] { return record.output().find("recording oscar/cue/") != std::string::npos; }, 60s))
+        << record.output();
+    std::this_thread::sleep_for(1s);
     kill(record.pid(), SIGINT);
     EXPECT_EQ(record.wait(20s), 0) << record.output();
     EXPECT_THAT(record.output(), ::testing::ContainsRegex("received [1-9][0-9]*"))
