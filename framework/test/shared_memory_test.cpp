@@ -121,6 +121,36 @@ TEST_F(SharedMemoryDir, RemovesPortsNobodyOwnsAndLocksOfPortsThatAreGone) {
   EXPECT_TRUE(fs::exists(dir_ / "fastrtps_port7400"));
 }
 
+// OSCAR's participants listen on ports that carry their pid. A living listener's port stays, also
+// in a sweep at once (as a system's last process exits) and in the moments it has no lock: its
+// semaphore taken before the port is created, the port created before its lock file, the lock
+// let go while the port is opened anew. A dead listener's port goes.
+TEST_F(SharedMemoryDir, APortStaysWhileItsListenerLivesEvenWithoutItsLock) {
+  const auto own_port = [] {
+    return fmt::format("fastrtps_port{}", internal::unique_shared_memory_locator().port);
+  };
+  const auto opening = own_port(), created = own_port(), reopened = own_port();
+  touch("sem." + opening + "_mutex");
+  touch(created);
+  touch("sem." + created + "_mutex");
+  touch(reopened);
+  touch(reopened + "_el");
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  ASSERT_GT(child, 0);
+  ASSERT_EQ(waitpid(child, nullptr, 0), child);
+  const auto dead =
+      fmt::format("fastrtps_port{}", (1u << 24) + (static_cast<unsigned>(child) << 4));
+  touch(dead);
+  touch(dead + "_el");
+  touch("sem." + dead + "_mutex");
+  EXPECT_EQ(remove_files_of_dead_processes(7, dir_), 1u);
+  std::set<std::string> left;
+  for (const auto& e : fs::directory_iterator(dir_)) left.insert(e.path().filename().string());
+  EXPECT_EQ(left, (std::set<std::string>{"sem." + opening + "_mutex", created,
+                                         "sem." + created + "_mutex", reopened, reopened + "_el"}));
+}
+
 // A test that shut its own system down sweeps that system's files only, at once: another
 // system's dead files still have their grace (senders may still write to them).
 TEST_F(SharedMemoryDir, WithAFilterOnlyTheNamedFilesAreLookedAt) {

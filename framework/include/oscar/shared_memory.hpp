@@ -29,8 +29,9 @@ class DeadSharedMemorySweeper {
                                    std::function<bool(const std::string&)> only = {});
   /// Notes what died since the last call and removes what has been dead for `grace`: segments
   /// and ports of dead owners, ports no reader owns (a sender created them while sending to a
-  /// dead participant), and port semaphores whose port is gone (Fast DDS leaves them). Returns
-  /// how many of these files it removed.
+  /// dead participant), and port semaphores whose port is gone (Fast DDS leaves them). A port
+  /// whose number names a living listener (OSCAR's participants put their pid in it) stays, with
+  /// its semaphore, whatever its lock file says. Returns how many of these files it removed.
   std::size_t sweep(Clock::time_point now = Clock::now());
 
  private:

@@ -72,6 +72,9 @@ ParticipantIdClaim& ParticipantIdClaim::operator=(ParticipantIdClaim&& other) no
 
 namespace {
 
+// Above every RTPS well-known port; pids are below 2^22, 16 participants per process.
+constexpr std::uint32_t kOwnPortsFrom = 1u << 24;
+
 // Fast DDS sends by shared memory only to locators of its own host, which it recognises by a
 // 16-bit host id in the locator's address: the MD5 digest of the host's IPv4 addresses (in the
 // order its IPFinder lists them), folded into 16 bits; 127, 1 if it has none.
@@ -96,12 +99,16 @@ Locator_t unique_shared_memory_locator() {
   static std::atomic<std::uint32_t> created{0};
   Locator_t l;
   l.kind = LOCATOR_KIND_SHM;
-  // Above every RTPS well-known port; pids are below 2^22, 16 participants per process.
-  l.port = (1u << 24) + (static_cast<std::uint32_t>(getpid()) << 4) + created++ % 16;
+  l.port = kOwnPortsFrom + (static_cast<std::uint32_t>(getpid()) << 4) + created++ % 16;
   l.address[0] = 'U';  // unicast
   l.address[1] = static_cast<eprosima::fastrtps::rtps::octet>(host);
   l.address[2] = static_cast<eprosima::fastrtps::rtps::octet>(host >> 8);
   return l;
+}
+
+std::optional<int> shared_memory_port_listener(std::uint32_t port) {
+  if (port < kOwnPortsFrom) return std::nullopt;
+  return static_cast<int>((port - kOwnPortsFrom) >> 4);
 }
 
 }  // namespace oscar::internal

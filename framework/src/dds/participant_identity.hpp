@@ -11,6 +11,7 @@
 //   listens on a port of its own, never used before: derived from the pid.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include <fastdds/rtps/common/Locator.h>
@@ -56,5 +57,9 @@ inline std::uint32_t user_unicast_port(int domain, int participant) {
 
 /// A shared-memory locator of this host with a port that no other participant has used.
 eprosima::fastrtps::rtps::Locator_t unique_shared_memory_locator();
+
+/// The pid of the process that listens on shared-memory port `port`, if the port is one that
+/// unique_shared_memory_locator() made (they carry it); none for Fast DDS's own port numbers.
+std::optional<int> shared_memory_port_listener(std::uint32_t port);
 
 }  // namespace oscar::internal

@@ -1,11 +1,15 @@
 #include "oscar/shared_memory.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <charconv>
 #include <string>
+#include <string_view>
 #include <system_error>
 
 #include "../participant_identity.hpp"
@@ -24,6 +28,23 @@ bool is_port(const std::string& name) {
   return name.size() > kPort.size() && name.starts_with(kPort) &&
          std::all_of(name.begin() + static_cast<std::ptrdiff_t>(kPort.size()), name.end(),
                      [](char c) { return c >= '0' && c <= '9'; });
+}
+
+// True if `port` ("fastrtps_port<N>") is the port of a living process. OSCAR's participants
+// listen on ports that carry their pid (participant_identity.hpp), and such a port goes without
+// its lock file for a moment: Fast DDS takes the port's semaphore, then creates the port, then
+// locks it, and it lets go of the lock while it opens the port anew after finding it unhealthy.
+// Removed in that moment, the listener would wait on a port nobody could find any more, and
+// every sender that opened it later would create another, unheard (the coordinator's commands to
+// a camera went nowhere for good while a monitor of another system shut down).
+bool listener_lives(const std::string& port) {
+  const std::string_view digits = std::string_view(port).substr(kPort.size());
+  std::uint32_t number = 0;
+  if (std::from_chars(digits.data(), digits.data() + digits.size(), number).ec != std::errc{}) {
+    return false;
+  }
+  const auto pid = internal::shared_memory_port_listener(number);
+  return pid && *pid > 0 && (kill(*pid, 0) == 0 || errno == EPERM);
 }
 
 // True if `lock_file` exists and nobody holds its lock (its owner is gone).
@@ -63,15 +84,20 @@ std::size_t DeadSharedMemorySweeper::sweep(Clock::time_point now) {
     if (only_ && !only_(name)) continue;
     if (name.starts_with(kPrefix) && name.ends_with(kLockSuffix)) {
       // A segment or port whose owner is gone.
-      if (!abandoned(entry.path()) || !due(name)) continue;
       const auto owned = name.substr(0, name.size() - kLockSuffix.size());
+      if (!abandoned(entry.path()) || (is_port(owned) && listener_lives(owned)) || !due(name)) {
+        continue;
+      }
       if (std::filesystem::remove(dir_ / owned, ignore)) ++removed;
       std::filesystem::remove(dir_ / (kSemaphore + owned + kMutexSuffix), ignore);
       std::filesystem::remove(entry.path(), ignore);
     } else if (is_port(name)) {
       // A port that no reader owns, exclusively ("_el") or shared ("_sl", Fast DDS's multicast
       // ports): a sender created it while sending to a participant that had died.
-      if (exists(name + std::string(kLockSuffix)) || exists(name + "_sl") || !due(name)) continue;
+      if (exists(name + std::string(kLockSuffix)) || exists(name + "_sl") || listener_lives(name) ||
+          !due(name)) {
+        continue;
+      }
       if (std::filesystem::remove(entry.path(), ignore)) ++removed;
       std::filesystem::remove(dir_ / (kSemaphore + name + kMutexSuffix), ignore);
     } else if (name.starts_with(kSemaphore) && name.ends_with(kMutexSuffix) &&
@@ -80,7 +106,7 @@ std::size_t DeadSharedMemorySweeper::sweep(Clock::time_point now) {
       // A port's lock, left behind by its port (Fast DDS never removes them).
       const auto port =
           name.substr(kSemaphore.size(), name.size() - kSemaphore.size() - kMutexSuffix.size());
-      if (exists(port) || !due(name)) continue;
+      if (exists(port) || listener_lives(port) || !due(name)) continue;
       if (std::filesystem::remove(entry.path(), ignore)) ++removed;
     }
   }
