@@ -34,12 +34,15 @@ constexpr int kMaxThreadId = 1 << 22;  // the kernel's PID_MAX_LIMIT
 
 bool thread_exists(int tid) { return kill(tid, 0) == 0 || errno == EPERM; }
 
-// Boost's interprocess mutexes are normal or recursive ones, process-shared.
+// Boost's interprocess mutexes are normal or recursive ones, process-shared. The scan looks at
+// every aligned word of a segment, and Fast DDS's ring cells and allocator nodes hold small
+// numbers that can take the shape of a locked mutex; but glibc's lock() counts its holder in
+// `nusers`, so a "mutex" that is locked with no user is data, and is not written to.
 bool held_by_dead_thread(const GlibcMutex& m) {
   const bool normal = m.kind == kProcessShared && m.count == 0;
   const bool recursive = m.kind == (kProcessShared | PTHREAD_MUTEX_RECURSIVE) && m.count >= 1;
   return (m.lock == 1 || m.lock == 2) && (normal || recursive) && m.owner > 0 &&
-         m.owner < kMaxThreadId && !thread_exists(m.owner);
+         m.owner < kMaxThreadId && m.nusers >= 1 && !thread_exists(m.owner);
 }
 
 // What glibc's unlock does for these kinds: forget the owner, free the lock word, wake waiters
