@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <fstream>
 #include <limits>
+#include <string>
 #include <vector>
 
 namespace oscar {
@@ -35,6 +37,30 @@ std::optional<std::filesystem::path> find_on_path(const std::string& program) {
     start = end + 1;
   }
   return std::nullopt;
+}
+
+namespace {
+
+// True if a thread's /proc stat file says it is neither a zombie nor dead.
+bool thread_runs(const std::filesystem::path& stat_file) {
+  std::ifstream stat(stat_file);
+  std::string line;
+  if (!std::getline(stat, line)) return false;
+  const auto close = line.rfind(')');  // the command in parentheses may hold anything
+  return close != std::string::npos && close + 2 < line.size() && line[close + 2] != 'Z' &&
+         line[close + 2] != 'X';
+}
+
+}  // namespace
+
+bool process_lives(pid_t pid) {
+  if (pid <= 0) return false;
+  std::error_code ec;
+  for (const auto& task :
+       std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/task", ec)) {
+    if (thread_runs(task.path() / "stat")) return true;
+  }
+  return false;
 }
 
 sigset_t block_stop_signals() {

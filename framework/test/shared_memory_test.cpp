@@ -19,6 +19,7 @@
 
 #include "dds/participant_identity.hpp"  // framework/src
 #include "oscar/dds_participant.hpp"
+#include "oscar/process_util.hpp"
 #include "process.hpp"  // tests/common
 
 namespace oscar {
@@ -125,31 +126,42 @@ TEST_F(SharedMemoryDir, RemovesPortsNobodyOwnsAndLocksOfPortsThatAreGone) {
 // OSCAR's participants listen on ports that carry their pid. A living listener's port stays, also
 // in a sweep at once (as a system's last process exits) and in the moments it has no lock: its
 // semaphore taken before the port is created, the port created before its lock file, the lock
-// let go while the port is opened anew. A dead listener's port goes.
+// let go while the port is opened anew. A dead listener's port goes, also while it is a zombie.
 TEST_F(SharedMemoryDir, APortStaysWhileItsListenerLivesEvenWithoutItsLock) {
-  const auto own_port = [] {
-    return fmt::format("fastrtps_port{}", internal::unique_shared_memory_locator().port);
+  const auto port_of = [](pid_t pid, unsigned participant) {
+    return fmt::format("fastrtps_port{}",
+                       (1u << 24) + (static_cast<unsigned>(pid) << 4) + participant);
   };
-  const auto opening = own_port(), created = own_port(), reopened = own_port();
+  const pid_t living = fork();
+  if (living == 0) {
+    pause();
+    _exit(0);
+  }
+  ASSERT_GT(living, 0);
+  const pid_t zombie = fork();
+  if (zombie == 0) _exit(0);
+  ASSERT_GT(zombie, 0);
+  const auto opening = port_of(living, 0), created = port_of(living, 1),
+             reopened = port_of(living, 2), dead = port_of(zombie, 0);
   touch("sem." + opening + "_mutex");
   touch(created);
   touch("sem." + created + "_mutex");
   touch(reopened);
   touch(reopened + "_el");
-  const pid_t child = fork();
-  if (child == 0) _exit(0);
-  ASSERT_GT(child, 0);
-  ASSERT_EQ(waitpid(child, nullptr, 0), child);
-  const auto dead =
-      fmt::format("fastrtps_port{}", (1u << 24) + (static_cast<unsigned>(child) << 4));
   touch(dead);
   touch(dead + "_el");
   touch("sem." + dead + "_mutex");
+  while (process_lives(zombie)) usleep(1000);  // exited, not reaped yet
   EXPECT_EQ(remove_files_of_dead_processes(7, dir_), 1u);
   std::set<std::string> left;
   for (const auto& e : fs::directory_iterator(dir_)) left.insert(e.path().filename().string());
   EXPECT_EQ(left, (std::set<std::string>{"sem." + opening + "_mutex", created,
                                          "sem." + created + "_mutex", reopened, reopened + "_el"}));
+  kill(living, SIGKILL);
+  waitpid(living, nullptr, 0);
+  waitpid(zombie, nullptr, 0);
+  EXPECT_EQ(remove_files_of_dead_processes(7, dir_), 3u) << "its listener is gone now";
+  EXPECT_TRUE(fs::is_empty(dir_));
 }
 
 // A test that shut its own system down sweeps that system's files only, at once: another

@@ -3,6 +3,7 @@
 /// SIGINT/SIGTERM into an orderly stop, and keep the heap suited to large cues.
 
 #include <signal.h>
+#include <sys/types.h>
 
 #include <chrono>
 #include <cstddef>
@@ -24,6 +25,12 @@ std::optional<std::filesystem::path> find_on_path(const std::string& program);
 sigset_t block_stop_signals();
 /// True if SIGINT or SIGTERM arrived within `timeout`.
 bool wait_for_stop(const sigset_t& signals, std::chrono::milliseconds timeout);
+
+/// True if process `pid` has a thread that is neither a zombie nor dead. A killed multi-threaded
+/// process shows its main thread as a zombie while its other threads still exit and hold its
+/// files (and with them the locks of its shared memory): it lives until the last one is gone.
+/// A zombie whose parent has not reaped it yet is dead (kill(pid, 0) would still find it).
+bool process_lives(pid_t pid);
 
 /// Keeps freed cue memory (camera images of hundreds of KB) inside the process instead of handing
 /// it back to the kernel after each cue: large blocks come from the heap, not from a fresh mmap,

@@ -28,6 +28,7 @@
 #include "oscar/cue_types.hpp"
 #include "oscar/malformed_samples.hpp"
 #include "oscar/module_spec.hpp"
+#include "oscar/process_util.hpp"
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/registry/running_systems.hpp"
 #include "oscar/registry/system_spec.hpp"
@@ -92,27 +93,6 @@ std::vector<std::string> command_line(pid_t pid) {
   std::vector<std::string> args;
   for (std::string arg; std::getline(in, arg, '\0');) args.push_back(arg);
   return args;
-}
-
-// True if a thread's /proc stat file says it is neither a zombie nor dead.
-bool running(const fs::path& stat_file) {
-  std::ifstream stat(stat_file);
-  std::string line;
-  if (!std::getline(stat, line)) return false;
-  const auto close = line.rfind(')');
-  return close != std::string::npos && close + 2 < line.size() && line[close + 2] != 'Z' &&
-         line[close + 2] != 'X';
-}
-
-// True if a process with that pid has a thread that is not a zombie. A killed multi-threaded
-// process shows its main thread as a zombie while the others still exit and hold its files
-// (and with them the locks of its shared memory): it is alive until the last thread is gone.
-bool alive(pid_t pid) {
-  std::error_code ec;
-  for (const auto& task : fs::directory_iterator(fmt::format("/proc/{}/task", pid), ec)) {
-    if (running(task.path() / "stat")) return true;
-  }
-  return false;
 }
 
 // The processes boot started for this system: the registry, the monitors and the modules all
@@ -363,7 +343,7 @@ void SystemUnderTest::note_processes() {
   }
   std::set<std::string> files(shm_files_.begin(), shm_files_.end());
   for (const pid_t p : pids) {
-    if (p == boot_pid_ || alive(p)) add_shared_memory_of(p, files);
+    if (p == boot_pid_ || process_lives(p)) add_shared_memory_of(p, files);
   }
   pids_.assign(pids.begin(), pids.end());
   shm_files_.assign(files.begin(), files.end());
@@ -483,10 +463,10 @@ std::optional<int> SystemUnderTest::shut_down(std::chrono::milliseconds timeout)
 std::vector<pid_t> SystemUnderTest::leftover_processes() const {
   std::set<pid_t> left;
   for (const pid_t p : pids_) {
-    if (p != boot_pid_ && alive(p)) left.insert(p);
+    if (p != boot_pid_ && process_lives(p)) left.insert(p);
   }
   for (const pid_t p : processes_of(file_, domain_)) left.insert(p);
-  if (!boot_status_ && alive(boot_pid_)) left.insert(boot_pid_);
+  if (!boot_status_ && process_lives(boot_pid_)) left.insert(boot_pid_);
   return {left.begin(), left.end()};
 }
 

@@ -1,18 +1,17 @@
 #include "oscar/shared_memory.hpp"
 
 #include <fcntl.h>
-#include <signal.h>
 #include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <charconv>
 #include <string>
 #include <string_view>
 #include <system_error>
 
 #include "../participant_identity.hpp"
+#include "oscar/process_util.hpp"
 
 namespace oscar {
 namespace {
@@ -30,13 +29,14 @@ bool is_port(const std::string& name) {
                      [](char c) { return c >= '0' && c <= '9'; });
 }
 
-// True if `port` ("fastrtps_port<N>") is the port of a living process. OSCAR's participants
-// listen on ports that carry their pid (participant_identity.hpp), and such a port goes without
-// its lock file for a moment: Fast DDS takes the port's semaphore, then creates the port, then
-// locks it, and it lets go of the lock while it opens the port anew after finding it unhealthy.
-// Removed in that moment, the listener would wait on a port nobody could find any more, and
-// every sender that opened it later would create another, unheard (the coordinator's commands to
-// a camera went nowhere for good while a monitor of another system shut down).
+// True if `port` ("fastrtps_port<N>") is the port of another living process. OSCAR's
+// participants listen on ports that carry their pid (participant_identity.hpp), and such a port
+// goes without its lock file for a moment: Fast DDS takes the port's semaphore, then creates the
+// port, then locks it, and it lets go of the lock while it opens the port anew after finding it
+// unhealthy. Removed in that moment, the listener would wait on a port nobody could find any
+// more, and every sender that opened it later would create another, unheard (the coordinator's
+// commands to a camera went nowhere for good while a monitor of another system shut down). The
+// sweeping process's own ports are its deleted participants' (a live one holds its lock).
 bool listener_lives(const std::string& port) {
   const std::string_view digits = std::string_view(port).substr(kPort.size());
   std::uint32_t number = 0;
@@ -44,7 +44,7 @@ bool listener_lives(const std::string& port) {
     return false;
   }
   const auto pid = internal::shared_memory_port_listener(number);
-  return pid && *pid > 0 && (kill(*pid, 0) == 0 || errno == EPERM);
+  return pid && *pid != getpid() && process_lives(*pid);
 }
 
 // True if `lock_file` exists and nobody holds its lock (its owner is gone).
