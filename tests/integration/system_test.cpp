@@ -305,7 +305,9 @@ TEST(Registry, RequestsOfAnUnknownKindOrWithOverlongNamesAreRefused) {
   const auto after = sys.registry().latest();
   ASSERT_TRUE(after);
   EXPECT_EQ(after->state(), "running");
-  EXPECT_EQ(entry(*after, "camera")->incarnation(), entry(before, "camera")->incarnation());
+  const auto *now = entry(*after, "camera"), *then = entry(before, "camera");
+  ASSERT_TRUE(now && then) << "the registry does not list module 'camera'";
+  EXPECT_EQ(now->incarnation(), then->incarnation());
 }
 
 // Restart limit 1 within 6 s: a failure after the window is restarted again; the count was
