@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "oscar/process_util.hpp"
 #include "oscar/registry/registry_client.hpp"
 #include "oscar/testing/booted_system.hpp"
 #include "proc.hpp"     // tests/common
@@ -88,14 +89,8 @@ inline const KernelState* kernel_state(const ModuleEntry& m, const std::string& 
   return nullptr;
 }
 
-/// True if a process with that pid still exists (and is not a zombie).
-inline bool alive(long pid) {
-  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
-  std::string line;
-  if (!std::getline(stat, line)) return false;
-  const auto close = line.rfind(')');
-  return close != std::string::npos && close + 2 < line.size() && line[close + 2] != 'Z';
-}
+/// True if a process with that pid still has a thread that is not a zombie.
+inline bool alive(long pid) { return process_lives(static_cast<pid_t>(pid)); }
 
 /// Pids of processes whose command line mentions `text`.
 inline std::vector<long> processes_mentioning(const std::string& text) {
