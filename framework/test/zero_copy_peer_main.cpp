@@ -8,11 +8,15 @@
 //   oscar-zero-copy-peer config COUNT    (RouDi's configuration: COUNT chunks per plain type)
 // TYPE: PlainBool, PlainLineSeg3DSeq or PlainGvImage. A publisher holds HOLD_LOANS chunks unused
 // (to show they come back when it is killed) and with LINGER stays after its last cue; a
-// subscriber keeps its HOLD newest cues, as an input's ring buffer does.
+// subscriber keeps its HOLD newest cues, as an input's ring buffer does. With
+// OSCAR_PEER_PORTS_AFTER=FILE in its environment, the peer prints "joined" once it joined RouDi and
+// asks for its ports once FILE exists.
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <deque>
+#include <filesystem>
 #include <string>
 #include <thread>
 #include <vector>
@@ -186,6 +190,12 @@ int main(int argc, char** argv) {
     if (const auto why_not = join_roudi("oscar-zc-" + a[1] + "-" + std::to_string(getpid()))) {
       std::printf("no zero-copy: %s\n", why_not->c_str());
       return 5;
+    }
+    if (const char* go = std::getenv("OSCAR_PEER_PORTS_AFTER")) {
+      std::printf("joined\n");
+      std::fflush(stdout);
+      while (!std::filesystem::exists(go))
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
     if (a[2] == "PlainBool") return run<oscar::PlainBool>(a);
     if (a[2] == "PlainLineSeg3DSeq") return run<oscar::PlainLineSeg3DSeq>(a);

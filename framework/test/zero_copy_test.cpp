@@ -333,5 +333,43 @@ TEST_F(ZeroCopy, AKilledConsumersChunksComeBackAndTheProducerGoesOn) {
     EXPECT_NE(line.find("ok=1"), std::string::npos) << line;
 }
 
+// iceoryx 2.0 waits for good for RouDi's answer to a port request, and a RouDi that hung (here:
+// stopped) and was killed and replaced by its monitor never answers. The process that asked ends,
+// saying so, so that its registry starts it again on the new RouDi.
+class ZeroCopyPortRequest : public ZeroCopy, public ::testing::WithParamInterface<std::string> {};
+
+TEST_P(ZeroCopyPortRequest, EndsTheProcessWhenTheRouDiAskedGoesAwayWithoutAnswering) {
+  const bool publisher = GetParam() == "publisher";
+  auto roudi = start_roudi(8);
+  std::filesystem::remove("/tmp/go");
+  ::setenv("OSCAR_PEER_PORTS_AFTER", "/tmp/go", 1);
+  Peer asking(publisher
+                  ? std::vector<std::string>{"pub", "PlainBool", "flag", "1", "10", "0", "0", "1"}
+                  : std::vector<std::string>{"sub", "PlainBool", "flag", "1", "1"},
+              "asking");
+  ::unsetenv("OSCAR_PEER_PORTS_AFTER");
+  ASSERT_TRUE(eventually([&] { return asking.printed("joined"); })) << asking.process.output();
+  ::kill(roudi->pid(), SIGSTOP);
+  std::ofstream("/tmp/go");
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_FALSE(asking.process.wait(std::chrono::milliseconds(0)))
+      << "it waits for the stopped RouDi's answer: " << asking.process.output();
+  ::kill(roudi->pid(), SIGKILL);
+  roudi->wait(std::chrono::seconds(10));
+  roudi = start_roudi(8);
+  EXPECT_EQ(asking.process.wait(std::chrono::seconds(10)), 1) << asking.process.output();
+  // Gone ("takes no message") or replaced ("is another socket"), whichever it sees first.
+  EXPECT_TRUE(asking.printed(fmt::format(
+      "the RouDi this process asked for a {} port went away before it answered (/tmp/roudi ",
+      GetParam())))
+      << asking.process.output();
+  EXPECT_TRUE(asking.printed("the process ends with exit code 1")) << asking.process.output();
+}
+
+INSTANTIATE_TEST_SUITE_P(Port, ZeroCopyPortRequest, ::testing::Values("publisher", "subscriber"),
+                         [](const ::testing::TestParamInfo<std::string>& port) {
+                           return port.param;
+                         });
+
 }  // namespace
 }  // namespace oscar::zero_copy

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <iceoryx_posh/popo/untyped_publisher.hpp>
 
+#include "zero_copy/roudi.hpp"
 #include "zero_copy/service.hpp"
 #include "zero_copy/tsan_handoff.hpp"
 
@@ -31,8 +32,11 @@ struct ChunkPublisher::Impl {
 
 ChunkPublisher::ChunkPublisher(const std::string& topic, const std::string& type_name,
                                std::size_t history)
-    : impl_(std::make_unique<Impl>(internal::service_for(topic, type_name), options_for(history))) {
-}
+    : impl_([&] {
+        const AwaitingRoudi awaiting("asked for a publisher port");
+        return std::make_unique<Impl>(internal::service_for(topic, type_name),
+                                      options_for(history));
+      }()) {}
 
 ChunkPublisher::~ChunkPublisher() = default;
 

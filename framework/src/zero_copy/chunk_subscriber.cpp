@@ -7,6 +7,7 @@
 #include <iceoryx_posh/popo/untyped_subscriber.hpp>
 #include <iceoryx_posh/popo/wait_set.hpp>
 
+#include "zero_copy/roudi.hpp"
 #include "zero_copy/service.hpp"
 #include "zero_copy/tsan_handoff.hpp"
 
@@ -42,8 +43,11 @@ struct ChunkSubscriber::State {
 
 ChunkSubscriber::ChunkSubscriber(const std::string& topic, const std::string& type_name,
                                  std::size_t queue_capacity, std::size_t history)
-    : state_(std::make_shared<State>(internal::service_for(topic, type_name),
-                                     options_for(queue_capacity, history))) {}
+    : state_([&] {
+        const AwaitingRoudi awaiting("asked for a subscriber port");
+        return std::make_shared<State>(internal::service_for(topic, type_name),
+                                       options_for(queue_capacity, history));
+      }()) {}
 
 ChunkSubscriber::~ChunkSubscriber() = default;
 

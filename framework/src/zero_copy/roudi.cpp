@@ -5,6 +5,7 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
@@ -85,43 +86,33 @@ Ending ending;  // under ending_mutex
   std::_Exit(e.exit_code);
 }
 
-// iceoryx 2.0 registers through a socket connected to the RouDi's it found. When that RouDi goes
-// before it answers (its monitor killed it because it hung, and started another), iceoryx would
-// try the dead connection again and again for a minute, logging an error each time, and then
-// abort. While it lives, this ends the process instead as soon as RouDi's socket takes no message
-// or is another file.
-class RegistrationWatch {
- public:
-  RegistrationWatch()
-      : socket_(roudi_socket()),
-        inode_(inode_of(socket_)),
-        thread_([this](std::stop_token stop) { watch(stop); }) {}
-
- private:
-  void watch(std::stop_token stop) {
-    std::mutex mutex;
-    std::condition_variable_any wake;
-    std::unique_lock lock(mutex);
-    for (;;) {
-      wake.wait_for(lock, stop, std::chrono::milliseconds(5), [] { return false; });
-      if (stop.stop_requested()) return;
-      const auto now = inode_of(socket_);
-      if (now == inode_ && roudi_running()) continue;
-      end_process(fmt::format(
-          "the RouDi this process was registering with went away before it answered ({} {})",
-          socket_,
-          now == 0        ? "is gone"
-          : now != inode_ ? "is another socket"
-                          : "takes no message"));
-    }
-  }
-
-  const std::string socket_;
-  const unsigned long inode_;
-  std::jthread thread_;  // last: stopped and joined first
-};
+// The inode of the socket of the RouDi this process joined; 0 before it joined.
+std::atomic<unsigned long> joined_socket_inode{0};
 
 }  // namespace
+
+AwaitingRoudi::AwaitingRoudi(std::string asking)
+    : asking_(std::move(asking)),
+      socket_(roudi_socket()),
+      inode_(joined_socket_inode != 0 ? joined_socket_inode.load() : inode_of(socket_)),
+      thread_([this](std::stop_token stop) { watch(stop); }) {}
+
+void AwaitingRoudi::watch(std::stop_token stop) {
+  std::mutex mutex;
+  std::condition_variable_any wake;
+  std::unique_lock lock(mutex);
+  for (;;) {
+    wake.wait_for(lock, stop, std::chrono::milliseconds(5), [] { return false; });
+    if (stop.stop_requested()) return;
+    const auto now = inode_of(socket_);
+    if (now == inode_ && roudi_running()) continue;
+    end_process(fmt::format("the RouDi this process {} went away before it answered ({} {})",
+                            asking_, socket_,
+                            now == 0        ? "is gone"
+                            : now != inode_ ? "is another socket"
+                                            : "takes no message"));
+  }
+}
 
 bool roudi_running() {
   const auto path = roudi_socket();
@@ -157,9 +148,10 @@ std::optional<std::string> join_roudi(const std::string& name) {
                        roudi_socket());
   }
   {
-    const RegistrationWatch watch;
+    const AwaitingRoudi awaiting("was registering with");
     iox::runtime::PoshRuntime::initRuntime(
         iox::RuntimeName_t(iox::cxx::TruncateToCapacity, name.c_str()));
+    joined_socket_inode = awaiting.socket_inode();
   }
   joined = true;
   return std::nullopt;
@@ -234,7 +226,10 @@ bool offered_on_this_host(const std::string& topic, const std::string& type_name
   static std::mutex mutex;  // one ServiceDiscovery for the process: it keeps a port with RouDi
   static iox::runtime::ServiceDiscovery* discovery = nullptr;
   std::lock_guard lock(mutex);
-  if (!discovery) discovery = new iox::runtime::ServiceDiscovery();  // lives as long as the process
+  if (!discovery) {
+    const AwaitingRoudi awaiting("asked for a service discovery port");
+    discovery = new iox::runtime::ServiceDiscovery();  // lives as long as the process
+  }
   bool found = false;
   discovery->findService(
       service.getServiceIDString(), service.getInstanceIDString(), service.getEventIDString(),

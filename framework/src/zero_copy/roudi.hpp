@@ -6,6 +6,7 @@
 #include <functional>
 #include <mutex>
 #include <optional>
+#include <stop_token>
 #include <string>
 #include <thread>
 
@@ -17,11 +18,36 @@ bool roudi_running();
 /// Registers this process with the host's RouDi as `name` (once per process: after a success,
 /// later calls return at once, whatever name they give). iceoryx itself would wait a minute for an
 /// absent RouDi and then abort, so this asks first. A RouDi that goes away before it answers (one
-/// that hung, killed by its monitor) ends the process at once, as end_process_on_iceoryx_error()
-/// says (without it: exit code 1, the reason on stderr).
+/// that hung, killed by its monitor) ends the process at once (AwaitingRoudi; without
+/// end_process_on_iceoryx_error(): exit code 1, the reason on stderr).
 /// @throws std::invalid_argument for a name iceoryx cannot take (empty, too long, with '/').
 /// @return nothing when registered, else why not (no RouDi, iox-roudi not installed).
 std::optional<std::string> join_roudi(const std::string& name);
+
+/// While it lives, this process waits for an answer of the RouDi it joined (before it joined: the
+/// one it is registering with). iceoryx 2.0 waits for good, and a RouDi that hung and was killed
+/// by its monitor never answers: from its own thread, this ends the process at once, as
+/// end_process_on_iceoryx_error() says, as soon as that RouDi's socket is gone, another or takes
+/// no message. Every request to RouDi is made under one: registration, a publisher or subscriber
+/// port, a wait-set's condition variable, service discovery.
+class AwaitingRoudi {
+ public:
+  /// `asking` completes "the RouDi this process ... went away", e.g. "asked for a publisher port".
+  explicit AwaitingRoudi(std::string asking);
+  AwaitingRoudi(const AwaitingRoudi&) = delete;
+  AwaitingRoudi& operator=(const AwaitingRoudi&) = delete;
+
+  /// The inode of the socket of the RouDi awaited.
+  unsigned long socket_inode() const { return inode_; }
+
+ private:
+  void watch(std::stop_token stop);
+
+  const std::string asking_;
+  const std::string socket_;
+  const unsigned long inode_;
+  std::jthread thread_;  // last: stopped and joined first
+};
 
 /// iceoryx 2.0 aborts the process on a fatal or severe error of its own (most often: the RouDi this
 /// process joined no longer answers a request for a publisher or subscriber). From this call on,
