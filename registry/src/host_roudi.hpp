@@ -37,6 +37,12 @@ class HostRoudi {
   /// a producer killed while it publishes, and another process asking for a port of the topic).
   static constexpr std::chrono::seconds kHungAfter{3};
 
+  /// True once, as of the last tick(), a RouDi listens on this host or starting one failed.
+  /// Modules started before that begin on DDS and move to shared memory only once one listens.
+  bool settled() const { return listening_said_ || foreign_said_ || failure_said_; }
+  /// How long a monitor holds its first launches back until settled().
+  static constexpr std::chrono::seconds kSettlePatience{5};
+
   /// How many RouDis it has started so far (a restart invalidates what processes that joined the
   /// one before hold: iceoryx 2.0 cannot re-register them).
   unsigned started() const { return started_; }

@@ -231,7 +231,22 @@ int main(int argc, char** argv) {
 #if OSCAR_ZERO_COPY
     std::optional<oscar::HostRoudi> roudi;  // the host's RouDi, for zero-copy cues
     if (system.zero_copy) roudi.emplace(system.zero_copy->chunks, log_dir);
+    // The first launches wait until the host's RouDi listens (at most kSettlePatience), so that
+    // modules begin in shared memory instead of moving there from DDS a moment later.
+    const auto patience_ends = Clock::now() + oscar::HostRoudi::kSettlePatience;
+    bool patience_over = false;
+    const auto await_roudi = [&] {
+      if (!roudi || patience_over || roudi->settled()) return false;
+      if (Clock::now() < patience_ends) return true;
+      patience_over = true;
+      spdlog::warn(
+          "RouDi does not listen {} s after the monitor started: starting modules anyway (their "
+          "plain cues go through DDS until it listens)",
+          oscar::HostRoudi::kSettlePatience.count());
+      return false;
+    };
 #else
+    const auto await_roudi = [] { return false; };
     if (system.zero_copy) spdlog::error("{}", oscar::zero_copy_unavailable().value_or(""));
 #endif
     // The heartbeat has a thread of its own: starting processes must not delay it.
@@ -267,7 +282,7 @@ int main(int argc, char** argv) {
       std::deque<oscar::LaunchRequest> batch;  // handled without holding the lock
       {
         std::lock_guard lock(mutex);
-        batch.swap(requests);
+        if (!await_roudi()) batch.swap(requests);
       }
       for (const auto& q : batch) {
         switch (q.kind()) {

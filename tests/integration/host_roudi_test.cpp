@@ -28,6 +28,7 @@ namespace {
 
 using namespace std::chrono_literals;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 template <class Condition>
 bool eventually(Condition condition, std::chrono::milliseconds timeout = 30s) {
@@ -339,6 +340,45 @@ modules:
   std::cout << kKills << " kills of the producer: RouDi was replaced "
             << count("started RouDi again") << " times, after hanging " << count(" hangs: ")
             << " times\n";
+}
+
+// A RouDi slow to listen (here: 2 s, less than the monitor's patience) holds the monitor's first
+// launches back, so that the booted modules begin in shared memory instead of moving there from
+// DDS a moment later.
+TEST(ZeroCopySystem, ModulesStartOnceTheHostsRouDiListens) {
+  if (!test::kNoPrivateTmp.empty())
+    GTEST_SKIP() << "needs a private mount namespace (root): " << test::kNoPrivateTmp;
+  std::filesystem::create_directories("/tmp/slow");
+  std::ofstream("/tmp/slow/iox-roudi") << "#!/bin/sh\nsleep 2\nexec /usr/bin/iox-roudi \"$@\"\n";
+  std::filesystem::permissions("/tmp/slow/iox-roudi", std::filesystem::perms::owner_all);
+  const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+  ::setenv("PATH", ("/tmp/slow:" + path).c_str(), 1);  // boot's monitor finds the slow one
+  test::BootedSystem sys("zc_slow", R"(
+system: zc_slow
+zero_copy: { chunks: 16 }
+modules:
+  - name: src
+    kernels: [ { type: bench_source, name: src, params: { type: PlainBool } } ]
+    mode: { continuous: 20ms }
+  - name: sink
+    kernels:
+      - { type: bench_sink, name: sink, params: { type: PlainBool }, inputs: { in: src/out } }
+    mode: single_step
+)");
+  ::setenv("PATH", path.c_str(), 1);
+  sys.wait_for([](const SystemState& st) {
+    const auto* m = test::entry(st, "sink");
+    const auto* k = m ? test::kernel_state(*m, "sink") : nullptr;
+    return st.state() == "running" && k && k->cycles() >= 5;
+  });
+  const auto monitor_log = read(sys.log_dir() + "/monitor-localhost.log");
+  const auto roudi_runs = monitor_log.find("RouDi runs");
+  ASSERT_NE(roudi_runs, std::string::npos) << monitor_log;
+  EXPECT_LT(roudi_runs, monitor_log.find("started src (")) << monitor_log;
+  EXPECT_LT(roudi_runs, monitor_log.find("started sink (")) << monitor_log;
+  const auto sink_log = read(sys.log_dir() + "/localhost/sink.log");
+  EXPECT_THAT(sink_log, HasSubstr("input sink/in: cues of src/out come zero-copy")) << sink_log;
+  EXPECT_THAT(sink_log, Not(HasSubstr("go through DDS only"))) << sink_log;
 }
 
 }  // namespace
