@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,21 @@ bool process_lives(pid_t pid) {
     if (thread_runs(task.path() / "stat")) return true;
   }
   return false;
+}
+
+std::vector<ino_t> inodes_mapped_from(const std::string& path) {
+  // Each line: address perms offset device inode path, with " (deleted)" after a removed file.
+  std::vector<ino_t> inodes;
+  std::ifstream maps("/proc/self/maps");
+  for (std::string line; std::getline(maps, line);) {
+    std::istringstream fields(line);
+    std::string address, perms, offset, device, name;
+    ino_t inode = 0;
+    if (fields >> address >> perms >> offset >> device >> inode >> name && name == path) {
+      inodes.push_back(inode);
+    }
+  }
+  return inodes;
 }
 
 sigset_t block_stop_signals() {

@@ -166,6 +166,25 @@ TEST_F(SharedMemoryDir, APortStaysWhileItsListenerLivesEvenWithoutItsLock) {
 
 // A test that shut its own system down sweeps that system's files only, at once: another
 // system's dead files still have their grace (senders may still write to them).
+TEST_F(SharedMemoryDir, APortFileIsCurrentWhileItIsTheFileThisProcessMaps) {
+  EXPECT_TRUE(maps_current_port_file(4711, dir_)) << "maps no such file: nothing to judge";
+  const auto path = dir_ / "fastrtps_port4711";
+  std::ofstream(path) << std::string(4096, 'x');
+  const int fd = open(path.c_str(), O_RDWR);
+  ASSERT_GE(fd, 0);
+  void* mapped = mmap(nullptr, 4096, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  close(fd);
+  ASSERT_NE(mapped, MAP_FAILED);
+  EXPECT_TRUE(maps_current_port_file(4711, dir_));
+  EXPECT_TRUE(maps_current_port_file(4712, dir_)) << "another port";
+  fs::remove(path);
+  EXPECT_FALSE(maps_current_port_file(4711, dir_)) << "removed";
+  std::ofstream(path) << "y";
+  EXPECT_FALSE(maps_current_port_file(4711, dir_)) << "another file of that name";
+  munmap(mapped, 4096);
+  EXPECT_TRUE(maps_current_port_file(4711, dir_));
+}
+
 TEST_F(SharedMemoryDir, WithAFilterOnlyTheNamedFilesAreLookedAt) {
   for (const auto* name : {"fastrtps_mine", "fastrtps_theirs"}) {
     touch(name);
@@ -452,6 +471,12 @@ TEST(ParticipantIdentity, AParticipantListensOnItsOwnSharedMemoryPort) {
   const int before = ours();
   DdsParticipant p(oscar::test::test_domain(), "own-port");
   EXPECT_EQ(ours(), before + 1);
+  // It names that port, and maps its file under the name maps_current_port_file() looks for.
+  const auto port = p.shared_memory_port();
+  ASSERT_TRUE(port);
+  EXPECT_EQ(internal::shared_memory_port_listener(*port), getpid());
+  EXPECT_TRUE(maps_current_port_file(*port));
+  EXPECT_FALSE(inodes_mapped_from(fmt::format("/dev/shm/fastrtps_port{}", *port)).empty());
 }
 
 }  // namespace

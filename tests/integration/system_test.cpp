@@ -2,11 +2,13 @@
 #include <signal.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <iterator>
 #include <string>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -141,6 +143,37 @@ TEST(Registry, KillNineRestartsTheModuleWithItsConfigurationAndWiring) {
            k->params().find("700ms") != std::string::npos &&
            !entry(st, "sink")->state().suspended();
   });
+}
+
+// A module whose shared-memory port file another process removed (systemd-logind's RemoveIPC,
+// an rm) goes on listening where no new sender looks: it ends, saying why, and its registry
+// starts it again, and a command from a sender new to it is answered.
+TEST(Registry, AModuleWhosePortFileWasRemovedEndsAndIsStartedAgain) {
+  BootedSystem sys("port_lost", kRestartable);
+  auto s = sys.running();
+  const auto old_pid = static_cast<std::uint32_t>(entry(s, "sink")->pid());
+  // Its port carries its pid (2^24 + pid * 16 + n); the module's participant is its only one.
+  std::vector<std::filesystem::path> ports;
+  for (std::uint32_t n = 0; n < 16; ++n) {
+    const auto port = std::filesystem::path(
+        fmt::format("/dev/shm/fastrtps_port{}", (1u << 24) + old_pid * 16 + n));
+    if (std::filesystem::exists(port)) ports.push_back(port);
+  }
+  ASSERT_EQ(ports.size(), 1u);
+  std::filesystem::remove(ports.front());
+  s = sys.wait_for([](const SystemState& st) {
+    return entry(st, "sink")->incarnation() == 2 && entry(st, "sink")->status() == "running" &&
+           st.state() == "running";
+  });
+  EXPECT_NE(entry(s, "sink")->pid(), old_pid);
+  std::ifstream log(sys.log_dir() + "/localhost/sink.log");
+  const std::string said(std::istreambuf_iterator<char>(log), {});
+  EXPECT_THAT(said, HasSubstr(fmt::format("stopping the module: its shared-memory port {} was "
+                                          "removed or replaced by another process",
+                                          ports.front().string())))
+      << said;
+  const auto reply = sys.configure("sink", CMD_SET_PARAM, {"sink", "log_every", "700ms"});
+  EXPECT_TRUE(reply.ok()) << reply.error();
 }
 
 TEST(Registry, ARestartedSourceNeitherRepeatsNorCorruptsItsCues) {

@@ -2,6 +2,7 @@
 /// @file One DDS participant per process, created with OSCAR's network profile, with cached
 /// topics and a map of the topic types discovery has seen (for clear type-mismatch errors).
 
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -45,6 +46,9 @@ class DdsParticipant {
   eprosima::fastdds::dds::Publisher& publisher() { return *publisher_; }
   eprosima::fastdds::dds::Subscriber& subscriber() { return *subscriber_; }
   int domain() const { return domain_; }
+  /// The shared-memory port this participant listens on (/dev/shm/fastrtps_port<N>); none
+  /// without the shared-memory transport.
+  std::optional<std::uint32_t> shared_memory_port() const;
   /// What a writer that could not be made on `topic` may be missing: under DDS Security, the
   /// permission of this participant's identity (" (identity 'module.a' of keystore K may not
   /// publish on it ...)"); "" for a plain participant.

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace oscar {
 
@@ -31,6 +32,10 @@ bool wait_for_stop(const sigset_t& signals, std::chrono::milliseconds timeout);
 /// files (and with them the locks of its shared memory): it lives until the last one is gone.
 /// A zombie whose parent has not reaped it yet is dead (kill(pid, 0) would still find it).
 bool process_lives(pid_t pid);
+
+/// The inodes of the files mapped into this process under `path` (/proc/self/maps), one per
+/// mapping; a file removed since is among them (the kernel keeps it while mapped).
+std::vector<ino_t> inodes_mapped_from(const std::string& path);
 
 /// Keeps freed cue memory (camera images of hundreds of KB) inside the process instead of handing
 /// it back to the kernel after each cue: large blocks come from the heap, not from a fresh mmap,

@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -50,6 +51,13 @@ class DeadSharedMemorySweeper {
 /// would remove them.) Returns how many files it removed.
 std::size_t remove_files_of_dead_processes(int domain,
                                            const std::filesystem::path& dir = "/dev/shm");
+
+/// Whether the port file `dir/fastrtps_port<port>` is still the one this process maps (its
+/// participant listens there). A file another process removed (systemd-logind's RemoveIPC at the
+/// end of the user's last session, an `rm`) or replaced leaves the listener waiting on a segment no
+/// sender finds: every process that opens the port from then on creates another one, unheard.
+/// True when this process maps no file of that name (nothing to judge).
+bool maps_current_port_file(std::uint32_t port, const std::filesystem::path& dir = "/dev/shm");
 
 /// Releases the process-shared mutexes in Fast DDS's port segments (files in `dir` whose names
 /// start with `prefix`) that a killed thread held.

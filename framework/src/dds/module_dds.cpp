@@ -6,6 +6,7 @@
 #include "oscar/malformed_samples.hpp"
 #include "oscar/raw_cdr_type.hpp"
 #include "oscar/security_files.hpp"
+#include "oscar/shared_memory.hpp"
 #include "oscar/topic_io.hpp"
 
 #include <unistd.h>
@@ -923,6 +924,23 @@ void Module::Dds::report_drops() {
   }
 }
 
+// Fast DDS's own replacement of a port it found unhealthy marks the old one, and its listener
+// moves to the new file within a second: only a file that stays lost for 3 looks counts.
+void Module::Dds::check_shared_memory_port() {
+  const auto port = participant_.shared_memory_port();
+  if (!port || maps_current_port_file(*port)) {
+    port_file_lost_looks_ = 0;
+    return;
+  }
+  if (++port_file_lost_looks_ < 3) return;
+  module_.end_for_restart(fmt::format(
+      "its shared-memory port /dev/shm/fastrtps_port{} was removed or replaced by another process "
+      "(systemd-logind's RemoveIPC does so at the end of the user's last session, see "
+      "docs/boot.md): a process that starts sending to it would never reach this module; the "
+      "registry starts it again",
+      *port));
+}
+
 // Commands are applied on their own thread, never inside a DDS callback: a rewire creates and
 // deletes readers, and activate waits for the processing thread.
 void Module::Dds::serve_config() {
@@ -930,6 +948,7 @@ void Module::Dds::serve_config() {
   const auto ready = [&] { return !serving_ || !queue_.empty() || !refollow_.empty(); };
   auto next_offer_poll = std::chrono::steady_clock::now();  // switch_to_offered()
   auto next_roudi_poll = std::chrono::steady_clock::now();  // join_roudi_later()
+  auto next_port_check = std::chrono::steady_clock::now() + std::chrono::seconds(1);
   while (true) {
     // Discovery is polled for raw inputs whose source has not shown up yet, RouDi for plain
     // inputs whose source it does not list yet; dropped commands are reported within a second.
@@ -943,6 +962,12 @@ void Module::Dds::serve_config() {
     if (!awaiting_type_.empty()) {
       lock.unlock();
       subscribe_discovered();
+      lock.lock();
+    }
+    if (std::chrono::steady_clock::now() >= next_port_check) {
+      next_port_check = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+      lock.unlock();
+      check_shared_memory_port();
       lock.lock();
     }
     if (roudi_later_ && std::chrono::steady_clock::now() >= next_roudi_poll) {

@@ -132,6 +132,9 @@ class Module::Dds {
   void follow_producer(InputPort& input, const std::string& source, const OutputOptions& offered);
   void refollow(const Refollow& r);
   void serve_config();
+  /// Every second (on the configuration thread): ends the module for a restart once its
+  /// shared-memory port file has not been the one it listens on for 3 looks in a row.
+  void check_shared_memory_port();
   void beat();
 
   Module& module_;
@@ -157,6 +160,7 @@ class Module::Dds {
   /// knows), under readers_mutex_.
   std::map<InputPort*, std::shared_ptr<void>> feeds_;
   std::vector<OutputPort*> chunked_outputs_;  ///< outputs given zero-copy chunks
+  int port_file_lost_looks_ = 0;              ///< check_shared_memory_port()'s looks in a row
   /// Ends the module when the RouDi it joined is replaced (zero_copy::RoudiWatch).
   std::shared_ptr<void> roudi_watch_;
 

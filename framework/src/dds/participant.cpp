@@ -313,6 +313,13 @@ DdsParticipant::DdsParticipant(int domain, const std::string& name, const Networ
   subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
 }
 
+std::optional<std::uint32_t> DdsParticipant::shared_memory_port() const {
+  for (const auto& l : participant_->get_qos().wire_protocol().default_unicast_locator_list) {
+    if (l.kind == LOCATOR_KIND_SHM) return l.port;
+  }
+  return std::nullopt;
+}
+
 std::string DdsParticipant::permission_hint(const std::string& topic) const {
   if (!security_) return "";
   return fmt::format(

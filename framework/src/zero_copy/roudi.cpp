@@ -10,10 +10,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <mutex>
 #include <optional>
-#include <sstream>
 #include <stdexcept>
 #include <stop_token>
 #include <thread>
@@ -38,21 +36,6 @@ std::string roudi_socket() {
 }
 
 std::string management_segment() { return std::string("/dev/shm/") + iox::roudi::SHM_NAME; }
-
-// The inode of the management segment this process has mapped (/proc/self/maps: address perms
-// offset device inode path, the path with " (deleted)" once unlinked); 0 if none.
-unsigned long mapped_inode(const std::string& segment) {
-  std::ifstream maps("/proc/self/maps");
-  std::string line;
-  while (std::getline(maps, line)) {
-    std::istringstream fields(line);
-    std::string address, perms, offset, device, path;
-    unsigned long inode = 0;
-    if (!(fields >> address >> perms >> offset >> device >> inode >> path)) continue;
-    if (path == segment) return inode;
-  }
-  return 0;
-}
 
 // The inode of file `path`; 0 if there is none.
 unsigned long inode_of(const std::string& path) {
@@ -186,7 +169,10 @@ void end_process_on_iceoryx_error(int exit_code,
 
 RoudiWatch::RoudiWatch(std::function<void(const std::string& why)> gone,
                        std::chrono::milliseconds period)
-    : gone_(std::move(gone)), period_(period), joined_inode_(mapped_inode(management_segment())) {
+    : gone_(std::move(gone)), period_(period), joined_inode_([] {
+        const auto mapped = inodes_mapped_from(management_segment());
+        return mapped.empty() ? 0 : mapped.front();
+      }()) {
   if (joined_inode_ == 0)
     throw std::runtime_error(
         fmt::format("this process maps no {}: it joined no RouDi", management_segment()));

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -126,6 +127,15 @@ std::size_t remove_files_of_dead_processes(int domain, const std::filesystem::pa
     }
   }
   return removed;
+}
+
+bool maps_current_port_file(std::uint32_t port, const std::filesystem::path& dir) {
+  const auto path = (dir / (kPort + std::to_string(port))).string();
+  const auto mapped = inodes_mapped_from(path);
+  if (mapped.empty()) return true;
+  struct stat now {};
+  return ::stat(path.c_str(), &now) == 0 &&
+         std::find(mapped.begin(), mapped.end(), now.st_ino) != mapped.end();
 }
 
 }  // namespace oscar
