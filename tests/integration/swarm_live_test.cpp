@@ -345,7 +345,8 @@ TEST_F(LiveSwarm, TheSnapshotDrawsTheRobotsTheirCommittedPathsAndJobs) {
   const auto robot = r.jobs()[0].robot();
   // The plan is published at most twice a second: the next one has the job.
   std::this_thread::sleep_for(700ms);
-  const auto s = snapshot({"-d", std::to_string(system_->domain())});
+  // (A loaded host under a sanitizer may take more than the default 3 s to find the coordinator.)
+  const auto s = snapshot({"-d", std::to_string(system_->domain()), "--timeout", "10"});
   ASSERT_EQ(s.exit_code, 0) << s.output;
   EXPECT_THAT(s.svg, HasSubstr(">drawn @+"));
   for (const std::string r_id : {"r1", "r2", "rn", "rs"}) {
@@ -370,6 +371,20 @@ TEST(SwarmSnapshot, WithoutACoordinatorItSaysSoAndExits2) {
   const auto s = snapshot({"-d", std::to_string(nobody.domain()), "--timeout", "0.5"});
   EXPECT_EQ(s.exit_code, 2);
   EXPECT_THAT(s.output, HasSubstr("no coordinator published a swarm plan on domain"));
+  EXPECT_TRUE(s.svg.empty());
+}
+
+// A coordinator that offers a plan but sends none (hung) is told apart from no coordinator.
+TEST(SwarmSnapshot, ACoordinatorThatSendsNoPlanIsNamedAsSuch) {
+  testing::FreeDomain domain;
+  DdsParticipant participant(domain.domain(), "test:hung_coordinator");
+  TopicWriter<SwarmPlan, SwarmPlanPubSubType> silent(participant, topics::swarm_plan());
+  const auto s = snapshot({"-d", std::to_string(domain.domain()), "--timeout", "1.5"});
+  EXPECT_EQ(s.exit_code, 2);
+  EXPECT_THAT(s.output, HasSubstr(fmt::format(
+                            "the coordinator on domain {} offers a swarm plan but sent none within "
+                            "3.0 s",
+                            domain.domain())));
   EXPECT_TRUE(s.svg.empty());
 }
 

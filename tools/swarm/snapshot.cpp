@@ -58,7 +58,9 @@ Polygon polygon_of(const SwarmArea& area) {
 }
 
 // The coordinator's newest plan (published transient local: it comes at once if there is one).
-std::optional<SwarmPlan> latest_plan(DdsParticipant& participant, std::chrono::milliseconds wait) {
+// A coordinator found within `wait` gets another `wait` to deliver it (discovery and a large
+// plan take their time on a loaded host). Throws if there is none.
+SwarmPlan latest_plan(DdsParticipant& participant, std::chrono::milliseconds wait) {
   std::mutex mutex;
   std::condition_variable arrived;
   std::optional<SwarmPlan> plan;
@@ -69,8 +71,20 @@ std::optional<SwarmPlan> latest_plan(DdsParticipant& participant, std::chrono::m
                                                        arrived.notify_all();
                                                      });
   std::unique_lock lock(mutex);  // released before the reader goes (its callback takes it)
-  arrived.wait_for(lock, wait, [&] { return plan.has_value(); });
-  return plan;
+  const auto has_plan = [&] { return plan.has_value(); };
+  if (arrived.wait_for(lock, wait, has_plan)) return *plan;
+  const double seconds = static_cast<double>(wait.count()) / 1000;
+  if (reader.matched() == 0) {
+    throw std::runtime_error(fmt::format(
+        "no coordinator published a swarm plan on domain {} within {:.1f} s (does the system "
+        "file have coordinator: swarm:?)",
+        participant.domain(), seconds));
+  }
+  if (arrived.wait_for(lock, wait, has_plan)) return *plan;
+  throw std::runtime_error(
+      fmt::format("the coordinator on domain {} offers a swarm plan but sent none within {:.1f} s "
+                  "(is it hung? `oscar ps` shows its state)",
+                  participant.domain(), 2 * seconds));
 }
 
 // The newest state of each of `robots` that publishes one within `wait`.
@@ -102,28 +116,22 @@ std::string snapshot_svg(const SnapshotOptions& o) {
   auto participant = o.system.participant("oscar-swarm-snapshot");
   const auto plan =
       latest_plan(*participant, std::chrono::milliseconds(static_cast<long>(o.timeout_s * 1000)));
-  if (!plan) {
-    throw std::runtime_error(fmt::format(
-        "no coordinator published a swarm plan on domain {} within {:.1f} s (does the system "
-        "file have coordinator: swarm:?)",
-        participant->domain(), o.timeout_s));
-  }
   // Where each robot is (robots publish at their rate; one silent for 2 s is drawn where its
   // committed path has it now).
   std::vector<std::string> robots;
-  for (const auto& path : plan->paths()) robots.push_back(path.robot());
+  for (const auto& path : plan.paths()) robots.push_back(path.robot());
   const auto states = robot_states(*participant, robots, std::chrono::milliseconds(2000));
   const auto now = wall_now();
   WorldPicture picture;
-  for (const auto& a : plan->static_obstacles()) picture.static_obstacles.push_back(polygon_of(a));
-  for (const auto& m : plan->moving_obstacles()) {
+  for (const auto& a : plan.static_obstacles()) picture.static_obstacles.push_back(polygon_of(a));
+  for (const auto& m : plan.moving_obstacles()) {
     if (m.path().empty()) continue;
     WorldPicture::MovingObstacle drawn{polygon_of(m.shape()), {}, position_at(m.path(), now)};
     for (const auto& w : m.path()) drawn.path.emplace_back(w.x(), w.y());
     picture.moving_obstacles.push_back(std::move(drawn));
   }
   std::size_t jobs_to_do = 0;
-  for (const auto& path : plan->paths()) {
+  for (const auto& path : plan.paths()) {
     WorldPicture::Robot r{path.robot(), {}, {}, std::nullopt, path.radius(), false};
     if (const auto s = states.find(path.robot()); s != states.end()) {
       r.now = Point(s->second.x(), s->second.y());
@@ -135,7 +143,7 @@ std::string snapshot_svg(const SnapshotOptions& o) {
     for (const auto& w : path.waypoints()) {
       if (w.t_ns() > now) r.path.emplace_back(w.x(), w.y());
     }
-    for (const auto& j : plan->jobs()) {
+    for (const auto& j : plan.jobs()) {
       const auto end = j.start_ns() + static_cast<std::int64_t>(j.duration_s() * 1e9);
       if (j.robot() != path.robot() || end <= now) continue;  // done since the plan came
       r.jobs.push_back(
@@ -148,7 +156,7 @@ std::string snapshot_svg(const SnapshotOptions& o) {
   picture.caption = {
       fmt::format("oscar swarm snapshot, {} robots, {} jobs to do: static obstacles (grey), moving "
                   "obstacles now and their path (orange, dashed),",
-                  plan->paths().size(), jobs_to_do),
+                  plan.paths().size(), jobs_to_do),
       "robots now (discs; red: broken down) with their committed paths from now on (colour), "
       "jobs (dots: id @ start in s from now)"};
   return world_svg(picture);
