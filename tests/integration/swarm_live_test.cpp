@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "booted_system.hpp"
 #include "oscar/coordinator/cue_feed.hpp"
@@ -27,6 +28,7 @@ namespace {
 
 using namespace std::chrono_literals;
 using test::job;
+using ::testing::Contains;
 using ::testing::HasSubstr;
 using Client = test::SwarmClient;
 
@@ -313,25 +315,68 @@ TEST_F(LiveSwarm, ConcurrentSubmissionsSeeEachOthersOpenTransactions) {
   EXPECT_GE(std::hypot(b.x() - 20, b.y() - 20), clearance) << "spot_2 lies where rs stands";
 }
 
-// Runs `oscar swarm snapshot` with `args`; its exit code, its output and the picture it drew.
-struct Snapshot {
+// Runs `oscar swarm ARGS...`: its exit code and its output (standard output and error).
+struct ToolRun {
   int exit_code = -1;
-  std::string output, svg;
+  std::string output;
+};
+ToolRun run_swarm_tool(std::vector<std::string> args) {
+  const auto log =
+      (std::filesystem::temp_directory_path() / fmt::format("swarm_tool_{}.log", getpid()))
+          .string();
+  args.insert(args.begin(), test::bin("oscar-swarm"));
+  test::Process p(args, log);
+  ToolRun run;
+  run.exit_code = p.wait(30s).value_or(-1);
+  run.output = p.output();
+  std::filesystem::remove(log);
+  return run;
+}
+
+// Runs `oscar swarm snapshot` with `args`; its exit code, its output and the picture it drew.
+struct Snapshot : ToolRun {
+  std::string svg;
 };
 Snapshot snapshot(std::vector<std::string> args) {
-  const auto dir = std::filesystem::temp_directory_path();
-  const auto file = (dir / fmt::format("swarm_snapshot_{}.svg", getpid())).string();
-  const auto log = (dir / fmt::format("swarm_snapshot_{}.log", getpid())).string();
-  args.insert(args.begin(), {test::bin("oscar-swarm"), "snapshot", "-o", file});
-  test::Process p(args, log);
-  Snapshot s;
-  s.exit_code = p.wait(30s).value_or(-1);
-  s.output = p.output();
+  const auto file =
+      (std::filesystem::temp_directory_path() / fmt::format("swarm_snapshot_{}.svg", getpid()))
+          .string();
+  args.insert(args.begin(), {"snapshot", "-o", file});
+  Snapshot s{run_swarm_tool(args), {}};
   std::ifstream in(file);
   s.svg.assign(std::istreambuf_iterator<char>(in), {});
   std::filesystem::remove(file);
-  std::filesystem::remove(log);
   return s;
+}
+
+// `oscar swarm status --json`: the robots in planning, the job committed and still to do, the
+// counts.
+TEST_F(LiveSwarm, TheStatusListsTheRobotsInPlanningAndTheJobsToDo) {
+  all_in_planning();
+  const auto id = client_->schedule(job("listed", 6, 3, 20, 60, 2));
+  const auto r = client_->outcome(id);
+  ASSERT_EQ(r.outcome(), SWARM_COMMITTED) << r.reason();
+  // The status is published every second and after each change: wait for the one with the job.
+  client_->status([](const SwarmStatus& s) { return s.jobs_committed() >= 1; }, "the job counted");
+  const auto run =
+      run_swarm_tool({"status", "--json", "-d", std::to_string(system_->domain()), "--timeout",
+                      "10"});  // (a loaded host under a sanitizer may need more than 3 s)
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const auto doc = nlohmann::json::parse(run.output.substr(run.output.find('{')));
+  const auto robots = doc.at("robots").get<std::vector<std::string>>();
+  for (const std::string robot : {"r1", "r2", "rn", "rs"}) {
+    EXPECT_THAT(robots, Contains(robot)) << run.output;
+  }
+  EXPECT_GE(doc.at("jobs_submitted").get<int>(), 1);
+  EXPECT_GE(doc.at("jobs_committed").get<int>(), 1);
+  bool listed = false;
+  for (const auto& j : doc.at("jobs")) {
+    if (j.at("id") != "listed") continue;
+    listed = true;
+    EXPECT_EQ(j.at("robot"), r.jobs()[0].robot());
+    EXPECT_GT(j.at("start_s").get<double>(), 0) << "its window opens 20 s from the submission";
+  }
+  EXPECT_TRUE(listed) << run.output;
 }
 
 // The picture of the running swarm: the robots where they are, labelled, the committed path of
@@ -374,18 +419,39 @@ TEST(SwarmSnapshot, WithoutACoordinatorItSaysSoAndExits2) {
   EXPECT_TRUE(s.svg.empty());
 }
 
-// A coordinator that offers a plan but sends none (hung) is told apart from no coordinator.
-TEST(SwarmSnapshot, ACoordinatorThatSendsNoPlanIsNamedAsSuch) {
+// Without a coordinator, the status says so.
+TEST(SwarmStatusCommand, WithoutACoordinatorItSaysSoAndExits2) {
+  testing::FreeDomain nobody;
+  const auto run =
+      run_swarm_tool({"status", "-d", std::to_string(nobody.domain()), "--timeout", "0.5"});
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.output, HasSubstr(fmt::format(
+                              "oscar swarm status: no coordinator published a swarm status on "
+                              "domain {} within 0.5 s",
+                              nobody.domain())));
+}
+
+// A coordinator that offers its topic but sends nothing (hung) is told apart from no
+// coordinator, by both commands that read the coordinator.
+TEST(SwarmSnapshot, ACoordinatorThatSendsNothingIsNamedAsSuch) {
   testing::FreeDomain domain;
   DdsParticipant participant(domain.domain(), "test:hung_coordinator");
-  TopicWriter<SwarmPlan, SwarmPlanPubSubType> silent(participant, topics::swarm_plan());
-  const auto s = snapshot({"-d", std::to_string(domain.domain()), "--timeout", "1.5"});
+  TopicWriter<SwarmPlan, SwarmPlanPubSubType> silent_plan(participant, topics::swarm_plan());
+  TopicWriter<SwarmStatus, SwarmStatusPubSubType> silent_status(participant,
+                                                                topics::swarm_status());
+  const auto d = std::to_string(domain.domain());
+  const auto s = snapshot({"-d", d, "--timeout", "1.5"});
   EXPECT_EQ(s.exit_code, 2);
-  EXPECT_THAT(s.output, HasSubstr(fmt::format(
-                            "the coordinator on domain {} offers a swarm plan but sent none within "
-                            "3.0 s",
-                            domain.domain())));
+  EXPECT_THAT(s.output, HasSubstr(fmt::format("oscar swarm snapshot: the coordinator on domain {} "
+                                              "offers a swarm plan but sent none within 3.0 s",
+                                              domain.domain())));
   EXPECT_TRUE(s.svg.empty());
+  const auto status = run_swarm_tool({"status", "-d", d, "--timeout", "1.5"});
+  EXPECT_EQ(status.exit_code, 2);
+  EXPECT_THAT(status.output,
+              HasSubstr(fmt::format("oscar swarm status: the coordinator on domain {} offers a "
+                                    "swarm status but sent none within 3.0 s",
+                                    domain.domain())));
 }
 
 // The placed job named `id` of a reply.

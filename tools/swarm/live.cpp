@@ -18,6 +18,7 @@
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
+#include "coordinator_topic.hpp"
 #include "oscar/input.hpp"
 #include "oscar/output.hpp"
 #include "oscar/swarm/problem.hpp"
@@ -244,22 +245,13 @@ int send_requests(const SystemOptions& system, const std::string& command,
 
 int run_status(const StatusOptions& o) {
   auto participant = o.system.participant("oscar-swarm-status");
-  std::mutex mutex;
-  std::condition_variable arrived;
   std::optional<SwarmStatus> status;
-  TopicReader<SwarmStatus, SwarmStatusPubSubType> reader(*participant, topics::swarm_status(),
-                                                         [&](const SwarmStatus& s, const auto&) {
-                                                           std::lock_guard lock(mutex);
-                                                           status = s;
-                                                           arrived.notify_all();
-                                                         });
-  std::unique_lock lock(mutex);
-  if (!arrived.wait_for(lock, std::chrono::milliseconds(static_cast<long>(o.timeout_s * 1000)),
-                        [&] { return status.has_value(); })) {
-    std::fprintf(stderr,
-                 "oscar swarm status: no coordinator published a swarm status on domain %d "
-                 "within %.1f s (does the system file have coordinator: swarm:?)\n",
-                 participant->domain(), o.timeout_s);
+  try {
+    status = newest_from_coordinator(
+        *participant, topics::swarm_status(),
+        std::chrono::milliseconds(static_cast<long>(o.timeout_s * 1000)), "swarm status");
+  } catch (const std::runtime_error& e) {
+    std::fprintf(stderr, "oscar swarm status: %s\n", e.what());
     return 2;
   }
   const auto& s = *status;

@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "coordinator_topic.hpp"
 #include "live.hpp"
 #include "oscar/input.hpp"
 #include "oscar/output.hpp"
@@ -57,36 +58,6 @@ Polygon polygon_of(const SwarmArea& area) {
   return make_polygon(points, "an obstacle of the coordinator's world");
 }
 
-// The coordinator's newest plan (published transient local: it comes at once if there is one).
-// A coordinator found within `wait` gets another `wait` to deliver it (discovery and a large
-// plan take their time on a loaded host). Throws if there is none.
-SwarmPlan latest_plan(DdsParticipant& participant, std::chrono::milliseconds wait) {
-  std::mutex mutex;
-  std::condition_variable arrived;
-  std::optional<SwarmPlan> plan;
-  TopicReader<SwarmPlan, SwarmPlanPubSubType> reader(participant, topics::swarm_plan(),
-                                                     [&](const SwarmPlan& p, const auto&) {
-                                                       std::lock_guard lock(mutex);
-                                                       plan = p;
-                                                       arrived.notify_all();
-                                                     });
-  std::unique_lock lock(mutex);  // released before the reader goes (its callback takes it)
-  const auto has_plan = [&] { return plan.has_value(); };
-  if (arrived.wait_for(lock, wait, has_plan)) return *plan;
-  const double seconds = static_cast<double>(wait.count()) / 1000;
-  if (reader.matched() == 0) {
-    throw std::runtime_error(fmt::format(
-        "no coordinator published a swarm plan on domain {} within {:.1f} s (does the system "
-        "file have coordinator: swarm:?)",
-        participant.domain(), seconds));
-  }
-  if (arrived.wait_for(lock, wait, has_plan)) return *plan;
-  throw std::runtime_error(
-      fmt::format("the coordinator on domain {} offers a swarm plan but sent none within {:.1f} s "
-                  "(is it hung? `oscar ps` shows its state)",
-                  participant.domain(), 2 * seconds));
-}
-
 // The newest state of each of `robots` that publishes one within `wait`.
 std::map<std::string, RobotState> robot_states(DdsParticipant& participant,
                                                const std::vector<std::string>& robots,
@@ -114,8 +85,9 @@ std::map<std::string, RobotState> robot_states(DdsParticipant& participant,
 
 std::string snapshot_svg(const SnapshotOptions& o) {
   auto participant = o.system.participant("oscar-swarm-snapshot");
-  const auto plan =
-      latest_plan(*participant, std::chrono::milliseconds(static_cast<long>(o.timeout_s * 1000)));
+  const auto plan = newest_from_coordinator(
+      *participant, topics::swarm_plan(),
+      std::chrono::milliseconds(static_cast<long>(o.timeout_s * 1000)), "swarm plan");
   // Where each robot is (robots publish at their rate; one silent for 2 s is drawn where its
   // committed path has it now).
   std::vector<std::string> robots;
