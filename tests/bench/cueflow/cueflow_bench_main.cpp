@@ -67,9 +67,10 @@ modules:
   return out;
 }
 
-nlohmann::json system_row(const std::string& system, const Row& r, const std::string& c,
-                          const Latency& l, std::size_t runs) {
-  return {{"system", system},     {"type", r.type},  {"bytes", r.bytes}, {"constellation", c},
+// `type`: the row's type as the bench names it (PlainBool in the zero-copy constellation).
+nlohmann::json system_row(const std::string& system, const std::string& type, const Row& r,
+                          const std::string& c, const Latency& l, std::size_t runs) {
+  return {{"system", system},     {"type", type},    {"bytes", r.bytes}, {"constellation", c},
           {"p50_us", l.p50},      {"p90_us", l.p90}, {"p99_us", l.p99},  {"max_us", l.max},
           {"samples", l.samples}, {"runs", runs}};
 }
@@ -248,9 +249,14 @@ int main(int argc, char** argv) {
         }
         for (const auto& peer : peers) {
           if (remote && !peer.remote) continue;  // a same-host mechanism
-          if (zero_copy) continue;               // the local rows have them
+          // Zero-copy: raw iceoryx is the baseline above; the floor reads its slot in place, the
+          // other peers are in the local rows.
+          const bool floor = peer.system == std::string("floor");
+          if (zero_copy && !floor) continue;
+          const auto args =
+              zero_copy ? std::vector<std::string>{"--in-place"} : std::vector<std::string>{};
           if (const auto l = remote ? bench.peer_remote(peer.program, r, *hosts)
-                                    : bench.program(peer.program, {}, r, multicore)) {
+                                    : bench.program(peer.program, args, r, multicore)) {
             peer_runs[peer.system].push_back(*l);
           } else {
             std::cerr << fmt::format("bench cueflow: {} {} {}: no report (logs in {})\n",
@@ -320,17 +326,21 @@ int main(int argc, char** argv) {
       auto add = [&](const std::string& system, const Latency& l, std::size_t runs,
                      const std::string& note) {
         if (system != "oscar") {  // OSCAR's row is above, with its ratio
-          auto row = system_row(system, r, c, l, runs);
+          auto row = system_row(system, type, r, c, l, runs);
           if (!note.empty()) row["config"] = note;
           rows.push_back(row);
         }
         peer_lines.push_back(fmt::format(
-            "{:<20} {:<13} {:>7} {:<10} {:>9.1f} {:>9.1f} {:>9.1f} {:>9.1f} {:>7.2f}  {}", system,
-            r.type, r.bytes, c, l.p50, l.p90, l.p99, l.max, ours.p50 > 0 ? l.p50 / ours.p50 : 0,
+            "{:<20} {:<17} {:>7} {:<15} {:>9.1f} {:>9.1f} {:>9.1f} {:>9.1f} {:>7.2f}  {}", system,
+            type, r.bytes, c, l.p50, l.p90, l.p99, l.max, ours.p50 > 0 ? l.p50 / ours.p50 : 0,
             note));
       };
       add("oscar", ours, ours_runs.size(), "");
-      add("fastdds", raw, raw_runs.size(), config);
+      if (zero_copy) {
+        add("iceoryx", raw, raw_runs.size(), "");
+      } else {
+        add("fastdds", raw, raw_runs.size(), config);
+      }
       for (const auto& peer : peers) {
         if (peer_runs.contains(peer.system)) {
           add(peer.system, median_of(peer_runs[peer.system]), peer_runs[peer.system].size(), "");
@@ -341,7 +351,7 @@ int main(int argc, char** argv) {
   if (json) {
     std::cout << nlohmann::json{{"rows", rows}}.dump() << "\n";
   } else if (all) {
-    std::cout << fmt::format("\n{:<20} {:<13} {:>7} {:<10} {:>9} {:>9} {:>9} {:>9} {:>7}  {}\n",
+    std::cout << fmt::format("\n{:<20} {:<17} {:>7} {:<15} {:>9} {:>9} {:>9} {:>9} {:>7}  {}\n",
                              "system", "type", "bytes", "constell.", "p50 us", "p90 us", "p99 us",
                              "max us", "/oscar", "config");
     for (const auto& line : peer_lines) std::cout << line << "\n";

@@ -69,7 +69,7 @@ class Segment {
   bool owner_ = false;
 };
 
-void subscribe(Slot& slot, std::size_t bytes, LatencyLog& log) {
+void subscribe(Slot& slot, std::size_t bytes, bool in_place, LatencyLog& log) {
   std::vector<unsigned char> copy(bytes);
   std::uint32_t seen = slot.seq.load();
   slot.subscriber_ready = 1;
@@ -81,20 +81,22 @@ void subscribe(Slot& slot, std::size_t bytes, LatencyLog& log) {
       continue;
     }
     seen = slot.seq.load(std::memory_order_acquire);
-    std::memcpy(copy.data(), slot.data, bytes);
+    if (!in_place) std::memcpy(copy.data(), slot.data, bytes);
     log.add(steady_ns() - slot.stamp_ns);
   }
 }
 
-void publish(Slot& slot, std::size_t bytes, const PeerOptions& o, const LatencyLog* log) {
+void publish(Slot& slot, std::size_t bytes, bool in_place, const PeerOptions& o,
+             const LatencyLog* log) {
   while (slot.subscriber_ready.load() == 0) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   const std::vector<unsigned char> payload(bytes, 0x80);
   Pacer pacer(o.period_us);
   for (int i = 1; i <= o.count && !(log && log->done()) && !stop_requested(); ++i) {
-    const auto stamp = steady_ns();  // before the copy: the floor is a copying transport
+    auto stamp = steady_ns();  // before the copy: the floor is a copying transport
     std::memcpy(slot.data, payload.data(), bytes);
+    if (in_place) stamp = steady_ns();  // the cue written where the subscriber reads it
     slot.stamp_ns = stamp;
     slot.seq.fetch_add(1, std::memory_order_release);
     futex(&slot.seq, FUTEX_WAKE, 1, nullptr);
@@ -108,6 +110,9 @@ int main(int argc, char** argv) {
   CLI::App app{"oscar-bench-floor: memcpy + futex floor for oscar bench cueflow"};
   PeerOptions o;
   add_peer_options(app, o);
+  bool in_place = false;
+  app.add_flag("--in-place", in_place,
+               "the zero-copy floor: stamped after the payload is in the slot, read in place");
   CLI11_PARSE(app, argc, argv);
   install_stop_handler();
   try {
@@ -116,12 +121,13 @@ int main(int argc, char** argv) {
                     o.mode != "pub");
     LatencyLog log(o);
     if (o.mode == "pub") {
-      publish(segment.slot(), bytes, o, nullptr);
+      publish(segment.slot(), bytes, in_place, o, nullptr);
       return 0;
     }
     std::thread publisher;
-    if (o.mode == "both") publisher = std::thread([&] { publish(segment.slot(), bytes, o, &log); });
-    subscribe(segment.slot(), bytes, log);
+    if (o.mode == "both")
+      publisher = std::thread([&] { publish(segment.slot(), bytes, in_place, o, &log); });
+    subscribe(segment.slot(), bytes, in_place, log);
     if (publisher.joinable()) publisher.join();
     log.write_report();
     return log.done() ? 0 : 1;
