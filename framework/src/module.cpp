@@ -155,16 +155,21 @@ void Module::wire_in_process() {
     }
   }
   // Triggers: a single-step kernel triggered by data runs when its trigger input gets a cue.
+  // The processing thread is woken after the lock is released: woken under it, it would only
+  // wait for the lock again (a second wake-up on the way of every cue).
   for (auto& s : slots_) {
     Slot* slot = s.get();
     for (auto& input : slot->instance->ports().inputs) {
       InputPort* port = input.get();
-      port->set_arrival_hook([this, slot, port] {
-        std::lock_guard lock(mutex_);
-        if (!slot->single_step()) return;
-        const auto& t = slot->mode.trigger;
-        const bool first_input = slot->instance->ports().inputs.front().get() == port;
-        if (t == "input:" + port->name() || (t.empty() && first_input)) mark_pending(*slot);
+      const bool first_input = slot->instance->ports().inputs.front().get() == port;
+      port->set_arrival_hook([this, slot, first_input, trigger = "input:" + port->name()] {
+        {
+          std::lock_guard lock(mutex_);
+          const auto& t = slot->mode.trigger;
+          if (!slot->single_step() || !(t == trigger || (t.empty() && first_input))) return;
+          slot->pending = true;
+        }
+        wake_.notify_all();
       });
     }
   }
