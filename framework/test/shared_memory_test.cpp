@@ -164,8 +164,7 @@ TEST_F(SharedMemoryDir, APortStaysWhileItsListenerLivesEvenWithoutItsLock) {
   EXPECT_TRUE(fs::is_empty(dir_));
 }
 
-// A test that shut its own system down sweeps that system's files only, at once: another
-// system's dead files still have their grace (senders may still write to them).
+// A process listens where new senders look while the port file of its name is the one it maps.
 TEST_F(SharedMemoryDir, APortFileIsCurrentWhileItIsTheFileThisProcessMaps) {
   EXPECT_TRUE(maps_current_port_file(4711, dir_)) << "maps no such file: nothing to judge";
   const auto path = dir_ / "fastrtps_port4711";
@@ -185,6 +184,36 @@ TEST_F(SharedMemoryDir, APortFileIsCurrentWhileItIsTheFileThisProcessMaps) {
   EXPECT_TRUE(maps_current_port_file(4711, dir_));
 }
 
+// The watch of a process's own port file says it is lost only after 3 looks in a row (Fast DDS
+// moves its listener off a port it replaced itself within a second), and names the file.
+TEST_F(SharedMemoryDir, APortFileWatchSaysLostAfterThreeLooksInARow) {
+  const auto path = dir_ / "fastrtps_port4711";
+  std::ofstream(path) << std::string(4096, 'x');
+  const int fd = open(path.c_str(), O_RDWR);
+  ASSERT_GE(fd, 0);
+  void* mapped = mmap(nullptr, 4096, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  close(fd);
+  ASSERT_NE(mapped, MAP_FAILED);
+  PortFileWatch watch(4711, dir_);
+  EXPECT_FALSE(watch.lost());
+  fs::create_hard_link(path, dir_ / "kept");
+  fs::remove(path);
+  EXPECT_FALSE(watch.lost()) << "1 look";
+  EXPECT_FALSE(watch.lost()) << "2 looks";
+  fs::rename(dir_ / "kept", path);  // the same file back: the count starts again
+  EXPECT_FALSE(watch.lost());
+  fs::remove(path);
+  EXPECT_FALSE(watch.lost()) << "1 look";
+  EXPECT_FALSE(watch.lost()) << "2 looks";
+  std::ofstream(path) << "y";  // another file of that name: still lost
+  EXPECT_EQ(watch.lost(), path.string()) << "3 looks";
+  munmap(mapped, 4096);
+  EXPECT_FALSE(watch.lost()) << "maps no file of that name any more: nothing to judge";
+  EXPECT_FALSE(PortFileWatch(std::nullopt, dir_).lost()) << "no shared-memory transport";
+}
+
+// A test that shut its own system down sweeps that system's files only, at once: another
+// system's dead files still have their grace (senders may still write to them).
 TEST_F(SharedMemoryDir, WithAFilterOnlyTheNamedFilesAreLookedAt) {
   for (const auto* name : {"fastrtps_mine", "fastrtps_theirs"}) {
     touch(name);

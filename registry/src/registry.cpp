@@ -30,7 +30,8 @@ Registry::Registry(const SystemSpec& system, DdsParticipant& participant, std::s
       recovering_(recovering),
       recovery_since_(Clock::now()),
       journal_file_(std::move(journal_file)),
-      wall_at_start_ns_(wall_now()) {
+      wall_at_start_ns_(wall_now()),
+      port_file_watch_(participant.shared_memory_port()) {
   for (const auto& m : system_.modules) {
     auto t = std::make_unique<Tracked>();
     t->spec = &m;
@@ -59,12 +60,13 @@ void Registry::stop() {
   wake_.notify_all();
 }
 
-void Registry::run() {
+bool Registry::run() {
   spdlog::info("registry: system '{}' with {} modules on {} hosts, domain {}{}", system_.name,
                modules_.size(), system_.hosts.size(), system_.domain,
                recovering_ ? "; recovering after a crash: adopting what the monitors run" : "");
   if (recovering_) message_ = "a registry before this one died: adopting what the monitors run";
   publish();
+  auto next_port_look = Clock::now() + std::chrono::seconds(1);
   std::unique_lock lock(mutex_);
   while (true) {
     wake_.wait_for(lock, std::chrono::milliseconds(10),
@@ -74,10 +76,23 @@ void Registry::run() {
     if (shutting_down_) break;
     lock.unlock();
     tick();
+    if (Clock::now() >= next_port_look) {
+      next_port_look = Clock::now() + std::chrono::seconds(1);
+      if (const auto lost = port_file_watch_.lost()) {
+        spdlog::error(
+            "registry: ending and leaving the system running: its shared-memory port {} was "
+            "removed or replaced by another process (systemd-logind's RemoveIPC does so at the "
+            "end of the user's last session, see docs/boot.md), so a process that starts from "
+            "now on could not reach it; boot starts another registry, which adopts the system",
+            *lost);
+        return false;
+      }
+    }
     lock.lock();
   }
   lock.unlock();
   shutdown();
+  return true;
 }
 
 void Registry::run_events(std::unique_lock<std::mutex>& lock) {

@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
         registry.stop();
       });
       try {
-        registry.run();
+        if (!registry.run()) code = oscar::kHandOverExit;
       } catch (const oscar::DomainInUse& e) {
         std::fprintf(stderr, "oscar-registry: %s\n", e.what());
         code = oscar::kDomainInUseExit;

@@ -213,6 +213,47 @@ TEST(RegistryDies, AKilledRegistryMidRestartFinishesTheRestart) {
   EXPECT_EQ(sys.shut_down(), 0) << sys.boot_output();
 }
 
+// A registry whose shared-memory port file another process removed (systemd-logind's RemoveIPC,
+// an rm) could no longer be reached by a process that starts later: it ends, leaving the system
+// running, and the registry boot starts in its place adopts it and restarts a module killed
+// afterwards (whose new process it hears).
+TEST(RegistryDies, ARegistryWhosePortFileWasRemovedHandsTheSystemToANewOne) {
+  BootedSystem sys("regdies_port", kThreeModules);
+  auto s = sys.running();
+  std::map<std::string, long> pids;
+  for (const auto& m : s.modules()) pids[m.name()] = m.pid();
+  const long old_registry = registry_pid(sys.file());
+  ASSERT_GT(old_registry, 0) << "no single oscar-registry process of " << sys.file();
+  // Its port carries its pid (2^24 + pid * 16 + n); the registry has one participant.
+  std::vector<std::filesystem::path> ports;
+  for (long n = 0; n < 16; ++n) {
+    const auto port = std::filesystem::path(
+        fmt::format("/dev/shm/fastrtps_port{}", (1L << 24) + old_registry * 16 + n));
+    if (std::filesystem::exists(port)) ports.push_back(port);
+  }
+  ASSERT_EQ(ports.size(), 1u);
+  std::filesystem::remove(ports.front());
+
+  s = sys.wait_for(recovered, 60s);
+  EXPECT_THAT(s.message(), HasSubstr("3 modules running were adopted, 0 started"));
+  EXPECT_NE(registry_pid(sys.file()), old_registry);
+  for (const auto& m : s.modules()) EXPECT_EQ(m.pid(), pids[m.name()]) << m.name();
+  EXPECT_THAT(boot_output_saying(sys, "restarting it"),
+              HasSubstr("registry died (exited with code 4): restarting it (1 of 5 in 60 s)"));
+  EXPECT_THAT(file_text(sys.log_dir() + "/registry.log"),
+              HasSubstr(fmt::format("registry: ending and leaving the system running: its "
+                                    "shared-memory port {} was removed or replaced",
+                                    ports.front().string())));
+
+  ASSERT_EQ(kill(static_cast<pid_t>(pids["sink"]), SIGKILL), 0);
+  s = sys.wait_for([](const SystemState& st) {
+    return entry(st, "sink")->incarnation() == 2 && entry(st, "sink")->status() == "running" &&
+           st.state() == "running";
+  });
+  EXPECT_EQ(module_processes(sys.file(), "sink"), std::vector<long>{entry(s, "sink")->pid()});
+  EXPECT_EQ(sys.shut_down(), 0) << sys.boot_output();
+}
+
 TEST(RegistryDies, BootGivesUpAfterFiveDeathsInAMinute) {
   BootedSystem sys("regdies_limit", kSlowRestart);
   const auto s = sys.running();

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,25 @@ std::size_t remove_files_of_dead_processes(int domain,
 /// sender finds: every process that opens the port from then on creates another one, unheard.
 /// True when this process maps no file of that name (nothing to judge).
 bool maps_current_port_file(std::uint32_t port, const std::filesystem::path& dir = "/dev/shm");
+
+/// Watches this process's own shared-memory port file (DdsParticipant::shared_memory_port()) with
+/// maps_current_port_file(). Fast DDS's own replacement of a port it found unhealthy marks the old
+/// file and moves its listener to the new one within a second, so only a file that stays lost for
+/// kLooks looks in a row counts.
+class PortFileWatch {
+ public:
+  static constexpr int kLooks = 3;
+  /// `port`: none without the shared-memory transport (nothing to watch).
+  explicit PortFileWatch(std::optional<std::uint32_t> port, std::filesystem::path dir = "/dev/shm");
+  /// One look (once a second): the port file's path once it has been lost for kLooks looks in a
+  /// row, otherwise none.
+  std::optional<std::string> lost();
+
+ private:
+  std::optional<std::uint32_t> port_;
+  std::filesystem::path dir_;
+  int lost_looks_ = 0;
+};
 
 /// Releases the process-shared mutexes in Fast DDS's port segments (files in `dir` whose names
 /// start with `prefix`) that a killed thread held.

@@ -924,21 +924,14 @@ void Module::Dds::report_drops() {
   }
 }
 
-// Fast DDS's own replacement of a port it found unhealthy marks the old one, and its listener
-// moves to the new file within a second: only a file that stays lost for 3 looks counts.
 void Module::Dds::check_shared_memory_port() {
-  const auto port = participant_.shared_memory_port();
-  if (!port || maps_current_port_file(*port)) {
-    port_file_lost_looks_ = 0;
-    return;
-  }
-  if (++port_file_lost_looks_ < 3) return;
+  const auto lost = port_file_watch_.lost();
+  if (!lost) return;
   module_.end_for_restart(fmt::format(
-      "its shared-memory port /dev/shm/fastrtps_port{} was removed or replaced by another process "
-      "(systemd-logind's RemoveIPC does so at the end of the user's last session, see "
-      "docs/boot.md): a process that starts sending to it would never reach this module; the "
-      "registry starts it again",
-      *port));
+      "its shared-memory port {} was removed or replaced by another process (systemd-logind's "
+      "RemoveIPC does so at the end of the user's last session, see docs/boot.md): a process that "
+      "starts sending to it would never reach this module; the registry starts it again",
+      *lost));
 }
 
 // Commands are applied on their own thread, never inside a DDS callback: a rewire creates and

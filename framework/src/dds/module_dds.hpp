@@ -26,6 +26,7 @@
 #include "module_slot.hpp"
 #include "oscar/dds_participant.hpp"
 #include "oscar/module.hpp"
+#include "oscar/shared_memory.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
 #include "oscar/type_texts.hpp"
@@ -160,7 +161,7 @@ class Module::Dds {
   /// knows), under readers_mutex_.
   std::map<InputPort*, std::shared_ptr<void>> feeds_;
   std::vector<OutputPort*> chunked_outputs_;  ///< outputs given zero-copy chunks
-  int port_file_lost_looks_ = 0;              ///< check_shared_memory_port()'s looks in a row
+  PortFileWatch port_file_watch_{participant_.shared_memory_port()};
   /// Ends the module when the RouDi it joined is replaced (zero_copy::RoudiWatch).
   std::shared_ptr<void> roudi_watch_;
 

@@ -138,4 +138,16 @@ bool maps_current_port_file(std::uint32_t port, const std::filesystem::path& dir
          std::find(mapped.begin(), mapped.end(), now.st_ino) != mapped.end();
 }
 
+PortFileWatch::PortFileWatch(std::optional<std::uint32_t> port, std::filesystem::path dir)
+    : port_(port), dir_(std::move(dir)) {}
+
+std::optional<std::string> PortFileWatch::lost() {
+  if (!port_ || maps_current_port_file(*port_, dir_)) {
+    lost_looks_ = 0;
+    return std::nullopt;
+  }
+  if (++lost_looks_ < kLooks) return std::nullopt;
+  return (dir_ / (kPort + std::to_string(*port_))).string();
+}
+
 }  // namespace oscar

@@ -22,6 +22,7 @@
 #include "oscar/config_client.hpp"
 #include "oscar/dds_participant.hpp"
 #include "oscar/registry/system_spec.hpp"
+#include "oscar/shared_memory.hpp"
 
 namespace oscar {
 
@@ -31,6 +32,9 @@ struct DomainInUse : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 inline constexpr int kDomainInUseExit = 3;
+/// What oscar-registry exits with when it ends leaving the system running, for a registry after
+/// it to take over (boot starts one with --recover): see Registry::run().
+inline constexpr int kHandOverExit = 4;
 
 class Registry {
  public:
@@ -47,10 +51,13 @@ class Registry {
   Registry& operator=(const Registry&) = delete;
 
   /// Boots the system and keeps it running until a shutdown request (or stop()); then stops the
-  /// modules in reverse order and tells the monitors to exit.
+  /// modules in reverse order, tells the monitors to exit and returns true. Returns false,
+  /// leaving the system running for a registry after it, once its shared-memory port file has
+  /// been removed or replaced by another process (PortFileWatch): a process that starts from
+  /// then on (a restarted module, a tool) would send it nothing it hears.
   /// @throws DomainInUse if another system's processes show on the domain before the first
   ///         module would start (see other_systems_on_domain()).
-  void run();
+  bool run();
   /// Asks run() to shut the system down and return (thread-safe).
   void stop();
 
@@ -135,6 +142,7 @@ class Registry {
   int started_in_recovery_ = 0;     // modules no monitor ran when recovering
   bool shutting_down_ = false;
   bool launched_any_ = false;
+  PortFileWatch port_file_watch_;  // looked at once a second by run()
   Clock::time_point last_publish_{};
 
   std::mutex mutex_;
