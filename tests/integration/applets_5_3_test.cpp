@@ -110,9 +110,9 @@ TEST(Applets53, TheLiveSystemFollowsTheHoldersOfAbb54StepByStep) {
   s.wait_module("battery", "continuous");
   // `oscar applets graph` draws this plan: who holds what, and what the docking controller needs.
   const auto svg = test::temp_path("applets_5_3") + ".svg";
-  test::Process graph(
-      {test::bin("oscar-applets"), "graph", "-o", svg, "-d", std::to_string(s.sys.domain())},
-      test::temp_path("applets_5_3_graph") + ".out");
+  test::Process graph({test::bin("oscar-applets"), "graph", "-o", svg, "-d",
+                       std::to_string(s.sys.domain()), "--timeout", "10"},
+                      test::temp_path("applets_5_3_graph") + ".out");
   ASSERT_EQ(graph.wait(std::chrono::seconds(30)), 0) << graph.output();
   std::stringstream dot;
   dot << std::ifstream(svg + ".dot").rdbuf();

@@ -10,6 +10,7 @@
 #include <optional>
 #include <sstream>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -72,9 +73,9 @@ TEST(Coordinator, AHigherPriorityPreemptsAndTheOldHoldersCommandIsRefusedNamingT
                "service 'Camera': it is held by 'high'"));
 
   // oscar applets ps --json shows the holder, the access and who waits.
-  test::Process ps(
-      {test::bin("oscar-applets"), "ps", "--json", "-d", std::to_string(c.sys.domain())},
-      test::temp_path("coord_ps") + ".out");
+  test::Process ps({test::bin("oscar-applets"), "ps", "--json", "-d",
+                    std::to_string(c.sys.domain()), "--timeout", "10"},
+                   test::temp_path("coord_ps") + ".out");
   ASSERT_EQ(ps.wait(std::chrono::seconds(30)), 0) << ps.output();
   const auto j = nlohmann::json::parse(ps.output());
   EXPECT_EQ(j["services"]["Camera"]["holders"], nlohmann::json::array({"high"}));
@@ -221,9 +222,9 @@ TEST(RemoteApplet, AcquiresTheServiceAndItsCommandReachesTheModuleThenReleasesIt
   // Its command went over DDS to the coordinator, which forwarded it to the framegrabber.
   EXPECT_TRUE(c.logged("applet high: frame mode -> half"));
 
-  test::Process ps(
-      {test::bin("oscar-applets"), "ps", "--json", "-d", std::to_string(c.sys.domain())},
-      test::temp_path("remote_ps") + ".out");
+  test::Process ps({test::bin("oscar-applets"), "ps", "--json", "-d",
+                    std::to_string(c.sys.domain()), "--timeout", "10"},
+                   test::temp_path("remote_ps") + ".out");
   ASSERT_EQ(ps.wait(std::chrono::seconds(30)), 0) << ps.output();
   const auto j = nlohmann::json::parse(ps.output());
   ASSERT_EQ(j["applets"].size(), 2u);
@@ -427,6 +428,20 @@ coordinator:
     return k && k->mode() == "single_step" && k->cycles() >= 5;
   });
   EXPECT_THAT(sys.boot_output(), ::testing::Not(HasSubstr("refused")));
+}
+
+// `oscar applets ps` tells a coordinator that offers its plan but sends none (hung) from none.
+TEST(Coordinator, AppletsPsNamesACoordinatorThatSendsNoPlan) {
+  testing::FreeDomain domain;
+  DdsParticipant participant(domain.domain(), "test:hung_coordinator");
+  TopicWriter<AppletPlan, AppletPlanPubSubType> silent(participant, topics::applet_plan());
+  test::Process ps(
+      {test::bin("oscar-applets"), "ps", "-d", std::to_string(domain.domain()), "--timeout", "1.5"},
+      test::temp_path("hung_ps") + ".out");
+  EXPECT_EQ(ps.wait(std::chrono::seconds(30)), 1) << ps.output();
+  EXPECT_THAT(ps.output(), HasSubstr(fmt::format("oscar applets: the coordinator on domain {} "
+                                                 "offers its plan but sent none within 3.0 s",
+                                                 domain.domain())));
 }
 
 }  // namespace

@@ -2,13 +2,12 @@
 // system's coordinator (docs/coordinator.md).
 #include "ps.hpp"
 
-#include <condition_variable>
 #include <cstdio>
-#include <mutex>
 #include <optional>
 
 #include "oscar/applets/dot.hpp"
 #include "oscar/coordinator/plan_json.hpp"
+#include "oscar/newest_sample.hpp"
 #include "oscar/registry/system_options.hpp"
 #include "oscar/topic_io.hpp"
 #include "oscar/topics.hpp"
@@ -30,24 +29,20 @@ namespace {
 // The plan the coordinator publishes, or nothing (and a message) if none arrives in time.
 std::optional<AppletPlan> live_plan(const SystemOptions& tool, double timeout_s, const char* who) {
   auto participant = tool.participant(who);
-  std::mutex mutex;
-  std::condition_variable arrived;
-  std::optional<AppletPlan> plan;
-  TopicReader<AppletPlan, AppletPlanPubSubType> reader(*participant, topics::applet_plan(),
-                                                       [&](const AppletPlan& p, const auto&) {
-                                                         std::lock_guard lock(mutex);
-                                                         plan = p;
-                                                         arrived.notify_all();
-                                                       });
-  std::unique_lock lock(mutex);
-  const auto timeout = std::chrono::milliseconds(static_cast<long>(timeout_s * 1000));
-  if (!arrived.wait_for(lock, timeout, [&] { return plan.has_value(); })) {
+  auto found = newest_sample(*participant, topics::applet_plan(),
+                             std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));
+  if (!found.writer_found) {
     std::fprintf(stderr,
                  "oscar applets: no coordinator published its plan on domain %d within %.1f s "
                  "(does the system file have a coordinator: section?)\n",
                  participant->domain(), timeout_s);
+  } else if (!found.sample) {
+    std::fprintf(stderr,
+                 "oscar applets: the coordinator on domain %d offers its plan but sent none "
+                 "within %.1f s (is it hung? `oscar ps` shows its state)\n",
+                 participant->domain(), 2 * timeout_s);
   }
-  return plan;
+  return std::move(found.sample);
 }
 
 }  // namespace
