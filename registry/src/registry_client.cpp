@@ -66,6 +66,15 @@ std::optional<SystemState> RegistryClient::wait_for(
   return std::nullopt;
 }
 
+std::optional<SystemState> RegistryClient::current_state(std::chrono::milliseconds wait) {
+  const auto any = [](const SystemState&) { return true; };
+  auto s = wait_for(any, wait);
+  if (!s && registry_found()) s = wait_for(any, wait);
+  return s;
+}
+
+bool RegistryClient::registry_found() const { return io_->states.matched() > 0; }
+
 std::optional<SystemState> RegistryClient::latest() {
   std::lock_guard lock(mutex_);
   return latest_;

@@ -18,6 +18,8 @@
 #include "oscar/registry/running_systems.hpp"
 #include "oscar/testing/eventually.hpp"
 #include "oscar/time.hpp"
+#include "oscar/topic_io.hpp"
+#include "oscar/topics.hpp"
 
 namespace oscar {
 namespace {
@@ -313,6 +315,22 @@ std::optional<int> ps(std::string& output) {
   const auto code = p.wait(20s);
   output = p.output();
   return code;
+}
+
+// A registry that is found but sends no state (hung) is named as such, apart from none at all.
+TEST(Tools, PsAndGraphNameARegistryThatSendsNoState) {
+  testing::FreeDomain domain;
+  DdsParticipant participant(domain.domain(), "test:hung_registry");
+  TopicWriter<SystemState, SystemStatePubSubType> silent(participant, topics::system_state());
+  for (const std::string tool : {"oscar-ps", "oscar-graph"}) {
+    test::Process p({test::bin(tool), "-d", std::to_string(domain.domain()), "--timeout", "1.5"},
+                    test::temp_path(tool + "_hung_registry.log"));
+    EXPECT_EQ(p.wait(30s), 1) << p.output();
+    EXPECT_THAT(p.output(), HasSubstr(fmt::format("{}: the registry on domain {} sent no state "
+                                                  "within 3",
+                                                  tool == "oscar-ps" ? "oscar ps" : "oscar graph",
+                                                  domain.domain())));
+  }
 }
 
 TEST(Tools, FindTheSystemBootedOnThisMachineWithoutFlagsAndAskWhenThereAreSeveral) {

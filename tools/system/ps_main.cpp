@@ -154,8 +154,15 @@ int main(int argc, char** argv) {
     auto participant = tool.participant("oscar-ps");
     HostClocks host_clocks(*participant);
     oscar::RegistryClient client(*participant, "ps");
-    const auto s = client.wait_for([](const oscar::SystemState&) { return true; },
-                                   std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));
+    const auto s =
+        client.current_state(std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));
+    if (!s && client.registry_found()) {
+      std::fprintf(stderr,
+                   "oscar ps: the registry on domain %d sent no state within %.1f s (is it hung? "
+                   "its log is registry.log in the system's log folder)\n",
+                   participant->domain(), 2 * timeout_s);
+      return 1;
+    }
     if (!s) {
       std::fprintf(stderr, "oscar ps: no registry answered on domain %d within %.1f s%s\n",
                    participant->domain(), timeout_s,

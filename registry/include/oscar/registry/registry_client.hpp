@@ -28,6 +28,12 @@ class RegistryClient {
   /// The newest state that satisfies `pred`, once one arrives within `timeout`.
   std::optional<SystemState> wait_for(const std::function<bool(const SystemState&)>& pred,
                                       std::chrono::milliseconds timeout);
+  /// The system state as a tool reads it once: waits up to `wait`; a registry found by then (its
+  /// state writer discovered) gets as long again to send it, since on a loaded host discovery
+  /// takes a while. None if nothing came (registry_found() tells why).
+  std::optional<SystemState> current_state(std::chrono::milliseconds wait);
+  /// Whether a registry's state writer has been discovered.
+  bool registry_found() const;
   /// The newest state seen so far.
   std::optional<SystemState> latest();
   /// Sends a request and waits for the registry's answer.
