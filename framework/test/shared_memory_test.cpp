@@ -45,6 +45,16 @@ class SharedMemoryDir : public testing::Test {
     ASSERT_EQ(flock(fd, LOCK_EX | LOCK_NB), 0);
     held_.push_back(fd);
   }
+  // Maps 4 KB of a new file `dir_/name` as a participant maps its port; unmapped at the end.
+  void* map_new_file(const std::string& name) {
+    std::ofstream(dir_ / name) << std::string(4096, 'x');
+    const int fd = open((dir_ / name).c_str(), O_RDWR);
+    EXPECT_GE(fd, 0);
+    void* mapped = mmap(nullptr, 4096, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+    close(fd);
+    EXPECT_NE(mapped, MAP_FAILED);
+    return mapped;
+  }
   fs::path dir_;
   std::vector<int> held_;
 };
@@ -168,12 +178,7 @@ TEST_F(SharedMemoryDir, APortStaysWhileItsListenerLivesEvenWithoutItsLock) {
 TEST_F(SharedMemoryDir, APortFileIsCurrentWhileItIsTheFileThisProcessMaps) {
   EXPECT_TRUE(maps_current_port_file(4711, dir_)) << "maps no such file: nothing to judge";
   const auto path = dir_ / "fastrtps_port4711";
-  std::ofstream(path) << std::string(4096, 'x');
-  const int fd = open(path.c_str(), O_RDWR);
-  ASSERT_GE(fd, 0);
-  void* mapped = mmap(nullptr, 4096, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
-  close(fd);
-  ASSERT_NE(mapped, MAP_FAILED);
+  void* mapped = map_new_file(path.filename());
   EXPECT_TRUE(maps_current_port_file(4711, dir_));
   EXPECT_TRUE(maps_current_port_file(4712, dir_)) << "another port";
   fs::remove(path);
@@ -188,12 +193,7 @@ TEST_F(SharedMemoryDir, APortFileIsCurrentWhileItIsTheFileThisProcessMaps) {
 // moves its listener off a port it replaced itself within a second), and names the file.
 TEST_F(SharedMemoryDir, APortFileWatchSaysLostAfterThreeLooksInARow) {
   const auto path = dir_ / "fastrtps_port4711";
-  std::ofstream(path) << std::string(4096, 'x');
-  const int fd = open(path.c_str(), O_RDWR);
-  ASSERT_GE(fd, 0);
-  void* mapped = mmap(nullptr, 4096, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
-  close(fd);
-  ASSERT_NE(mapped, MAP_FAILED);
+  void* mapped = map_new_file(path.filename());
   PortFileWatch watch(4711, dir_);
   EXPECT_FALSE(watch.lost());
   fs::create_hard_link(path, dir_ / "kept");
