@@ -18,6 +18,9 @@ struct Latency {
   long samples = 0;
   long gaps = 0;      ///< cues missing between two that arrived (0 where the report does not say)
   double span_s = 0;  ///< from the first to the last measured cue (0 where not said)
+  /// bench_sink's only: from the stamp to the kernel's process() that reads the cue, the
+  /// delivery plus the hand-over to the module's processing thread (0 where not said).
+  double process_p50 = 0, process_p90 = 0;
   /// The rate the measured cues came at (0 without a span).
   double rate_hz() const { return span_s > 0 ? static_cast<double>(samples - 1) / span_s : 0; }
 };
@@ -29,6 +32,10 @@ inline Latency parse_report(const nlohmann::json& j) {
   Latency l{d.at("p50"), d.at("p90"), d.value("p99", 0.0), d.at("max"), j.at("samples")};
   l.gaps = j.value("gaps", 0L);
   l.span_s = j.value("span_s", 0.0);
+  if (const auto p = j.find("process_us"); p != j.end()) {
+    l.process_p50 = p->at("p50");
+    l.process_p90 = p->at("p90");
+  }
   return l;
 }
 
@@ -39,16 +46,21 @@ inline double median(std::vector<double> v) {
 
 /// The median of each figure over repeated runs; samples are summed.
 inline Latency median_of(const std::vector<Latency>& runs) {
-  std::vector<double> p50, p90, p99, max;
+  std::vector<double> p50, p90, p99, max, process_p50, process_p90;
   long samples = 0;
   for (const auto& r : runs) {
     p50.push_back(r.p50);
     p90.push_back(r.p90);
     p99.push_back(r.p99);
     max.push_back(r.max);
+    process_p50.push_back(r.process_p50);
+    process_p90.push_back(r.process_p90);
     samples += r.samples;
   }
-  return {median(p50), median(p90), median(p99), median(max), samples};
+  Latency m{median(p50), median(p90), median(p99), median(max), samples};
+  m.process_p50 = median(process_p50);
+  m.process_p90 = median(process_p90);
+  return m;
 }
 
 /// The raw Fast DDS configurations the bench tries: delivery, publish mode, transport.

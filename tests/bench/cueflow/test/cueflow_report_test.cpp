@@ -1,5 +1,6 @@
 // The arithmetic of `oscar bench cueflow` (cueflow_report.hpp and peer_common.hpp) and the
 // Cyclone peer's reach (cyclone_reach.hpp), no timing.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -25,6 +26,23 @@ TEST(CueflowReport, ReadsAReportWithoutP99AsZero) {
   const auto l = parse_report(
       nlohmann::json::parse(R"({"samples":5,"delivery_us":{"p50":1,"p90":2,"max":3}})"));
   EXPECT_DOUBLE_EQ(l.p99, 0);
+  EXPECT_DOUBLE_EQ(l.process_p50, 0) << "only bench_sink's report has it";
+}
+
+// bench_sink also says when process() read each cue: the hand-over to the processing thread.
+TEST(CueflowReport, ReadsBenchSinksProcessLatencyAndMediansIt) {
+  const auto sink = [](double p50) {
+    return parse_report(nlohmann::json::parse(
+        fmt::format(R"({{"samples":5,"delivery_us":{{"p50":1,"p90":2,"max":3}},)"
+                    R"("process_us":{{"p50":{},"p90":{},"max":40}}}})",
+                    p50, 2 * p50)));
+  };
+  const auto l = sink(7.5);
+  EXPECT_DOUBLE_EQ(l.process_p50, 7.5);
+  EXPECT_DOUBLE_EQ(l.process_p90, 15);
+  const auto m = median_of({sink(9), sink(3), sink(6)});
+  EXPECT_DOUBLE_EQ(m.process_p50, 6);
+  EXPECT_DOUBLE_EQ(m.process_p90, 12);
 }
 
 TEST(CueflowReport, MediansEachFigureOverRunsAndSumsSamples) {
