@@ -351,13 +351,18 @@ Snapshot snapshot(std::vector<std::string> args) {
 
 // `oscar swarm status --json`: the robots in planning, the job committed and still to do, the
 // counts.
-TEST_F(LiveSwarm, TheStatusListsTheRobotsInPlanningAndTheJobsToDo) {
+TEST_F(LiveSwarm, TheStatusListsTheRobotsInPlanningAndTheJobsAhead) {
   all_in_planning();
   const auto id = client_->schedule(job("listed", 6, 3, 20, 60, 2));
   const auto r = client_->outcome(id);
   ASSERT_EQ(r.outcome(), SWARM_COMMITTED) << r.reason();
   // The status is published every second and after each change: wait for the one with the job.
-  client_->status([](const SwarmStatus& s) { return s.jobs_committed() >= 1; }, "the job counted");
+  client_->status(
+      [](const SwarmStatus& s) {
+        return std::any_of(s.jobs().begin(), s.jobs().end(),
+                           [](const auto& j) { return j.id() == "listed"; });
+      },
+      "the job listed");
   const auto run =
       run_swarm_tool({"status", "--json", "-d", std::to_string(system_->domain()), "--timeout",
                       "10"});  // (a loaded host under a sanitizer may need more than 3 s)
