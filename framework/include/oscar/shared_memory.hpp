@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include <sys/types.h>
+
 namespace oscar {
 
 /// Removes the shared-memory segments and ports of Fast DDS processes that are gone (those whose
@@ -60,10 +62,10 @@ std::size_t remove_files_of_dead_processes(int domain,
 /// True when this process maps no file of that name (nothing to judge).
 bool maps_current_port_file(std::uint32_t port, const std::filesystem::path& dir = "/dev/shm");
 
-/// Watches this process's own shared-memory port file (DdsParticipant::shared_memory_port()) with
-/// maps_current_port_file(). Fast DDS's own replacement of a port it found unhealthy marks the old
-/// file and moves its listener to the new one within a second, so only a file that stays lost for
-/// kLooks looks in a row counts.
+/// Watches this process's own shared-memory port file (DdsParticipant::shared_memory_port()) as
+/// maps_current_port_file() judges it. Fast DDS's own replacement of a port it found unhealthy
+/// marks the old file and moves its listener to the new one within a second, so only a file that
+/// stays lost for kLooks looks in a row counts.
 class PortFileWatch {
  public:
   static constexpr int kLooks = 3;
@@ -77,6 +79,7 @@ class PortFileWatch {
   std::optional<std::uint32_t> port_;
   std::filesystem::path dir_;
   int lost_looks_ = 0;
+  std::optional<ino_t> confirmed_;  // the port file's inode this process mapped at the last look
 };
 
 /// Releases the process-shared mutexes in Fast DDS's port segments (files in `dir` whose names

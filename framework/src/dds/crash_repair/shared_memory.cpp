@@ -129,25 +129,44 @@ std::size_t remove_files_of_dead_processes(int domain, const std::filesystem::pa
   return removed;
 }
 
+namespace {
+// Whether the file at `path` (its stat in `now`, if `there`) is one of those in `mapped`.
+bool is_mapped(const std::vector<ino_t>& mapped, bool there, const struct stat& now) {
+  return there && std::find(mapped.begin(), mapped.end(), now.st_ino) != mapped.end();
+}
+}  // namespace
+
 bool maps_current_port_file(std::uint32_t port, const std::filesystem::path& dir) {
   const auto path = (dir / (kPort + std::to_string(port))).string();
   const auto mapped = inodes_mapped_from(path);
-  if (mapped.empty()) return true;
   struct stat now {};
-  return ::stat(path.c_str(), &now) == 0 &&
-         std::find(mapped.begin(), mapped.end(), now.st_ino) != mapped.end();
+  const bool there = ::stat(path.c_str(), &now) == 0;
+  return mapped.empty() || is_mapped(mapped, there, now);
 }
 
 PortFileWatch::PortFileWatch(std::optional<std::uint32_t> port, std::filesystem::path dir)
     : port_(port), dir_(std::move(dir)) {}
 
 std::optional<std::string> PortFileWatch::lost() {
-  if (!port_ || maps_current_port_file(*port_, dir_)) {
+  if (!port_) return std::nullopt;
+  const auto path = (dir_ / (kPort + std::to_string(*port_))).string();
+  struct stat now {};
+  const bool there = ::stat(path.c_str(), &now) == 0;
+  // While the file at the path is the one found mapped at the last look, nothing changed:
+  // /proc/self/maps (hundreds of lines in a module) is read only when the file did.
+  if (there && confirmed_ && now.st_ino == *confirmed_) {
+    lost_looks_ = 0;
+    return std::nullopt;
+  }
+  const auto mapped = inodes_mapped_from(path);
+  confirmed_.reset();
+  if (is_mapped(mapped, there, now)) confirmed_ = now.st_ino;
+  if (mapped.empty() || confirmed_) {
     lost_looks_ = 0;
     return std::nullopt;
   }
   if (++lost_looks_ < kLooks) return std::nullopt;
-  return (dir_ / (kPort + std::to_string(*port_))).string();
+  return path;
 }
 
 }  // namespace oscar
