@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 
@@ -12,8 +13,9 @@
 
 namespace oscar::test {
 
-inline double cpu_seconds(long pid) {
-  const auto stat = proc_file(pid, "stat");
+namespace internal {
+// User + system time from a /proc/<pid>/stat text, in seconds; 0 if there is none.
+inline double stat_cpu_seconds(const std::string& stat) {
   const auto after_name = stat.rfind(')');  // the name may hold spaces and parentheses
   if (after_name == std::string::npos) return 0;
   std::istringstream fields(stat.substr(after_name + 2));
@@ -24,6 +26,33 @@ inline double cpu_seconds(long pid) {
     if (i == 15) stime = std::stoull(field);
   }
   return static_cast<double>(utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
+}
+}  // namespace internal
+
+inline double cpu_seconds(long pid) { return internal::stat_cpu_seconds(proc_file(pid, "stat")); }
+
+/// What a program costs the machine, summed over its processes running now (their own time, not
+/// that of children they waited for: a daemon's would hold every earlier session's).
+struct ProgramCpu {
+  double seconds = 0;  ///< user + system
+  int processes = 0;
+};
+
+/// The CPU of every process running now whose name (its `comm`) `counts`, by name.
+template <class Predicate>
+std::map<std::string, ProgramCpu> cpu_by_program(Predicate counts) {
+  std::map<std::string, ProgramCpu> by_name;
+  for (const long pid : listed_pids()) {
+    const auto stat = proc_file(pid, "stat");
+    const auto open = stat.find('('), close = stat.rfind(')');
+    if (open == std::string::npos || close == std::string::npos || close < open) continue;
+    const auto name = stat.substr(open + 1, close - open - 1);
+    if (!counts(name)) continue;
+    auto& program = by_name[name];
+    program.seconds += internal::stat_cpu_seconds(stat);
+    ++program.processes;
+  }
+  return by_name;
 }
 
 /// CPU-seconds every core of the machine has spent busy since it started (/proc/stat: user,

@@ -7,14 +7,18 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <regex>
 #include <thread>
+#include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <CLI/CLI.hpp>
 #include <oscar/command_line.hpp>
 
@@ -152,7 +156,44 @@ struct Figures {
   /// The machine's busy CPU-seconds from boot's start until the bench saw it report running
   /// (within 50 ms): every process of the system on every test host, and whatever else runs.
   std::vector<double> machine_cpu_s;
+  /// At the same moment, what each program of the system had used since its processes started.
+  std::vector<std::map<std::string, oscar::test::ProgramCpu>> programs;
 };
+
+// The programs of a booted system and the ssh connections to its hosts, by process name (the
+// benchmark itself is not one of them).
+bool part_of_the_boot(const std::string& name) {
+  return (name.starts_with("oscar-") && !name.starts_with("oscar-bench")) || name == "ssh" ||
+         name == "sshd";
+}
+
+// A program's share of the boots: the p50 over the runs of its CPU-seconds at running (0 in a
+// run without it), and the most processes it had.
+struct ProgramFigure {
+  std::string name;
+  double cpu_s_p50 = 0;
+  int processes = 0;
+};
+
+// The costliest first.
+std::vector<ProgramFigure> program_figures(const Figures& f) {
+  std::map<std::string, int> processes;
+  for (const auto& run : f.programs) {
+    for (const auto& [name, cpu] : run) processes[name] = std::max(processes[name], cpu.processes);
+  }
+  std::vector<ProgramFigure> out;
+  for (const auto& [name, most] : processes) {
+    std::vector<double> seconds;
+    for (const auto& run : f.programs) {
+      const auto it = run.find(name);
+      seconds.push_back(it == run.end() ? 0.0 : it->second.seconds);
+    }
+    out.push_back({name, percentile(seconds, 0.5), most});
+  }
+  std::sort(out.begin(), out.end(),
+            [](const auto& a, const auto& b) { return a.cpu_s_p50 > b.cpu_s_p50; });
+  return out;
+}
 
 // One boot: the time boot reports to `running`, then one module's restart (the last sink),
 // then Ctrl-C.
@@ -178,6 +219,7 @@ void run_once(const Options& o, const Hosts& hosts, const std::string& file,
     if (std::regex_search(out, m, running)) {
       f.boot_ms.push_back(std::stod(m[1]));
       f.machine_cpu_s.push_back(oscar::test::machine_busy_cpu_seconds() - busy_before);
+      f.programs.push_back(oscar::test::cpu_by_program(part_of_the_boot));
       break;
     }
     if (boot.wait(0ms) || std::chrono::steady_clock::now() > until) {
@@ -199,6 +241,13 @@ void run_once(const Options& o, const Hosts& hosts, const std::string& file,
   std::filesystem::remove(log);  // kept after a failure
   std::fprintf(stderr, "run %d/%d: running after %.0f ms; %s running again %.0f ms after kill -9\n",
                run + 1, o.runs, f.boot_ms.back(), restarted.c_str(), f.restart_ms.back());
+}
+
+std::string program_json(const std::vector<ProgramFigure>& programs) {
+  std::vector<std::string> entries;
+  for (const auto& p : programs)
+    entries.push_back(fmt::format("\"{}\":{:.2f}", p.name, p.cpu_s_p50));
+  return fmt::format("{}", fmt::join(entries, ","));
 }
 
 }  // namespace
@@ -252,16 +301,18 @@ int main(int argc, char** argv) {
     for (int run = 0; run < o.runs; ++run) run_once(o, hosts, file, keystore, run, f);
     if (!keystore.empty()) std::filesystem::remove_all(keystore);
     const char* discovery = o.discovery_server ? "server" : "static";
+    const auto programs = program_figures(f);
     if (json) {
       std::printf(
           "{\"hosts\":%d,\"modules\":%d,\"ssh\":%s,\"discovery\":\"%s\",\"security\":%s,\"boot_ms_"
           "p50\":%.0f,"
           "\"boot_ms_max\":%.0f,\"restart_ms_p50\":%.0f,\"runs\":%d,"
-          "\"machine_cpu_s_until_running_p50\":%.1f,\"cores\":%ld,\"shm_segment_bytes\":%u}\n",
+          "\"machine_cpu_s_until_running_p50\":%.1f,\"cores\":%ld,\"shm_segment_bytes\":%u,"
+          "\"program_cpu_s_at_running_p50\":{%s}}\n",
           o.hosts, o.modules, o.ssh ? "true" : "false", discovery, o.security ? "true" : "false",
           percentile(f.boot_ms, 0.5), percentile(f.boot_ms, 1.0), percentile(f.restart_ms, 0.5),
           o.runs, percentile(f.machine_cpu_s, 0.5), sysconf(_SC_NPROCESSORS_ONLN),
-          o.shm_segment_bytes);
+          o.shm_segment_bytes, program_json(programs).c_str());
     } else {
       std::printf(
           "oscar bench boot: %d modules on %d host%s%s, %s discovery%s, lease %s, %d runs\n",
@@ -272,6 +323,11 @@ int main(int argc, char** argv) {
       std::printf(
           "  CPU the machine spent until then (all its %ld cores, every process): p50 %.1f s\n",
           sysconf(_SC_NPROCESSORS_ONLN), percentile(f.machine_cpu_s, 0.5));
+      std::printf("  of it, by program (p50; its processes):");
+      for (const auto& p : programs) {
+        std::printf(" %s %.2f s (%d)", p.name.c_str(), p.cpu_s_p50, p.processes);
+      }
+      std::printf("\n");
       std::printf("  restart of one module (kill -9 to running): p50 %.0f ms\n",
                   percentile(f.restart_ms, 0.5));
     }
