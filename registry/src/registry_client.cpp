@@ -131,6 +131,19 @@ std::string where_systems_run(int domain) {
          "-d DOMAIN, $OSCAR_DOMAIN or --system FILE)";
 }
 
+std::string why_no_state(const RegistryClient& client, int domain, std::chrono::milliseconds wait) {
+  const double seconds = std::chrono::duration<double>(wait).count();
+  if (client.registry_found()) {
+    // current_state() gave a registry it found as long again.
+    return fmt::format(
+        "the registry on domain {} sent no state within {:.1f} s (is it hung? its log is "
+        "registry.log in the system's log folder)",
+        domain, 2 * seconds);
+  }
+  return fmt::format("no registry answered on domain {} within {:.1f} s{}", domain, seconds,
+                     where_systems_run(domain));
+}
+
 std::unique_ptr<DdsParticipant> tool_participant(const std::string& name, std::string system_file,
                                                  const std::string& host, int domain,
                                                  ToolAuthority authority) {

@@ -154,19 +154,11 @@ int main(int argc, char** argv) {
     auto participant = tool.participant("oscar-ps");
     HostClocks host_clocks(*participant);
     oscar::RegistryClient client(*participant, "ps");
-    const auto s =
-        client.current_state(std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));
-    if (!s && client.registry_found()) {
-      std::fprintf(stderr,
-                   "oscar ps: the registry on domain %d sent no state within %.1f s (is it hung? "
-                   "its log is registry.log in the system's log folder)\n",
-                   participant->domain(), 2 * timeout_s);
-      return 1;
-    }
+    const std::chrono::milliseconds wait(static_cast<long>(timeout_s * 1000));
+    const auto s = client.current_state(wait);
     if (!s) {
-      std::fprintf(stderr, "oscar ps: no registry answered on domain %d within %.1f s%s\n",
-                   participant->domain(), timeout_s,
-                   oscar::where_systems_run(participant->domain()).c_str());
+      fmt::print(stderr, "oscar ps: {}\n",
+                 oscar::why_no_state(client, participant->domain(), wait));
       return 1;
     }
     // The monitors' writers may be discovered a little after the registry's.

@@ -108,18 +108,11 @@ int main(int argc, char** argv) {
   try {
     auto participant = tool.participant("oscar-graph");
     oscar::RegistryClient client(*participant, "graph");
-    const auto s =
-        client.current_state(std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));
-    if (!s && client.registry_found()) {
-      fmt::print(stderr,
-                 "oscar graph: the registry on domain {} sent no state within {} s (is it hung? "
-                 "its log is registry.log in the system's log folder)\n",
-                 participant->domain(), 2 * timeout_s);
-      return 1;
-    }
+    const std::chrono::milliseconds wait(static_cast<long>(timeout_s * 1000));
+    const auto s = client.current_state(wait);
     if (!s) {
-      fmt::print(stderr, "oscar graph: no registry answered on domain {} within {} s{}\n",
-                 participant->domain(), timeout_s, oscar::where_systems_run(participant->domain()));
+      fmt::print(stderr, "oscar graph: {}\n",
+                 oscar::why_no_state(client, participant->domain(), wait));
       return 1;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<long>(discovery_s * 1000)));

@@ -61,6 +61,10 @@ std::optional<RunningSystem> default_system();
 /// how to name one, or that none was, e.g. " (running on this machine: ...; name one with -d)".
 std::string where_systems_run(int domain);
 
+/// Why `client.current_state(wait)` gave no state, for a tool's error line: a registry it found
+/// sent none (is it hung?), or no registry answered on `domain` at all (with where_systems_run()).
+std::string why_no_state(const RegistryClient& client, int domain, std::chrono::milliseconds wait);
+
 /// What a command-line tool may do in a secured system (docs/security.md): look (the
 /// `operator` identity, which may write nothing) or act with boot's authority
 /// (`operator_boot`: configure modules, ask the registry to restart or shut down).
