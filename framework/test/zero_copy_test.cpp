@@ -23,6 +23,7 @@
 
 #include "oscar/cue_types.hpp"
 #include "private_tmp.hpp"
+#include "proc.hpp"
 #include "process.hpp"
 #include "zero_copy/chunk_identity.hpp"
 #include "zero_copy/cue_path.hpp"
@@ -350,6 +351,8 @@ TEST_P(ZeroCopyPortRequest, EndsTheProcessWhenTheRouDiAskedGoesAwayWithoutAnswer
   ::unsetenv("OSCAR_PEER_PORTS_AFTER");
   ASSERT_TRUE(eventually([&] { return asking.printed("joined"); })) << asking.process.output();
   ::kill(roudi->pid(), SIGSTOP);
+  // Asked before RouDi has really stopped, it would still answer.
+  ASSERT_TRUE(eventually([&] { return oscar::test::stopped(roudi->pid()); }));
   std::ofstream("/tmp/go");
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   EXPECT_FALSE(asking.process.wait(std::chrono::milliseconds(0)))

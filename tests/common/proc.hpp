@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 namespace oscar::test {
@@ -28,6 +29,22 @@ inline std::vector<long> listed_pids() {
     if (name.find_first_not_of("0123456789") == std::string::npos) pids.push_back(std::stol(name));
   }
   return pids;
+}
+
+/// Whether every thread of process `pid` has stopped (state 'T', e.g. after SIGSTOP). kill()
+/// returns before the signal took effect: a thread that was running may go on for a moment.
+inline bool stopped(long pid) {
+  std::error_code error;
+  const auto tasks = "/proc/" + std::to_string(pid) + "/task";
+  bool any = false;
+  for (const auto& task : std::filesystem::directory_iterator(tasks, error)) {
+    const auto stat = proc_file(pid, ("task/" + task.path().filename().string() + "/stat").c_str());
+    const auto state = stat.rfind(") ");
+    if (state == std::string::npos || state + 2 >= stat.size() || stat[state + 2] != 'T')
+      return false;
+    any = true;
+  }
+  return any && !error;
 }
 
 }  // namespace oscar::test
