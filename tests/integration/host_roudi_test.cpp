@@ -168,6 +168,7 @@ TEST_F(HostRoudi, AHungRouDiIsKilledAndStartedAgain) {
   std::this_thread::sleep_for(4s);  // longer than the 3 s: an idle RouDi does not count as hung
   EXPECT_FALSE(monitor_said("hangs")) << monitor.output();
   ::kill(static_cast<pid_t>(first.front()), SIGSTOP);
+  ASSERT_TRUE(eventually([&] { return test::stopped(first.front()); }));  // kill() returns first
   // A module started meanwhile waits for RouDi's answer to its registration.
   auto module = test::run_module(
       "plain_src", {"-k", "bench_source:src", "-p", "src.type=PlainBool", "-m", "continuous:20ms"});
