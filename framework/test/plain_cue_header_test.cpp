@@ -48,17 +48,17 @@ TEST(PlainCueHeader, PublishingSetsSeqAndSourceAndTheGenerationStampOnlyIfThereI
   EXPECT_EQ(info.header.max_source_length, 63u);
   auto cue = std::make_unique<PlainGvImage>();
   cue->header().source().fill('x');  // what was there is replaced, NUL-terminated
-  info.header.complete(cue.get(), 7, "cam/image", 1234);
+  info.header.complete(cue.get(), 7, "cam/image", [] { return 1234; });
   auto h = info.header.read(cue.get());
   EXPECT_EQ(h.seq(), 7u);
   EXPECT_EQ(h.source(), "cam/image");
   EXPECT_EQ(h.stamps(), (std::vector<std::uint64_t>{1234}));
   append_stamp(cue->header(), 2000);
-  info.header.complete(cue.get(), 8, "cam/image", 5678);
+  info.header.complete(cue.get(), 8, "cam/image", [] { return 5678; });
   EXPECT_EQ(info.header.read(cue.get()).stamps(), (std::vector<std::uint64_t>{1234, 2000}))
       << "the kernel's stamps stay";
   const std::string longest(63, 's');
-  info.header.complete(cue.get(), 9, longest, 1);
+  info.header.complete(cue.get(), 9, longest, [] { return 1; });
   EXPECT_EQ(info.header.read(cue.get()).source(), longest);
   EXPECT_EQ(cue->header().source()[63], '\0');
 }

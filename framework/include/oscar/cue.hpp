@@ -4,6 +4,7 @@
 #include <concepts>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -56,10 +57,11 @@ struct CueHeaderAccess {
   std::int64_t (*generation_stamp)(const void* cue) = nullptr;
   /// The stamps, source and seq as a CueHeader value (a copy): what raw inputs and tools read.
   CueHeader (*read)(const void* cue) = nullptr;
-  /// On publish: sets seq and source, and `stamp` as the generation stamp if there is none.
-  /// The source must fit (max_source_length; outputs check it when they are declared).
+  /// On publish: sets seq and source, then reads `clock` for the generation stamp if there is
+  /// none: last, so that the stamp says when the cue was complete. The source must fit
+  /// (max_source_length; outputs check it when they are declared).
   void (*complete)(void* cue, std::uint64_t seq, const std::string& source,
-                   std::int64_t stamp) = nullptr;
+                   const std::function<std::int64_t()>& clock) = nullptr;
   /// The longest source ("<kernel>/<channel>") the header holds.
   std::size_t max_source_length = std::numeric_limits<std::size_t>::max();
 };
@@ -122,10 +124,10 @@ struct CueHeaderForm<CueHeader> {
   static std::size_t stamp_count(const CueHeader& h) { return h.stamps().size(); }
   static CueHeader read(const CueHeader& h) { return h; }
   static void complete(CueHeader& h, std::uint64_t seq, const std::string& source,
-                       std::int64_t stamp) {
+                       const std::function<std::int64_t()>& clock) {
     h.seq(seq);
     h.source(source);
-    if (h.stamps().empty()) append_stamp(h, stamp);
+    if (h.stamps().empty()) append_stamp(h, clock());
   }
 };
 

@@ -23,8 +23,9 @@ CueHeaderAccess cue_header_access() {
         return Form::read(static_cast<const T*>(cue)->header());
       },
       .complete =
-          [](void* cue, std::uint64_t seq, const std::string& source, std::int64_t stamp) {
-            Form::complete(static_cast<T*>(cue)->header(), seq, source, stamp);
+          [](void* cue, std::uint64_t seq, const std::string& source,
+             const std::function<std::int64_t()>& clock) {
+            Form::complete(static_cast<T*>(cue)->header(), seq, source, clock);
           },
       .max_source_length = Form::kMaxSourceLength,
   };

@@ -76,10 +76,10 @@ struct CueHeaderForm<PlainCueHeader> {
     return out;
   }
   static void complete(PlainCueHeader& h, std::uint64_t seq, const std::string& source,
-                       std::int64_t stamp) {
+                       const std::function<std::int64_t()>& clock) {
     h.seq(seq);
     set_source(h, source);
-    if (h.stamp_count() == 0) append_stamp(h, stamp);
+    if (h.stamp_count() == 0) append_stamp(h, clock());
   }
 };
 

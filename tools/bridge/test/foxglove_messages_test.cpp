@@ -97,7 +97,7 @@ TEST(FoxgloveMessages, AnImageWhosePixelsDoNotFillItIsNotDrawn) {
 TEST(FoxgloveMessages, APlainImageIsARawImageOfItsFirstByteCountPixels) {
   auto image = std::make_unique<PlainGvImage>();  // 442 KB: not on the stack
   CueHeaderForm<PlainCueHeader>::complete(image->header(), 7, "cam_p/out",
-                                          1'700'000'000'000'000'005ull);
+                                          [] { return 1'700'000'000'000'000'005; });
   image->dx(4);
   image->dy(2);
   image->byte_count(8);
