@@ -112,21 +112,24 @@ OutputPort::OutputPort(std::string kernel, std::string name, const CueTypeInfo& 
 
 void OutputPort::publish_erased(std::shared_ptr<void> cue) {
   std::lock_guard lock(mutex_);
-  type_.header.complete(cue.get(), ++seq_, address(), clock_());
+  // The oldest cue leaves the ring before this one is stamped: freeing it (a chunk goes back to
+  // RouDi) is no part of this cue's journey. What follows the publish counts as well, for a
+  // consumer woken on this core runs only once this thread waits; it is kept short.
+  buffer_.drop_oldest_if_full();
+  type_.header.complete(cue.get(), ++seq_, address(), clock_);
   if (persisted_seq_) *persisted_seq_ = seq_;
   std::shared_ptr<const void> frozen = std::move(cue);
   if (chunks_) frozen = chunks_->publish(std::move(frozen));
-  // The cue evicted from the ring is freed at the end, after the cue is on its way.
-  const auto evicted =
-      buffer_.push(frozen, type_.header.generation_stamp(frozen.get()), wall_now());
+  buffer_.push(frozen, type_.header.generation_stamp(frozen.get()), wall_now());
   for (auto* input : consumers_) input->deliver_from(type_, frozen);
   if (remote_) remote_(frozen.get());
 }
 
 void OutputPort::forward_erased(std::shared_ptr<const void> cue) {
   std::lock_guard lock(mutex_);
+  buffer_.drop_oldest_if_full();
   if (chunks_) cue = chunks_->publish(std::move(cue));
-  const auto evicted = buffer_.push(cue, type_.header.generation_stamp(cue.get()), wall_now());
+  buffer_.push(cue, type_.header.generation_stamp(cue.get()), wall_now());
   for (auto* input : consumers_) input->deliver_from(type_, cue);
   if (remote_) remote_(cue.get());
 }

@@ -32,6 +32,13 @@ std::shared_ptr<const void> RingBuffer::push(std::shared_ptr<const void> cue, St
   return evicted;
 }
 
+std::shared_ptr<const void> RingBuffer::drop_oldest_if_full() {
+  std::lock_guard lock(mutex_);
+  if (count_ < slots_.size()) return nullptr;
+  --count_;  // the oldest is the slot the next push writes
+  return std::move(slots_[next_].cue);
+}
+
 std::size_t RingBuffer::size() const {
   std::lock_guard lock(mutex_);
   return count_;

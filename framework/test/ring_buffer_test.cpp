@@ -47,6 +47,23 @@ TEST(RingBuffer, WrapAroundKeepsTheNewestDepthCues) {
   EXPECT_THAT(values(rb.latest(2)), testing::ElementsAre(4, 5));
 }
 
+TEST(RingBuffer, DropOldestIfFullMakesRoomOnlyInAFullRing) {
+  RingBuffer rb(3);
+  fill(rb, 2);
+  EXPECT_EQ(rb.drop_oldest_if_full(), nullptr);
+  EXPECT_EQ(rb.size(), 2u);
+  rb.push(cue(3), 30, 0);
+  const auto dropped = rb.drop_oldest_if_full();
+  ASSERT_NE(dropped, nullptr);
+  EXPECT_EQ(*std::static_pointer_cast<const int>(dropped), 1);
+  EXPECT_EQ(dropped.use_count(), 1) << "the ring holds it no more";
+  EXPECT_THAT(values(rb.latest(10)), testing::ElementsAre(2, 3));
+  EXPECT_EQ(rb.push(cue(4), 40, 0), nullptr) << "room was made: nothing to evict";
+  EXPECT_THAT(values(rb.latest(10)), testing::ElementsAre(2, 3, 4));
+  EXPECT_EQ(value(*rb.wait_next(2, std::chrono::milliseconds(0))), 3);
+  EXPECT_EQ(rb.pushed(), 4u);
+}
+
 TEST(RingBuffer, AtOrBeforeFindsTheNewestNotAfterT) {
   RingBuffer rb(3);
   fill(rb, 5);  // holds 30, 40, 50

@@ -37,6 +37,9 @@ class RingBuffer {
   /// the caller chooses when it is freed (a large cue's free can cost a system call, which a
   /// publisher should not pay between stamping a cue and sending it).
   std::shared_ptr<const void> push(std::shared_ptr<const void> cue, Stamp t, Stamp received);
+  /// Makes room for the next push: if the ring is full, drops its oldest entry and returns that
+  /// cue (else nullptr), so that a publisher frees it before it stamps the next cue.
+  std::shared_ptr<const void> drop_oldest_if_full();
 
   std::size_t depth() const { return slots_.size(); }
   std::size_t size() const;
