@@ -58,8 +58,10 @@ std::shared_ptr<void> OutputChunks::loan() {
 std::shared_ptr<const void> OutputChunks::publish(std::shared_ptr<const void> cue) {
   std::lock_guard lock(publisher_->mutex);
   // Until RouDi has connected the output's own subscriber, a published chunk could not be taken
-  // back: the cue stays the output's, and the host's other processes get a copy.
-  const bool take_back = own_.subscribed();
+  // back: the cue stays the output's, and the host's other processes get a copy. Once connected
+  // it stays so (a process whose RouDi goes away ends), and is not asked again.
+  if (!own_subscribed_) own_subscribed_ = own_.subscribed();
+  const bool take_back = own_subscribed_;
   auto* loan = std::get_deleter<ReturnLoan>(cue);
   void* chunk = nullptr;
   if (take_back && loan && loan->publisher == publisher_ && cue.use_count() == 1) {

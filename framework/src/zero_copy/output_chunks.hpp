@@ -33,6 +33,7 @@ class OutputChunks final : public CueChunks {
   ChunkSubscriber own_;
   const CueTypeInfo& type_;
   std::string topic_;
+  bool own_subscribed_ = false;  // under the publisher's mutex, as exhausted_said_
   bool exhausted_said_ = false;
 };
 
