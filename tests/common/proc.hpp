@@ -37,8 +37,10 @@ inline bool stopped(long pid) {
   std::error_code error;
   const auto tasks = "/proc/" + std::to_string(pid) + "/task";
   bool any = false;
-  for (const auto& task : std::filesystem::directory_iterator(tasks, error)) {
-    const auto stat = proc_file(pid, ("task/" + task.path().filename().string() + "/stat").c_str());
+  for (std::filesystem::directory_iterator task(tasks, error), end; !error && task != end;
+       task.increment(error)) {  // a process that ends meanwhile is an error, not an exception
+    const auto stat =
+        proc_file(pid, ("task/" + task->path().filename().string() + "/stat").c_str());
     const auto state = stat.rfind(") ");
     if (state == std::string::npos || state + 2 >= stat.size() || stat[state + 2] != 'T')
       return false;
