@@ -21,14 +21,19 @@ RingBuffer::RingBuffer(std::size_t depth) : slots_(depth) {
 std::shared_ptr<const void> RingBuffer::push(std::shared_ptr<const void> cue, Stamp t,
                                              Stamp received) {
   std::shared_ptr<const void> evicted;
+  bool waited_for = false;
   {
     std::lock_guard lock(mutex_);
     evicted = std::move(slots_[next_].cue);
     slots_[next_] = RingEntry{std::move(cue), t, received, ++pushed_};
     next_ = (next_ + 1) % slots_.size();
     count_ = std::min(count_ + 1, slots_.size());
+    waited_for = waiting_ > 0;
   }
-  arrived_.notify_all();
+  // Skipped without waiters: every push of a publisher runs here between a cue's stamp and its
+  // delivery, and even an empty notify_all() is a call into code the cue's payload has pushed
+  // out of the cache.
+  if (waited_for) arrived_.notify_all();
   return evicted;
 }
 
@@ -107,9 +112,10 @@ std::vector<RingEntry> RingBuffer::range(Stamp t0, Stamp t1) const {
 std::optional<RingEntry> RingBuffer::wait_next(std::uint64_t after_index,
                                                std::chrono::nanoseconds timeout) const {
   std::unique_lock lock(mutex_);
-  if (!arrived_.wait_for(lock, timeout, [&] { return pushed_ > after_index; })) {
-    return std::nullopt;
-  }
+  ++waiting_;  // under the lock until wait_for() releases it: no push can slip in unnoticed
+  const bool arrived = arrived_.wait_for(lock, timeout, [&] { return pushed_ > after_index; });
+  --waiting_;
+  if (!arrived) return std::nullopt;
   for (const auto& e : held_locked()) {
     if (e.index > after_index) return e;
   }

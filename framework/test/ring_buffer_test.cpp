@@ -110,16 +110,39 @@ TEST(RingBuffer, WaitNextReturnsTheNextUnseenCue) {
   EXPECT_FALSE(rb.wait_next(second->index, std::chrono::milliseconds(1)));
 }
 
+// Woken by the push, not found when the wait timed out: a push skips the wake-up when nobody
+// waits, so these check it is not skipped when someone does.
+constexpr auto kLongWait = std::chrono::seconds(60);
+
 TEST(RingBuffer, WaitNextWakesWhenACueArrives) {
   RingBuffer rb(2);
   std::thread producer([&] {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     rb.push(cue(7), 70, 0);
   });
-  auto e = rb.wait_next(0, std::chrono::seconds(10));
+  const auto start = std::chrono::steady_clock::now();
+  auto e = rb.wait_next(0, kLongWait);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, kLongWait / 2) << "woken, not timed out";
   producer.join();
   ASSERT_TRUE(e);
   EXPECT_EQ(value(*e), 7);
+}
+
+TEST(RingBuffer, OnePushWakesEveryWaiter) {
+  RingBuffer rb(2);
+  std::atomic<int> woken{0};
+  std::vector<std::thread> waiters;
+  for (int i = 0; i < 3; ++i) {
+    waiters.emplace_back([&] {
+      const auto start = std::chrono::steady_clock::now();
+      const auto e = rb.wait_next(0, kLongWait);
+      if (e && value(*e) == 7 && std::chrono::steady_clock::now() - start < kLongWait / 2) ++woken;
+    });
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // most likely all wait by now
+  rb.push(cue(7), 70, 0);
+  for (auto& t : waiters) t.join();
+  EXPECT_EQ(woken, 3);
 }
 
 TEST(RingBuffer, SkipsToTheOldestHeldWhenTheNextWasEvicted) {

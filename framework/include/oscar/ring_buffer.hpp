@@ -33,9 +33,9 @@ class RingBuffer {
   /// @throws std::invalid_argument if depth is 0.
   explicit RingBuffer(std::size_t depth);
 
-  /// Stores a cue, evicting the oldest when full; wakes waiters. Returns the evicted cue (nullptr
-  /// if none). A publisher calls drop_oldest_if_full() before it stamps the cue instead, so that
-  /// nothing is freed between the stamp and the cue's delivery.
+  /// Stores a cue, evicting the oldest when full; wakes waiters (if any). Returns the evicted cue
+  /// (nullptr if none). A publisher calls drop_oldest_if_full() before it stamps the cue instead,
+  /// so that nothing is freed between the stamp and the cue's delivery.
   std::shared_ptr<const void> push(std::shared_ptr<const void> cue, Stamp t, Stamp received);
   /// Makes room for the next push: if the ring is full, drops its oldest entry and returns that
   /// cue (else nullptr), so that a publisher frees it before it stamps the next cue.
@@ -72,6 +72,7 @@ class RingBuffer {
   std::size_t next_ = 0;   // slot the next push writes
   std::size_t count_ = 0;  // entries held
   std::uint64_t pushed_ = 0;
+  mutable std::size_t waiting_ = 0;  // threads in wait_next(): a push wakes only if there are any
 };
 
 }  // namespace oscar
