@@ -37,22 +37,23 @@ InputPort::InputPort(std::string kernel, std::string name, const CueTypeInfo& ty
       reliability_(options.reliability),
       buffer_(options.depth) {}
 
-void InputPort::deliver(std::shared_ptr<const void> cue) {
-  const Stamp t = type_.header.generation_stamp(cue.get());
-  buffer_.push(std::move(cue), t, wall_now());
+bool InputPort::takes_any_type() const { return &type_ == &raw_cue_type(); }
+
+void InputPort::deliver_from(const CueTypeInfo& producer, std::shared_ptr<const void> cue) {
+  const Stamp generated = producer.header.generation_stamp(cue.get());
+  deliver_from(producer, std::move(cue), generated);
+}
+
+void InputPort::deliver_from(const CueTypeInfo& producer, std::shared_ptr<const void> cue,
+                             Stamp generated) {
+  if (takes_any_type() && &producer != &type_) cue = to_raw_cue(producer, cue.get());
+  buffer_.push(std::move(cue), generated, wall_now());
   std::function<void()> hook;
   {
     std::lock_guard lock(hooks_mutex_);
     hook = arrival_hook_;
   }
   if (hook) hook();
-}
-
-bool InputPort::takes_any_type() const { return &type_ == &raw_cue_type(); }
-
-void InputPort::deliver_from(const CueTypeInfo& producer, std::shared_ptr<const void> cue) {
-  if (takes_any_type() && &producer != &type_) cue = to_raw_cue(producer, cue.get());
-  deliver(std::move(cue));
 }
 
 void InputPort::set_arrival_hook(std::function<void()> hook) {
@@ -116,21 +117,26 @@ void OutputPort::publish_erased(std::shared_ptr<void> cue) {
   // RouDi) is no part of this cue's journey. What follows the publish counts as well, for a
   // consumer woken on this core runs only once this thread waits; it is kept short.
   buffer_.drop_oldest_if_full();
-  type_.header.complete(cue.get(), ++seq_, address(), clock_);
+  const Stamp generated = type_.header.complete(cue.get(), ++seq_, address(), clock_);
   if (persisted_seq_) *persisted_seq_ = seq_;
   std::shared_ptr<const void> frozen = std::move(cue);
   if (chunks_) frozen = chunks_->publish(std::move(frozen));
-  buffer_.push(frozen, type_.header.generation_stamp(frozen.get()), wall_now());
-  for (auto* input : consumers_) input->deliver_from(type_, frozen);
-  if (remote_) remote_(frozen.get());
+  hand_over(frozen, generated);
 }
 
 void OutputPort::forward_erased(std::shared_ptr<const void> cue) {
   std::lock_guard lock(mutex_);
   buffer_.drop_oldest_if_full();
+  const Stamp generated = type_.header.generation_stamp(cue.get());
   if (chunks_) cue = chunks_->publish(std::move(cue));
-  buffer_.push(cue, type_.header.generation_stamp(cue.get()), wall_now());
-  for (auto* input : consumers_) input->deliver_from(type_, cue);
+  hand_over(cue, generated);
+}
+
+// After the stamp every step counts toward the cue's latency, on a cold cache after a large cue
+// was written: the generation stamp is passed along, not read back from the header.
+void OutputPort::hand_over(const std::shared_ptr<const void>& cue, Stamp generated) {
+  buffer_.push(cue, generated, wall_now());
+  for (auto* input : consumers_) input->deliver_from(type_, cue, generated);
   if (remote_) remote_(cue.get());
 }
 

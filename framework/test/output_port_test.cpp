@@ -7,6 +7,7 @@
 
 #include "oscar/cue_type_info.hpp"
 #include "oscar/cue_types.hpp"
+#include "oscar/input.hpp"
 #include "oscar/output.hpp"
 
 namespace oscar {
@@ -47,6 +48,29 @@ TEST(OutputPort, FreesTheCueItsRingEvictsBeforeItStampsTheNext) {
   EXPECT_TRUE(read);
   EXPECT_EQ(out.buffer().size(), 2u);
   EXPECT_EQ(out.buffer().pushed(), 3u);
+}
+
+TEST(OutputPort, GivesItsRingAndItsInputsTheStampItCompletedTheHeaderWith) {
+  OutputPort out("src", "out", cue_type_info<Bool>(), OutputOptions{});
+  InputPort in("dst", "in", cue_type_info<Bool>(), InputOptions{});
+  out.connect(&in);
+  out.set_clock([] { return Stamp{42}; });
+  out.publish_erased(std::make_shared<Bool>());
+  EXPECT_EQ(out.buffer().latest()->t, 42);
+  EXPECT_EQ(in.buffer().latest()->t, 42);
+
+  auto stamped = std::make_shared<Bool>();
+  append_stamp(stamped->header(), 7);  // a kernel's own generation stamp
+  append_stamp(stamped->header(), 9);
+  out.publish_erased(std::move(stamped));
+  EXPECT_EQ(out.buffer().latest()->t, 7);
+  EXPECT_EQ(in.buffer().latest()->t, 7);
+
+  auto replayed = std::make_shared<Bool>();
+  append_stamp(replayed->header(), 99);
+  out.forward_erased(std::move(replayed));
+  EXPECT_EQ(out.buffer().latest()->t, 99);
+  EXPECT_EQ(in.buffer().latest()->t, 99);
 }
 
 }  // namespace

@@ -58,10 +58,11 @@ struct CueHeaderAccess {
   /// The stamps, source and seq as a CueHeader value (a copy): what raw inputs and tools read.
   CueHeader (*read)(const void* cue) = nullptr;
   /// On publish: sets seq and source, then reads `clock` for the generation stamp if there is
-  /// none: last, so that the stamp says when the cue was complete. The source must fit
-  /// (max_source_length; outputs check it when they are declared).
-  void (*complete)(void* cue, std::uint64_t seq, const std::string& source,
-                   const std::function<std::int64_t()>& clock) = nullptr;
+  /// none: last, so that the stamp says when the cue was complete. Returns the generation stamp
+  /// (the clock's, or the one the kernel set), so that the output need not read it back. The
+  /// source must fit (max_source_length; outputs check it when they are declared).
+  std::int64_t (*complete)(void* cue, std::uint64_t seq, const std::string& source,
+                           const std::function<std::int64_t()>& clock) = nullptr;
   /// The longest source ("<kernel>/<channel>") the header holds.
   std::size_t max_source_length = std::numeric_limits<std::size_t>::max();
 };
@@ -123,11 +124,14 @@ struct CueHeaderForm<CueHeader> {
   static std::int64_t generation_stamp(const CueHeader& h) { return oscar::generation_stamp(h); }
   static std::size_t stamp_count(const CueHeader& h) { return h.stamps().size(); }
   static CueHeader read(const CueHeader& h) { return h; }
-  static void complete(CueHeader& h, std::uint64_t seq, const std::string& source,
-                       const std::function<std::int64_t()>& clock) {
+  static std::int64_t complete(CueHeader& h, std::uint64_t seq, const std::string& source,
+                               const std::function<std::int64_t()>& clock) {
     h.seq(seq);
     h.source(source);
-    if (h.stamps().empty()) append_stamp(h, clock());
+    if (!h.stamps().empty()) return generation_stamp(h);
+    const std::int64_t now = clock();
+    append_stamp(h, now);
+    return now;
   }
 };
 

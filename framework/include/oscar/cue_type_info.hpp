@@ -22,11 +22,10 @@ CueHeaderAccess cue_header_access() {
       .read = [](const void* cue) -> CueHeader {
         return Form::read(static_cast<const T*>(cue)->header());
       },
-      .complete =
-          [](void* cue, std::uint64_t seq, const std::string& source,
-             const std::function<std::int64_t()>& clock) {
-            Form::complete(static_cast<T*>(cue)->header(), seq, source, clock);
-          },
+      .complete = [](void* cue, std::uint64_t seq, const std::string& source,
+                     const std::function<std::int64_t()>& clock) -> std::int64_t {
+        return Form::complete(static_cast<T*>(cue)->header(), seq, source, clock);
+      },
       .max_source_length = Form::kMaxSourceLength,
   };
 }

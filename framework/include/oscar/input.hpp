@@ -116,12 +116,13 @@ class InputPort {
   RingBuffer& buffer() { return buffer_; }
   const RingBuffer& buffer() const { return buffer_; }
 
-  /// Stores an arriving cue of the input's type (stamping its receive time) and runs the arrival
-  /// hook.
-  void deliver(std::shared_ptr<const void> cue);
-  /// Delivers a cue of the producer's type `producer`: a raw input gets it as RawCue, serialized
-  /// (raw_cue.hpp); any other input gets it as it is (the types were checked when wiring).
+  /// Delivers a cue of the producer's type `producer`: stores it, stamped with its receive time,
+  /// and runs the arrival hook. A raw input gets it as RawCue, serialized (raw_cue.hpp); any
+  /// other input gets it as it is (the types were checked when wiring).
   void deliver_from(const CueTypeInfo& producer, std::shared_ptr<const void> cue);
+  /// The same for a cue whose generation stamp the caller holds: an output of this process that
+  /// has just completed the cue's header, so that the header is not read again on the way.
+  void deliver_from(const CueTypeInfo& producer, std::shared_ptr<const void> cue, Stamp generated);
   /// Called after every delivery, on the delivering thread (the frame triggers kernels with it).
   void set_arrival_hook(std::function<void()> hook);
   void set_pull_source(std::shared_ptr<PullSource> source);

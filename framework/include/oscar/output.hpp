@@ -75,6 +75,9 @@ class OutputPort {
   void persist_sequence(std::uint64_t* counter);
 
  private:
+  // Stores the cue in the ring and hands it on; called with mutex_ held.
+  void hand_over(const std::shared_ptr<const void>& cue, Stamp generated);
+
   std::string kernel_, name_;
   const CueTypeInfo& type_;
   OutputOptions options_;

@@ -75,11 +75,14 @@ struct CueHeaderForm<PlainCueHeader> {
     out.seq(h.seq());
     return out;
   }
-  static void complete(PlainCueHeader& h, std::uint64_t seq, const std::string& source,
-                       const std::function<std::int64_t()>& clock) {
+  static std::int64_t complete(PlainCueHeader& h, std::uint64_t seq, const std::string& source,
+                               const std::function<std::int64_t()>& clock) {
     h.seq(seq);
     set_source(h, source);
-    if (h.stamp_count() == 0) append_stamp(h, clock());
+    if (h.stamp_count() != 0) return generation_stamp(h);
+    const std::int64_t now = clock();
+    append_stamp(h, now);
+    return now;
   }
 };
 
