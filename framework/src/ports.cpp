@@ -35,9 +35,10 @@ InputPort::InputPort(std::string kernel, std::string name, const CueTypeInfo& ty
       type_(type),
       transfer_(options.transfer),
       reliability_(options.reliability),
+      takes_any_type_(&type == &raw_cue_type()),
       buffer_(options.depth) {}
 
-bool InputPort::takes_any_type() const { return &type_ == &raw_cue_type(); }
+bool InputPort::takes_any_type() const { return takes_any_type_; }
 
 void InputPort::deliver_from(const CueTypeInfo& producer, std::shared_ptr<const void> cue) {
   const Stamp generated = producer.header.generation_stamp(cue.get());
@@ -46,19 +47,20 @@ void InputPort::deliver_from(const CueTypeInfo& producer, std::shared_ptr<const 
 
 void InputPort::deliver_from(const CueTypeInfo& producer, std::shared_ptr<const void> cue,
                              Stamp generated) {
-  if (takes_any_type() && &producer != &type_) cue = to_raw_cue(producer, cue.get());
+  if (takes_any_type_ && &producer != &type_) cue = to_raw_cue(producer, cue.get());
   buffer_.push(std::move(cue), generated, wall_now());
-  std::function<void()> hook;
+  std::shared_ptr<const std::function<void()>> hook;
   {
     std::lock_guard lock(hooks_mutex_);
     hook = arrival_hook_;
   }
-  if (hook) hook();
+  if (hook) (*hook)();
 }
 
 void InputPort::set_arrival_hook(std::function<void()> hook) {
+  auto shared = hook ? std::make_shared<const std::function<void()>>(std::move(hook)) : nullptr;
   std::lock_guard lock(hooks_mutex_);
-  arrival_hook_ = std::move(hook);
+  arrival_hook_ = std::move(shared);
 }
 
 void InputPort::set_pull_source(std::shared_ptr<PullSource> source) {

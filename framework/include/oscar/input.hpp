@@ -148,9 +148,11 @@ class InputPort {
   const CueTypeInfo& type_;
   Transfer transfer_;
   Reliability reliability_;
+  bool takes_any_type_;
   RingBuffer buffer_;
   std::mutex hooks_mutex_;
-  std::function<void()> arrival_hook_;
+  // Shared, so that a delivery copies a pointer, not the hook and what it captured.
+  std::shared_ptr<const std::function<void()>> arrival_hook_;
   std::shared_ptr<PullSource> pull_source_;
 };
 
