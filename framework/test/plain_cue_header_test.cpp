@@ -48,26 +48,22 @@ TEST(PlainCueHeader, PublishingSetsSeqAndSourceAndTheGenerationStampOnlyIfThereI
   EXPECT_EQ(info.header.max_source_length, 63u);
   auto cue = std::make_unique<PlainGvImage>();
   cue->header().source().fill('x');  // what was there is replaced, NUL-terminated
-  EXPECT_EQ(info.header.complete(cue.get(), 7, "cam/image",
-                                 [&] {
-                                   EXPECT_EQ(cue->header().seq(), 7u) << "the clock is read last";
-                                   EXPECT_EQ(source_of(cue->header()), "cam/image")
-                                       << "the clock is read last";
-                                   return 1234;
-                                 }),
-            1234);
+  const auto clock = [&] {
+    EXPECT_EQ(cue->header().seq(), 7u) << "the clock is read last";
+    EXPECT_EQ(source_of(cue->header()), "cam/image") << "the clock is read last";
+    return 1234;
+  };
+  EXPECT_EQ(info.header.complete(cue.get(), 7, "cam/image", clock), 1234);
   auto h = info.header.read(cue.get());
   EXPECT_EQ(h.seq(), 7u);
   EXPECT_EQ(h.source(), "cam/image");
   EXPECT_EQ(h.stamps(), (std::vector<std::uint64_t>{1234}));
   append_stamp(cue->header(), 2000);
-  EXPECT_EQ(info.header.complete(cue.get(), 8, "cam/image",
-                                 [] {
-                                   ADD_FAILURE()
-                                       << "a cue that has its generation stamp needs no clock";
-                                   return 5678;
-                                 }),
-            1234)
+  const auto unused_clock = [] {
+    ADD_FAILURE() << "a cue that has its generation stamp needs no clock";
+    return 5678;
+  };
+  EXPECT_EQ(info.header.complete(cue.get(), 8, "cam/image", unused_clock), 1234)
       << "the generation stamp it has";
   EXPECT_EQ(info.header.read(cue.get()).stamps(), (std::vector<std::uint64_t>{1234, 2000}))
       << "the kernel's stamps stay";
